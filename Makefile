@@ -1,0 +1,117 @@
+# One entry point. `make help` lists the targets.
+SHELL   := /bin/bash
+CC      ?= gcc
+BUILD   := build
+GEN     := $(BUILD)/gen
+VENV    := $(BUILD)/venv
+PY      := $(VENV)/bin/python
+ARMCC   := arm-none-eabi-gcc
+
+SDL_CFLAGS := $(shell sdl2-config --cflags 2>/dev/null)
+SDL_LIBS   := $(shell sdl2-config --libs 2>/dev/null)
+
+WARN     := -Wall -Wextra -Wshadow -Wstrict-prototypes -Wno-missing-field-initializers
+INC      := -Ifirmware -Ihal -Ihal/null -Ihal/sdl -Itools/bspc -Ihost
+# Firmware and HAL: freestanding, integer-only (any float or double is an error on
+# the host: -mgeneral-regs-only), no libc calls synthesised from loops.
+FW_FLAGS := -ffreestanding -mgeneral-regs-only -fno-strict-aliasing -fno-tree-loop-distribute-patterns
+BASE     := -std=c11 -g $(WARN) $(INC) -D_DEFAULT_SOURCE
+REL      := -O2
+SAN      := -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all
+
+# ---- sources -----------------------------------------------------------------
+FW_SRC    := $(sort $(wildcard firmware/*.c)) $(GEN)/fx_tables.c
+HAL_SRC   := hal/fb.c hal/perf.c
+NULL_SRC  := hal/null/hal_null.c
+SDL_SRC   := hal/sdl/hal_sdl.c
+BSPC_LIB  := $(filter-out tools/bspc/main.c,$(sort $(wildcard tools/bspc/*.c)))
+HOST_LIB  := host/png.c host/fxtext.c host/scene_file.c
+FLOATFREE := firmware/% hal/fb.c hal/perf.c hal/null/% $(GEN)/%
+
+objs = $(patsubst %.c,$(1)/%.o,$(2))
+fwflags = $(if $(filter $(FLOATFREE),$(1)),$(FW_FLAGS))
+
+# ---- variants: build/ (optimised) and build/san/ (ASan + UBSan, used by the tests)
+define variant
+$(1)/obj/%.o: %.c $(GEN)/fx_tables.c
+	@mkdir -p $$(@D)
+	$$(CC) $$(BASE) $(2) $$(call fwflags,$$<) $$(if $$(filter hal/sdl/% host/emu.c,$$<),$$(SDL_CFLAGS)) -MMD -MP -c $$< -o $$@
+$(1)/obj/$(GEN)/%.o: $(GEN)/%.c
+	@mkdir -p $$(@D)
+	$$(CC) $$(BASE) $(2) $$(FW_FLAGS) -c $$< -o $$@
+
+$(1)/bspc: $(call objs,$(1)/obj,tools/bspc/main.c $(BSPC_LIB) firmware/crc32.c)
+	$$(CC) $(2) $$^ -o $$@ -lm
+$(1)/render: $(call objs,$(1)/obj,host/render.c $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC))
+	$$(CC) $(2) $$^ -o $$@ -lm
+$(1)/emu: $(call objs,$(1)/obj,host/emu.c $(GEN)/default_scene.c $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(SDL_SRC))
+	$$(CC) $(2) $$^ -o $$@ $$(SDL_LIBS) -lm
+$(1)/test_%: $(call objs,$(1)/obj,tests/unit/test_%.c) $(call objs,$(1)/obj,$(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC) host/fxtext.c)
+	$$(CC) $(2) $$^ -o $$@ -lcmocka -lm
+endef
+$(eval $(call variant,$(BUILD),$(REL)))
+$(eval $(call variant,$(BUILD)/san,$(SAN)))
+
+UNIT_TESTS := $(patsubst tests/unit/%.c,%,$(wildcard tests/unit/test_*.c))
+PROGRAMS   := $(BUILD)/bspc $(BUILD)/render $(BUILD)/emu
+SAN_PROGS  := $(BUILD)/san/bspc $(BUILD)/san/render $(addprefix $(BUILD)/san/,$(UNIT_TESTS))
+
+# ---- generated sources ----------------------------------------------------------
+$(BUILD)/gen_tables: tools/gen_tables.c
+	@mkdir -p $(@D)
+	$(CC) -O2 $< -o $@ -lm
+$(GEN)/fx_tables.c: $(BUILD)/gen_tables
+	@mkdir -p $(@D)
+	$< > $@
+$(BUILD)/bin2c: tools/bin2c.c
+	@mkdir -p $(@D)
+	$(CC) -O2 $(BASE) $< -o $@
+$(BUILD)/default.bsc: tests/scenes/default.scene $(BUILD)/bspc
+	$(BUILD)/bspc $< -o $@
+$(GEN)/default_scene.c: $(BUILD)/default.bsc $(BUILD)/bin2c
+	$(BUILD)/bin2c default_scene $< > $@
+
+# ---- top-level targets ------------------------------------------------------------
+.PHONY: all deps run test unit pytest nofloat bench-bsp clean help
+.DEFAULT_GOAL := all
+
+all: $(PROGRAMS) nofloat
+
+help:
+	@echo "make deps       install missing Debian packages and the Python venv (idempotent)"
+	@echo "make            build build/bspc, build/render, build/emu (and check: no floating point)"
+	@echo "make run        walk the built-in scene in a window (headless: fly-through PNGs)"
+	@echo "make test       deps, build, unit tests and pytest, with ASan and UBSan"
+	@echo "make bench-bsp  bspc over all 68 Freedoom maps per strategy, beside zdbsp and glbsp"
+	@echo "make clean      remove build/"
+
+deps:
+	@tools/deps.sh
+
+run: deps all
+	$(BUILD)/emu
+
+# No floating point in firmware/ and hal/ targets, three ways: no float/double token
+# in the code (comments stripped), the host compile with -mgeneral-regs-only above,
+# and a Cortex-M soft-float compile whose objects may not need any float helper.
+NOFLOAT_SRC := $(FW_SRC) $(HAL_SRC) $(NULL_SRC) $(SDL_SRC) $(EXTRA_NOFLOAT)
+nofloat: $(GEN)/fx_tables.c
+	@tools/check_nofloat.sh $(NOFLOAT_SRC)
+
+unit: $(addprefix $(BUILD)/san/,$(UNIT_TESTS))
+	@set -e; for t in $^; do echo "== $$t"; $$t; done
+
+pytest: $(PROGRAMS) $(SAN_PROGS)
+	$(PY) -m pytest -q tests
+
+test: deps
+	@$(MAKE) --no-print-directory all unit
+	@$(MAKE) --no-print-directory pytest
+
+bench-bsp: deps $(BUILD)/bspc
+	$(PY) tools/bench_bsp.py
+
+clean:
+	rm -rf $(BUILD)/obj $(BUILD)/san $(BUILD)/gen $(PROGRAMS) $(BUILD)/*.bsc $(BUILD)/gen_tables $(BUILD)/bin2c
+
+-include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

@@ -1,0 +1,64 @@
+/* clip.c - Sutherland-Hodgman clipping of convex polygons in view space.
+ * The intersection on an edge is always computed from its inside end toward its
+ * outside end, so two polygons sharing an edge get bit-identical clipped vertices
+ * whichever way round they walk it: no cracks between neighbouring walls. */
+#include "clip.h"
+
+int64_t clip_distance(const view_xform *v, view_pt p, unsigned plane)
+{
+    switch (plane) {
+    case CLIP_NEAR: return (int64_t)p.z - VIEW_ZNEAR;
+    case CLIP_LEFT: return (int64_t)p.z + p.x;
+    case CLIP_RIGHT: return (int64_t)p.z - p.x;
+    case CLIP_TOP: return (int64_t)(VIEW_CY + v->look) * p.z - (int64_t)VIEW_FOCAL * p.y;
+    default: return (int64_t)(VIEW_CY - v->look) * p.z + (int64_t)VIEW_FOCAL * p.y;
+    }
+}
+
+/* The point where edge a->b crosses the plane, with da >= 0 > db. The parameter
+ * t = da / (da - db) is formed in 2.30 after scaling both distances below 2^31,
+ * so (b - a) * t < 2^32 * 2^30 fits in 64 bits. */
+static view_pt intersect(view_pt a, int64_t da, view_pt b, int64_t db)
+{
+    uint64_t den = (uint64_t)(da - db);
+    uint64_t num = (uint64_t)da;
+    while (den >= (1ull << 31)) {
+        den >>= 1;
+        num >>= 1;
+    }
+    int64_t t = den ? (int64_t)((num << 30) / den) : 0;
+    view_pt r;
+    r.x = a.x + (int32_t)fx_asr64(((int64_t)b.x - a.x) * t, 30);
+    r.y = a.y + (int32_t)fx_asr64(((int64_t)b.y - a.y) * t, 30);
+    r.z = a.z + (int32_t)fx_asr64(((int64_t)b.z - a.z) * t, 30);
+    return r;
+}
+
+static int clip_plane(clip_poly *p, const view_xform *v, unsigned plane)
+{
+    view_pt out[CLIP_MAX_VERTS];
+    int64_t d[CLIP_MAX_VERTS];
+    int n = p->n, m = 0, inside = 0;
+    for (int i = 0; i < n; i++) {
+        d[i] = clip_distance(v, p->v[i], plane);
+        inside += d[i] >= 0;
+    }
+    if (inside == n) return n;
+    if (inside == 0) return p->n = 0;
+    for (int i = 0; i < n && m < CLIP_MAX_VERTS - 1; i++) {
+        int j = (i + 1 == n) ? 0 : i + 1;
+        if (d[i] >= 0) out[m++] = p->v[i];
+        if ((d[i] >= 0) != (d[j] >= 0))
+            out[m++] = (d[i] >= 0) ? intersect(p->v[i], d[i], p->v[j], d[j]) : intersect(p->v[j], d[j], p->v[i], d[i]);
+    }
+    for (int i = 0; i < m; i++) p->v[i] = out[i];
+    return p->n = m;
+}
+
+int clip_polygon(clip_poly *p, const view_xform *v, unsigned mask)
+{
+    if (p->n > CLIP_MAX_VERTS - 5) p->n = 0; /* caller broke the contract: draw nothing */
+    for (unsigned plane = 1; plane <= CLIP_BOTTOM && p->n >= 3; plane <<= 1)
+        if (mask & plane) clip_plane(p, v, plane);
+    return p->n >= 3 ? p->n : 0;
+}

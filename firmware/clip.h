@@ -1,0 +1,32 @@
+/* clip.h - clipping convex view-space polygons to the view frustum (prefix clip_).
+ * Five planes: near (z >= VIEW_ZNEAR), left and right (|x| <= z, the 90-degree
+ * field of view) and top and bottom (the 200-line screen, sheared by look).
+ * After clipping, every vertex projects inside the screen rectangle. */
+#ifndef CLIP_H
+#define CLIP_H
+
+#include "view.h"
+
+enum {
+    CLIP_NEAR = 1u << 0,
+    CLIP_LEFT = 1u << 1,
+    CLIP_RIGHT = 1u << 2,
+    CLIP_TOP = 1u << 3,
+    CLIP_BOTTOM = 1u << 4,
+    CLIP_ALL = 31u
+};
+
+#define CLIP_MAX_VERTS 40 /* input polygons may have up to CLIP_MAX_VERTS - 5 vertices */
+
+typedef struct {
+    int n;
+    view_pt v[CLIP_MAX_VERTS];
+} clip_poly;
+
+/* Clip p in place against the planes in mask; returns the vertices left (0 if none). */
+int clip_polygon(clip_poly *p, const view_xform *v, unsigned mask);
+
+/* Signed distance of a view point from one plane (>= 0 inside), in 18.14 * 2^8 units. */
+int64_t clip_distance(const view_xform *v, view_pt p, unsigned plane);
+
+#endif

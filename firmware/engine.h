@@ -1,0 +1,33 @@
+/* engine.h - the firmware's entry points (prefix eng_). The target owns the main
+ * loop and calls eng_step once per frame; the engine owns no globals. */
+#ifndef ENGINE_H
+#define ENGINE_H
+
+#include <stdint.h>
+#include "camera.h"
+#include "hal.h"
+#include "render.h"
+#include "scene.h"
+
+typedef struct {
+    scene sc;
+    cam_state cam;
+    render_mode mode;
+    hal_present_mode present;
+    uint32_t frame;         /* frames rendered since eng_init */
+    render_stats stats;     /* of the last frame */
+} engine;
+
+/* Validate the compiled scene, load its palette, put the eye at the player start.
+ * Returns SCENE_OK or the loader's status (details in err, which may be NULL). */
+scene_status eng_init(engine *e, const void *blob, uint32_t len, scene_error *err);
+
+/* Render the current view into the surface for the present mode and present it.
+ * ids may be NULL. Does not call hal_frame_done. */
+void eng_render(engine *e, uint32_t *ids);
+
+/* One frame: apply input over dt milliseconds (mode and present keys included),
+ * render, present, and tell the target the frame is done. */
+void eng_step(engine *e, uint32_t input, uint32_t dt_ms);
+
+#endif

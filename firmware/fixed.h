@@ -1,0 +1,84 @@
+/* fixed.h - 16.16 fixed-point arithmetic and angle tables (prefix fx_).
+ *
+ * Owns the number formats every other part of the renderer relies on:
+ *   fx_t     signed 16.16 in an int32_t: range [-32768, 32768 - 2^-16], step 2^-16.
+ *   fx_ang_t binary angle: a full turn is 2^32, so wrap-around is free (uint32_t).
+ * Products that can exceed 32 bits go through 64-bit intermediates. Every
+ * routine saturates to [FX_MIN, FX_MAX] instead of overflowing, so no input
+ * causes undefined behaviour; the ranges over which each result is exact
+ * (correctly rounded toward negative infinity unless stated) are documented
+ * beside it and checked by tests/unit/test_fixed.c against a double reference.
+ */
+#ifndef FX_FIXED_H
+#define FX_FIXED_H
+
+#include <stdint.h>
+
+typedef int32_t fx_t;
+typedef uint32_t fx_ang_t;
+
+#define FX_SHIFT 16
+#define FX_ONE ((fx_t)1 << FX_SHIFT)
+#define FX_HALF ((fx_t)1 << (FX_SHIFT - 1))
+#define FX_MAX INT32_MAX
+#define FX_MIN INT32_MIN
+
+/* Whole number to 16.16. Exact for |i| <= 32767; saturates outside. */
+static inline fx_t fx_from_int(int32_t i)
+{
+    if (i > 32767) return FX_MAX;
+    if (i < -32768) return FX_MIN;
+    return (fx_t)((uint32_t)i << FX_SHIFT);
+}
+
+/* Floor of a 16.16 value as a whole number (arithmetic shift, defined for all inputs). */
+static inline int32_t fx_floor_int(fx_t a)
+{
+    return (a >= 0) ? (a >> FX_SHIFT) : (int32_t)(-(int64_t)((((uint64_t)(-(int64_t)a)) + 0xFFFFu) >> FX_SHIFT));
+}
+
+/* Saturate a 64-bit value into the 32-bit range. */
+static inline int32_t fx_sat32(int64_t v)
+{
+    if (v > INT32_MAX) return INT32_MAX;
+    if (v < INT32_MIN) return INT32_MIN;
+    return (int32_t)v;
+}
+
+/* Arithmetic right shift of a signed 64-bit value, floor semantics, defined for
+ * negative values (C leaves >> of negatives implementation-defined). 0 <= s < 63. */
+static inline int64_t fx_asr64(int64_t v, unsigned s)
+{
+    return (v >= 0) ? (v >> s) : -(int64_t)(((uint64_t)(-(v + 1)) >> s) + 1);
+}
+
+/* a*b in 16.16, rounded toward negative infinity. Any inputs; the result
+ * saturates when |a*b| >= 32768. */
+fx_t fx_mul(fx_t a, fx_t b);
+
+/* a/b in 16.16, truncated toward zero. b == 0 gives FX_MAX (a >= 0) or FX_MIN
+ * (a < 0); a quotient outside the 16.16 range saturates. */
+fx_t fx_div(fx_t a, fx_t b);
+
+/* 1/a in 16.16 (= fx_div(FX_ONE, a)), truncated toward zero. |a| <= 2 raw (a
+ * quotient of 2^31 or more) saturates; a == 0 gives FX_MAX. */
+fx_t fx_recip(fx_t a);
+
+/* 64-bit by 32-bit multiply-shift used by the transform: (a*b) >> s with floor
+ * semantics; a may use up to 48 significant bits and b 16.16 or 2.30. The
+ * caller guarantees |a*b| < 2^63 (documented at each use). */
+static inline int64_t fx_mul64(int64_t a, int32_t b, unsigned s)
+{
+    return fx_asr64(a * (int64_t)b, s);
+}
+
+/* Angles. fx_ang_from_deg takes degrees in 16.16 (any value: it wraps). */
+fx_ang_t fx_ang_from_deg(fx_t deg);
+/* sin/cos as 2.30 fixed point (1.0 = 1 << 30), from a 4096-entry quarter-wave
+ * table generated at build time (tools/gen_tables.c) with linear interpolation
+ * between entries: max error 2^-24 or so; exact 0 and +-1 at the quadrant angles. */
+#define FX_TRIG_SHIFT 30
+int32_t fx_sin(fx_ang_t a);
+int32_t fx_cos(fx_ang_t a);
+
+#endif

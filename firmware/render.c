@@ -1,0 +1,41 @@
+/* render.c - mode dispatch and the parts every mode shares. */
+#include "render.h"
+
+static const char *const mode_names[RENDER_MODE_COUNT] = {"painter"};
+
+const char *render_mode_name(render_mode m)
+{
+    return ((unsigned)m < RENDER_MODE_COUNT) ? mode_names[m] : "?";
+}
+
+static int str_eq(const char *a, const char *b)
+{
+    while (*a && *a == *b) a++, b++;
+    return *a == *b;
+}
+
+int render_mode_parse(const char *name)
+{
+    for (int m = 0; m < RENDER_MODE_COUNT; m++)
+        if (str_eq(name, mode_names[m])) return m;
+    return -1;
+}
+
+void render_clear(const rast_target *t, uint8_t colour)
+{
+    for (int y = 0; y < VIEW_H; y++) rast_span(t, y, 0, VIEW_W, colour, RAST_ID(RAST_KIND_NONE, 0));
+}
+
+void render_frame(const scene *s, const camera *cam, render_mode mode, const rast_target *t, render_stats *stats)
+{
+    render_stats local;
+    render_stats *st = stats ? stats : &local;
+    view_xform v;
+    *st = (render_stats){0};
+    view_setup(&v, cam);
+    switch (mode) {
+    default:
+        painter_render(s, &v, t, st);
+        break;
+    }
+}

@@ -1,0 +1,61 @@
+/* scene.h - a validated, read-in-place view of a compiled scene (prefix scene_).
+ * scene_load() checks everything in firmware/scene_format.h before any other
+ * part of the renderer may look at the blob; nothing after it re-checks. */
+#ifndef SCENE_H
+#define SCENE_H
+
+#include <stdint.h>
+#include "scene_format.h"
+
+typedef struct {
+    const scn_header *hdr;
+    const scn_vertex *verts;
+    const scn_sector *sectors;
+    const scn_line *lines;
+    const scn_seg *segs;
+    const scn_node *nodes;
+    const scn_leaf *leaves;
+    const scn_vertex *pverts;
+    const uint8_t *palette; /* 768 bytes */
+    uint32_t nverts, nsectors, nlines, nsegs, nnodes, nleaves, npverts;
+    uint32_t root;
+} scene;
+
+typedef enum {
+    SCENE_OK = 0,
+    SCENE_ERR_SHORT,     /* fewer bytes than the header or than total_bytes says */
+    SCENE_ERR_ALIGN,     /* blob not 4-byte aligned in memory */
+    SCENE_ERR_MAGIC,
+    SCENE_ERR_VERSION,
+    SCENE_ERR_HEADER,    /* header_bytes or total_bytes inconsistent */
+    SCENE_ERR_CRC,
+    SCENE_ERR_SECTION,   /* a section is misaligned or lies outside the blob */
+    SCENE_ERR_INDEX,     /* a record refers to something that does not exist */
+    SCENE_ERR_RANGE,     /* a coordinate or height outside the proven-safe range */
+    SCENE_ERR_TREE,      /* the node graph is not a tree, or is deeper than supported */
+    SCENE_ERR_COUNT
+} scene_status;
+
+typedef struct {
+    scene_status status;
+    int section;     /* SCN_SEC_* of the offending record, or -1 */
+    uint32_t index;  /* its index */
+} scene_error;
+
+/* Validate blob[0..len) and fill s. Returns SCENE_OK, or a status with details in err
+ * (err may be NULL). s is only usable after SCENE_OK. */
+scene_status scene_load(scene *s, const void *blob, uint32_t len, scene_error *err);
+
+/* Human-readable names, for messages: status ("bad CRC") and section ("segs"). */
+const char *scene_status_text(scene_status st);
+const char *scene_section_name(int section);
+
+/* The leaf containing map point (x, y) (16.16); points on a partition go to its front. */
+uint32_t scene_leaf_at(const scene *s, int32_t x, int32_t y);
+/* The sector containing (x, y), or SCN_NONE. */
+uint32_t scene_sector_at(const scene *s, int32_t x, int32_t y);
+
+/* Which side of a node's partition a point is on: 0 front (right), 1 back. */
+int scene_node_side(const scn_node *n, int32_t x, int32_t y);
+
+#endif

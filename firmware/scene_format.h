@@ -1,0 +1,98 @@
+/* scene_format.h - the compiled-scene blob (prefix scn_): the one contract between
+ * the BSP compiler (tools/bspc) and the renderer (firmware/scene.c loads it).
+ *
+ * The blob is little-endian and position-independent: a fixed header, then
+ * sections addressed by byte offsets from the start of the blob. Every record is
+ * a multiple of 4 bytes and every section starts 4-byte aligned, so a loaded blob
+ * (itself 4-byte aligned) can be read in place on a little-endian target.
+ * The loader never trusts it: magic, version, sizes, CRC-32, every count, every
+ * offset and every index are validated before the renderer touches it.
+ *
+ * Coordinates and heights are 16.16 (fx_t) map units: x east, y north, z up.
+ */
+#ifndef SCN_FORMAT_H
+#define SCN_FORMAT_H
+
+#include <stdint.h>
+
+#define SCN_MAGIC 0x4E435342u /* bytes "BSCN" */
+#define SCN_VERSION 1u
+#define SCN_NONE 0xFFFFFFFFu     /* "no sector" / "no index" */
+#define SCN_LEAF_BIT 0x80000000u /* child index refers to a leaf */
+
+/* Proven-safe ranges (see docs/ranges.md); bspc rejects scenes outside them. */
+#define SCN_COORD_MAX 32767 /* |x|, |y| of every vertex, whole units */
+#define SCN_HEIGHT_MAX 16383 /* |floor|, |ceiling| heights, whole units */
+#define SCN_MAX_DEPTH 255    /* deepest node path the walk stack supports */
+
+enum scn_section_id {
+    SCN_SEC_VERTICES, /* scn_vertex[]: original vertices first, then split points */
+    SCN_SEC_SECTORS,  /* scn_sector[] */
+    SCN_SEC_LINES,    /* scn_line[]: linedefs in source order (id buffer index = line*2+side) */
+    SCN_SEC_SEGS,     /* scn_seg[]: wall pieces, grouped by leaf */
+    SCN_SEC_NODES,    /* scn_node[] */
+    SCN_SEC_LEAVES,   /* scn_leaf[] */
+    SCN_SEC_PVERTS,   /* scn_vertex[]: leaf floor polygons, convex, counter-clockwise */
+    SCN_SEC_PALETTE,  /* 768 bytes: 256 x (r, g, b), 8 bits per gun; count = 256 */
+    SCN_SEC_COUNT
+};
+
+typedef struct {
+    uint32_t offset; /* from the start of the blob, multiple of 4 */
+    uint32_t count;  /* records */
+} scn_section;
+
+typedef struct {
+    uint32_t magic;        /* SCN_MAGIC */
+    uint16_t version;      /* SCN_VERSION */
+    uint16_t header_bytes; /* sizeof(scn_header) */
+    uint32_t total_bytes;  /* whole blob */
+    uint32_t crc32;        /* CRC-32 (IEEE, as zlib) of bytes [16, total_bytes) */
+    uint32_t flags;        /* reserved, 0 */
+    int32_t player_x, player_y; /* 16.16 */
+    int32_t player_angle;       /* degrees, 16.16, 0 = east, counter-clockwise */
+    uint32_t player_sector;     /* sector of the player start, or SCN_NONE */
+    uint32_t root;              /* node index, or SCN_LEAF_BIT | leaf index */
+    uint32_t max_depth;         /* longest root-to-leaf path, in nodes */
+    scn_section sec[SCN_SEC_COUNT];
+} scn_header;
+
+typedef struct {
+    int32_t x, y; /* 16.16 */
+} scn_vertex;
+
+#define SCN_SECTOR_SKY 1u /* ceiling is sky */
+
+typedef struct {
+    int32_t floor_h, ceil_h; /* 16.16 */
+    uint8_t floor_color, ceil_color, light, flags;
+} scn_sector;
+
+enum { SCN_PART_UPPER, SCN_PART_MIDDLE, SCN_PART_LOWER };
+
+typedef struct {
+    uint32_t v1, v2;      /* vertex indices; the front side is on the right going v1 -> v2 */
+    uint32_t sector[2];   /* front, back (SCN_NONE: one-sided) */
+    uint8_t color[2][3];  /* [side][SCN_PART_*] */
+    uint16_t flags;       /* reserved, 0 */
+} scn_line;
+
+typedef struct {
+    uint32_t v1, v2; /* vertex indices; the seg faces right going v1 -> v2 */
+    uint32_t line;   /* linedef index */
+    uint32_t side;   /* 0 front, 1 back of the linedef */
+} scn_seg;
+
+typedef struct {
+    int32_t x, y, dx, dy;  /* partition line through (x,y) along (dx,dy), 16.16; front = right side */
+    int32_t bbox[2][4];    /* [child][top, bottom, left, right]: ymax, ymin, xmin, xmax, 16.16 */
+    uint32_t child[2];     /* 0 front (right), 1 back; SCN_LEAF_BIT marks a leaf */
+} scn_node;
+
+typedef struct {
+    uint32_t first_seg, num_segs; /* segs[first_seg .. first_seg + num_segs) */
+    uint32_t sector;              /* the leaf's sector (SCN_NONE if it has none) */
+    uint32_t first_pvert, num_pverts; /* floor polygon in pverts[] (0 pverts if degenerate) */
+} scn_leaf;
+
+#endif

@@ -1,0 +1,207 @@
+/* fb.c - the counted framebuffer write primitives and the two present modes
+ * (prefix hal_), shared by every target. Freestanding C11: no libc, no
+ * floating point, no malloc, and no state of its own - the page being drawn
+ * in flip mode is always the one the display start does not select, so the
+ * target's display-start register is the only state, and a target reset
+ * resets everything.
+ *
+ * Every framebuffer store goes through a volatile pointer of the width that
+ * is counted: the compiler may neither merge, split, vectorise nor turn the
+ * loops into memset/memcpy calls, so the counters describe the stores the
+ * machine code really makes (and memory-mapped VRAM on a real target sees
+ * exactly those bus transactions).
+ */
+#include <stddef.h>
+#include "hal.h"
+#include "perf_internal.h"
+
+static const char *const present_names[HAL_PRESENT_COUNT] = {
+    [HAL_PRESENT_FLIP] = "flip",
+    [HAL_PRESENT_COPY8] = "copy8",
+    [HAL_PRESENT_COPY16] = "copy16",
+    [HAL_PRESENT_COPY32] = "copy32",
+};
+
+const char *hal_present_name(hal_present_mode m)
+{
+    if ((unsigned)m >= (unsigned)HAL_PRESENT_COUNT)
+        return "unknown";
+    return present_names[m];
+}
+
+static int str_eq(const char *a, const char *b)
+{
+    while (*a && *a == *b) {
+        a++;
+        b++;
+    }
+    return *a == *b;
+}
+
+int hal_present_parse(const char *name)
+{
+    if (name == NULL)
+        return -1;
+    for (int m = 0; m < HAL_PRESENT_COUNT; m++)
+        if (str_eq(name, present_names[m]))
+            return m;
+    return -1;
+}
+
+/* Page the display shows now, normalised to 0 or 1. */
+static int shown_index(void)
+{
+    return hal_target_display_start() ? 1 : 0;
+}
+
+hal_surface hal_begin_frame(hal_present_mode m)
+{
+    hal_surface s = { NULL, 0 };
+    if (m == HAL_PRESENT_FLIP) {
+        s.pixels = hal_target_vram(1 - shown_index());
+        s.in_vram = 1;
+    } else if (m == HAL_PRESENT_COPY8 || m == HAL_PRESENT_COPY16 || m == HAL_PRESENT_COPY32) {
+        s.pixels = hal_target_sysmem();
+        s.in_vram = 0;
+    }
+    return s; /* unknown mode: pixels NULL, hal_fill_span ignores it */
+}
+
+void hal_fill_span(const hal_surface *s, int y, int x, int len, uint8_t colour)
+{
+    if (s == NULL || s->pixels == NULL)
+        return;
+    if (y < 0 || y >= HAL_HEIGHT || len <= 0 || x >= HAL_WIDTH)
+        return;
+    if (x < 0) {
+        len += x; /* len > 0 and x < 0: cannot overflow */
+        x = 0;
+        if (len <= 0)
+            return;
+    }
+    if (len > HAL_WIDTH - x)
+        len = HAL_WIDTH - x;
+
+    uint8_t *p = s->pixels + (uint32_t)y * HAL_WIDTH + (uint32_t)x;
+    uint32_t n = (uint32_t)len;
+    uint32_t n8 = 0, n16 = 0, n32;
+    uint16_t c16 = (uint16_t)(colour * 0x0101u);
+    uint32_t c32 = colour * 0x01010101u;
+
+    /* head: a byte to reach 2-alignment, a word to reach 4-alignment */
+    if (((uintptr_t)p & 1u) != 0) {
+        *(volatile uint8_t *)p = colour;
+        p += 1;
+        n -= 1;
+        n8++;
+    }
+    if (((uintptr_t)p & 2u) != 0 && n >= 2) {
+        *(volatile uint16_t *)(void *)p = c16;
+        p += 2;
+        n -= 2;
+        n16++;
+    }
+    /* middle: aligned dwords */
+    n32 = n >> 2;
+    volatile uint32_t *w = (volatile uint32_t *)(void *)p;
+    for (uint32_t i = 0; i < n32; i++)
+        w[i] = c32;
+    p += n32 * 4u;
+    n &= 3u;
+    /* tail: a word, then a byte */
+    if (n >= 2) {
+        *(volatile uint16_t *)(void *)p = c16;
+        p += 2;
+        n -= 2;
+        n16++;
+    }
+    if (n != 0) {
+        *(volatile uint8_t *)p = colour;
+        n8++;
+    }
+
+    int dest = s->in_vram ? HAL_DEST_VRAM : HAL_DEST_SYSMEM;
+    if (n8)
+        hal_perf_add_writes(1, dest, n8, 0);
+    if (n16)
+        hal_perf_add_writes(2, dest, n16, 0);
+    if (n32)
+        hal_perf_add_writes(4, dest, n32, 0);
+    hal_perf_add_pixels((uint32_t)len);
+}
+
+/* The copies: the system-memory buffer and the pages are 4-aligned and
+ * HAL_PAGE_BYTES is a multiple of 4, so every access is naturally aligned. */
+static void copy8(uint8_t *dst, const uint8_t *src)
+{
+    volatile uint8_t *d = dst;
+    for (uint32_t i = 0; i < HAL_PAGE_BYTES; i++)
+        d[i] = src[i];
+    hal_perf_add_writes(1, HAL_DEST_VRAM, HAL_PAGE_BYTES, 1);
+}
+
+static void copy16(uint8_t *dst, const uint8_t *src)
+{
+    volatile uint16_t *d = (volatile uint16_t *)(void *)dst;
+    const uint16_t *s = (const uint16_t *)(const void *)src;
+    for (uint32_t i = 0; i < HAL_PAGE_BYTES / 2; i++)
+        d[i] = s[i];
+    hal_perf_add_writes(2, HAL_DEST_VRAM, HAL_PAGE_BYTES / 2, 1);
+}
+
+static void copy32(uint8_t *dst, const uint8_t *src)
+{
+    volatile uint32_t *d = (volatile uint32_t *)(void *)dst;
+    const uint32_t *s = (const uint32_t *)(const void *)src;
+    for (uint32_t i = 0; i < HAL_PAGE_BYTES / 4; i++)
+        d[i] = s[i];
+    hal_perf_add_writes(4, HAL_DEST_VRAM, HAL_PAGE_BYTES / 4, 1);
+}
+
+void hal_present(hal_present_mode m)
+{
+    uint8_t *shown;
+    const uint8_t *src;
+    switch (m) {
+    case HAL_PRESENT_FLIP:
+        /* the page just drawn is the hidden one; show it. The next
+         * hal_begin_frame draws into the other. No writes are counted. */
+        hal_target_set_display_start(1 - shown_index());
+        return;
+    case HAL_PRESENT_COPY8:
+    case HAL_PRESENT_COPY16:
+    case HAL_PRESENT_COPY32:
+        break;
+    default:
+        return;
+    }
+    shown = hal_target_vram(shown_index());
+    src = hal_target_sysmem();
+    if (shown == NULL || src == NULL)
+        return;
+    if (m == HAL_PRESENT_COPY8)
+        copy8(shown, src);
+    else if (m == HAL_PRESENT_COPY16)
+        copy16(shown, src);
+    else
+        copy32(shown, src);
+}
+
+const uint8_t *hal_shown_page(void)
+{
+    return hal_target_vram(shown_index());
+}
+
+void hal_set_palette(const uint8_t *rgb)
+{
+    uint8_t *pal = hal_target_palette();
+    if (rgb == NULL || pal == NULL)
+        return;
+    for (uint32_t i = 0; i < HAL_PALETTE_BYTES; i++)
+        pal[i] = rgb[i];
+}
+
+const uint8_t *hal_get_palette(void)
+{
+    return hal_target_palette();
+}

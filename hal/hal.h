@@ -1,0 +1,133 @@
+/* hal.h - the target contract (prefix hal_). The renderer core (firmware/) talks to
+ * the machine only through this header.
+ *
+ * The machine is a VGA-like 320x200, 8-bit, 256-colour display:
+ *   - two 64,000-byte VRAM pages (row pitch 320) and a display-start register
+ *     choosing the shown page;
+ *   - a 256-entry palette, 8 bits per gun (r, g, b), 768 bytes;
+ *   - a millisecond tick, an input bitmask, and a frame-done hook.
+ *
+ * Shared by every target (hal/fb.c, hal/perf.c): the counted framebuffer write
+ * primitives, the two present modes, and the performance counters that mimic
+ * the Pentium's (two programmable counters with selectable events plus a
+ * time-stamp-style cycle counter driven by a bus cost model).
+ *
+ * Per target (hal/null, hal/sdl, hal/mps2, ...): where VRAM, the system-memory
+ * buffer and the palette live, what showing a page means, input and time.
+ * The firmware owns no main loop: the target calls the engine step.
+ */
+#ifndef HAL_H
+#define HAL_H
+
+#include <stdint.h>
+
+#define HAL_WIDTH 320
+#define HAL_HEIGHT 200
+#define HAL_PAGE_BYTES (HAL_WIDTH * HAL_HEIGHT)
+#define HAL_PALETTE_BYTES 768
+
+/* ---- present modes ---------------------------------------------------- */
+typedef enum {
+    HAL_PRESENT_FLIP,   /* draw into the hidden VRAM page, then flip the display start */
+    HAL_PRESENT_COPY8,  /* draw into system memory, copy to the shown page a byte at a time */
+    HAL_PRESENT_COPY16, /* ... 16 bits at a time */
+    HAL_PRESENT_COPY32, /* ... 32 bits at a time */
+    HAL_PRESENT_COUNT
+} hal_present_mode;
+
+/* Name for a mode ("flip", "copy8", "copy16", "copy32"); parse returns -1 if unknown. */
+const char *hal_present_name(hal_present_mode m);
+int hal_present_parse(const char *name);
+
+/* ---- performance counters --------------------------------------------- */
+typedef enum {
+    HAL_EV_WRITES,        /* framebuffer write transactions of any width (drawing + present) */
+    HAL_EV_BYTES,         /* bytes written to any framebuffer */
+    HAL_EV_WRITES8,       /* write transactions by width */
+    HAL_EV_WRITES16,
+    HAL_EV_WRITES32,
+    HAL_EV_VRAM_WRITES,   /* transactions that hit VRAM */
+    HAL_EV_SYSMEM_WRITES, /* transactions that hit the system-memory buffer */
+    HAL_EV_PIXELS,        /* pixels drawn by the renderer (overdraw = pixels / 64,000) */
+    HAL_EV_COPY_WRITES,   /* transactions made by the present copy */
+    HAL_EV_COUNT
+} hal_event;
+
+const char *hal_event_name(hal_event e); /* "writes", "bytes", ... (JSON keys); "unknown" if out of range */
+
+/* Bus cost model: modelled cycles per write transaction, whatever its width,
+ * because a bus transaction costs the same for a byte or a dword - the point of
+ * Abrash's chapter 62 measurement. Defaults: VRAM 8, system memory 1. */
+typedef struct {
+    uint32_t vram_cycles;
+    uint32_t sysmem_cycles;
+} hal_bus_model;
+
+#define HAL_PERF_COUNTERS 2
+/* Zero every event total, both counters and the cycle count; keeps the bus model
+ * and the events the counters have selected. */
+void hal_perf_reset(void);
+void hal_perf_set_bus(hal_bus_model m);
+hal_bus_model hal_perf_bus(void);
+uint64_t hal_perf_event(hal_event e);            /* running total of one event */
+void hal_perf_select(int counter, hal_event e);  /* counter 0 or 1: count e from now, from zero */
+uint64_t hal_perf_read(int counter);             /* counts of the selected event since selected */
+uint64_t hal_perf_tsc(void);                     /* modelled bus cycles since reset */
+
+/* ---- framebuffer writes (counted) -------------------------------------- */
+typedef struct {
+    uint8_t *pixels; /* 320 x 200, pitch 320 */
+    uint8_t in_vram; /* 1: VRAM page, 0: system memory */
+} hal_surface;
+
+/* Start a frame: the surface to draw into is the hidden VRAM page (flip) or the
+ * system-memory buffer (copy modes). An unknown mode gives pixels == NULL, which
+ * hal_fill_span ignores. */
+hal_surface hal_begin_frame(hal_present_mode m);
+
+/* Fill pixels [x, x+len) of row y with one colour, with aligned dword writes in
+ * the middle and byte/word writes at the ends, counting every transaction.
+ * Out-of-range rows or columns are clipped, never written. */
+void hal_fill_span(const hal_surface *s, int y, int x, int len, uint8_t colour);
+
+/* Finish a frame: flip the display start to the drawn page, or copy the
+ * system-memory buffer to the shown VRAM page with the chosen width (counted). */
+void hal_present(hal_present_mode m);
+
+/* The page the display shows now (what a camera pointed at the screen sees). */
+const uint8_t *hal_shown_page(void);
+
+/* Palette: 768 bytes, 8 bits per gun. */
+void hal_set_palette(const uint8_t *rgb);
+const uint8_t *hal_get_palette(void);
+
+/* ---- input and time (per target) --------------------------------------- */
+#define HAL_KEY_FORWARD (1u << 0)
+#define HAL_KEY_BACK (1u << 1)
+#define HAL_KEY_TURN_LEFT (1u << 2)
+#define HAL_KEY_TURN_RIGHT (1u << 3)
+#define HAL_KEY_STRAFE_LEFT (1u << 4)
+#define HAL_KEY_STRAFE_RIGHT (1u << 5)
+#define HAL_KEY_FLY_UP (1u << 6)
+#define HAL_KEY_FLY_DOWN (1u << 7)
+#define HAL_KEY_LOOK_UP (1u << 8)
+#define HAL_KEY_LOOK_DOWN (1u << 9)
+#define HAL_KEY_RUN (1u << 10)
+/* edge-triggered: reported once per press, cleared when read */
+#define HAL_KEY_NEXT_MODE (1u << 16)
+#define HAL_KEY_NEXT_PRESENT (1u << 17)
+#define HAL_KEY_PRINT_COUNTERS (1u << 18)
+#define HAL_KEY_QUIT (1u << 30)
+
+uint32_t hal_input(void);     /* HAL_KEY_* bits held or pressed since the last call */
+uint32_t hal_ticks_ms(void);  /* milliseconds since the target started */
+void hal_frame_done(void);    /* the engine finished a frame: show it, stream it, ... */
+
+/* ---- what each target provides to the shared code ------------------------ */
+uint8_t *hal_target_vram(int page);        /* page 0 or 1, HAL_PAGE_BYTES each */
+uint8_t *hal_target_sysmem(void);          /* the system-memory back buffer */
+uint8_t *hal_target_palette(void);         /* HAL_PALETTE_BYTES */
+void hal_target_set_display_start(int page);
+int hal_target_display_start(void);
+
+#endif

@@ -1,0 +1,22 @@
+/* perf_internal.h - the hook by which hal/fb.c (and targets that write the
+ * framebuffer themselves) feed the performance counters of hal/perf.c.
+ * Not part of the target contract: firmware/ never includes this file.
+ */
+#ifndef HAL_PERF_INTERNAL_H
+#define HAL_PERF_INTERNAL_H
+
+#include <stdint.h>
+
+/* Where a write transaction lands. */
+enum { HAL_DEST_SYSMEM = 0, HAL_DEST_VRAM = 1 };
+
+/* Record `count` write transactions of `width_bytes` (1, 2 or 4) to `dest`
+ * (HAL_DEST_*). is_copy: 1 when made by the present copy, 0 when drawing.
+ * Updates writes, bytes, writes8/16/32, vram/sysmem writes, copy writes and
+ * the modelled cycle count. Any other width is ignored. */
+void hal_perf_add_writes(unsigned width_bytes, int dest, uint32_t count, int is_copy);
+
+/* Record `count` pixels drawn by the renderer (HAL_EV_PIXELS). */
+void hal_perf_add_pixels(uint32_t count);
+
+#endif

@@ -1,0 +1,148 @@
+/* emu.c - build/emu: the host-emulated run. The firmware engine on the SDL target:
+ * a window scaled up, keyboard input, counters on demand. Without a display it
+ * says so and renders a short scripted fly-through to PNG files instead. */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "engine.h"
+#include "hal.h"
+#include "hal_sdl.h"
+#include "png.h"
+#include "scene_file.h"
+
+extern const uint8_t default_scene[];
+extern const uint32_t default_scene_len;
+
+static const char usage[] =
+    "usage: emu [SCENE] [--scale N] [--frames N] [--headless] [--out DIR]\n"
+    "\n"
+    "Walk through SCENE (default: the built-in scene) in a window.\n"
+    "SCENE is a compiled scene, a text scene, or FILE.wad:MAP (e.g. freedoom2.wad:MAP01).\n"
+    "\n"
+    "Keys: Up/Down move, Left/Right turn, Alt+Left/Right or ',' '.' strafe,\n"
+    "      PgUp/PgDn or A/Z fly, Home/End or Q/W look up/down, Shift run,\n"
+    "      M render mode, P present mode (flip, copy8, copy16, copy32),\n"
+    "      C print counters, Esc quit.\n"
+    "\n"
+    "  --scale N     window size factor (default 3)\n"
+    "  --frames N    quit after N frames (default: run until Esc)\n"
+    "  --headless    do not open a window: render the fly-through to PNG files\n"
+    "  --out DIR     where the headless fly-through goes (default build/flythrough)\n"
+    "  -h, --help    this text\n";
+
+#define FLY_FRAMES 36
+#define FLY_STEP_MS 83 /* a tenth of a turn per frame at the camera's turn speed */
+
+static void print_counters(const engine *e)
+{
+    printf("frame %u mode %s present %s:", e->frame, render_mode_name(e->mode), hal_present_name(e->present));
+    for (int ev = 0; ev < HAL_EV_COUNT; ev++)
+        printf(" %s=%llu", hal_event_name((hal_event)ev), (unsigned long long)hal_perf_event((hal_event)ev));
+    printf(" bus_cycles=%llu\n", (unsigned long long)hal_perf_tsc());
+    fflush(stdout);
+}
+
+static int run_window(engine *e, long frames)
+{
+    uint32_t last = hal_ticks_ms();
+    for (long n = 0; frames <= 0 || n < frames; n++) {
+        uint32_t input = hal_input();
+        if (input & HAL_KEY_QUIT) break;
+        uint32_t now = hal_ticks_ms();
+        uint32_t dt = now - last;
+        last = now;
+        if (dt < 1) dt = 1;
+        if (dt > 100) dt = 100;
+        hal_perf_reset();
+        eng_step(e, input, dt);
+        if (input & HAL_KEY_PRINT_COUNTERS) print_counters(e);
+    }
+    return 0;
+}
+
+static int run_headless(engine *e, const char *dir)
+{
+    if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
+        fprintf(stderr, "emu: %s: cannot create: %s\n", dir, strerror(errno));
+        return 1;
+    }
+    char path[4096];
+    for (int i = 0; i < FLY_FRAMES; i++) {
+        hal_perf_reset();
+        eng_step(e, i == 0 ? 0 : HAL_KEY_TURN_LEFT, i == 0 ? 1 : FLY_STEP_MS);
+        snprintf(path, sizeof path, "%s/frame_%03d.png", dir, i);
+        if (png_write_indexed(path, hal_shown_page(), HAL_WIDTH, HAL_HEIGHT, hal_get_palette()) != 0) {
+            fprintf(stderr, "emu: %s: cannot write: %s\n", path, strerror(errno));
+            return 1;
+        }
+    }
+    printf("emu: wrote %d frames of a turn around the start to %s/frame_000.png .. frame_%03d.png\n", FLY_FRAMES, dir,
+           FLY_FRAMES - 1);
+    print_counters(e);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    const char *spec = NULL, *out = "build/flythrough";
+    long frames = 0;
+    int scale = HAL_SDL_DEFAULT_SCALE, headless = 0;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
+            fputs(usage, stdout);
+            return 0;
+        } else if (!strcmp(argv[i], "--headless")) {
+            headless = 1;
+        } else if (i + 1 < argc && !strcmp(argv[i], "--scale")) {
+            scale = atoi(argv[++i]);
+        } else if (i + 1 < argc && !strcmp(argv[i], "--frames")) {
+            frames = atol(argv[++i]);
+        } else if (i + 1 < argc && !strcmp(argv[i], "--out")) {
+            out = argv[++i];
+        } else if (argv[i][0] == '-') {
+            fprintf(stderr, "emu: unknown option '%s' (see --help)\n", argv[i]);
+            return 2;
+        } else if (!spec) {
+            spec = argv[i];
+        } else {
+            fprintf(stderr, "emu: more than one scene given: '%s'\n", argv[i]);
+            return 2;
+        }
+    }
+
+    uint8_t *blob = NULL;
+    size_t len = default_scene_len;
+    const void *data = default_scene;
+    char err[512];
+    if (spec) {
+        bspc_options opt = bspc_defaults();
+        if (scene_file_load(spec, &opt, &blob, &len, err, sizeof err) != 0) {
+            fprintf(stderr, "emu: %s\n", err);
+            return 1;
+        }
+        data = blob;
+    }
+    static engine e;
+    scene_error se;
+    if (len > UINT32_MAX || eng_init(&e, data, (uint32_t)len, &se) != SCENE_OK) {
+        scene_file_describe_error(spec ? spec : "built-in scene", se.status, se.section, se.index, err, sizeof err);
+        fprintf(stderr, "emu: %s\n", err);
+        free(blob);
+        return 1;
+    }
+
+    int rc;
+    if (!headless && hal_sdl_init(scale, "bspvga") == 0) {
+        rc = run_window(&e, frames);
+        hal_sdl_quit();
+    } else {
+        if (!headless)
+            printf("emu: no display available (%s); rendering a fly-through headless instead\n", hal_sdl_error());
+        rc = run_headless(&e, out);
+    }
+    free(blob);
+    return rc;
+}

@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# deps.sh - install what the project needs, and only what is missing:
+# Debian packages (apt-get) and a Python virtual environment from the pinned
+# requirements.txt. Safe to run again: it says what it does and skips what is there.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+VENV=${VENV:-build/venv}
+PACKAGES=(
+  gcc make libc6-dev          # host build
+  libsdl2-dev                 # hal/sdl: the host window
+  libcmocka-dev               # C unit tests
+  gcc-arm-none-eabi           # Cortex-M soft-float build (no-float check)
+  freedoom                    # real maps: freedoom1.wad, freedoom2.wad
+  zdbsp glbsp                 # other BSP compilers, for make bench-bsp
+  valgrind                    # instruction counts
+  xvfb xauth                  # a display for SDL tests on headless machines
+  python3 python3-venv        # tests and tools
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "deps: installing Debian packages: ${missing[*]}"
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+else
+  echo "deps: Debian packages present"
+fi
+
+PY=${PYTHON:-python3}
+if [ ! -x "$VENV/bin/python" ]; then
+  echo "deps: creating Python virtual environment in $VENV"
+  "$PY" -m venv "$VENV"
+fi
+if ! cmp -s requirements.txt "$VENV/.requirements"; then
+  echo "deps: installing pinned Python packages from requirements.txt"
+  "$VENV/bin/python" -m pip install -q --disable-pip-version-check -r requirements.txt
+  cp requirements.txt "$VENV/.requirements"
+else
+  echo "deps: Python packages present ($VENV)"
+fi
