@@ -11,8 +11,10 @@
 /* Front-facing: the eye strictly on the right of v1 -> v2 (edge-on is culled). */
 static int seg_faces_eye(const view_xform *v, const scn_vertex *a, const scn_vertex *b)
 {
-    int64_t dx = fx_asr64((int64_t)b->x - a->x, 2), dy = fx_asr64((int64_t)b->y - a->y, 2);
-    int64_t ex = fx_asr64(v->cx - a->x, 2), ey = fx_asr64(v->cy - a->y, 2);
+    /* |b - a| < 2^32 and |eye - a| < 2^33 raw: shifted to 2^31 and 2^30 the
+     * products stay below 2^61. */
+    int64_t dx = fx_asr64((int64_t)b->x - a->x, 1), dy = fx_asr64((int64_t)b->y - a->y, 1);
+    int64_t ex = fx_asr64(v->cx - a->x, 3), ey = fx_asr64(v->cy - a->y, 3);
     return dx * ey - dy * ex < 0;
 }
 

@@ -170,6 +170,7 @@ scene_status scene_load(scene *s, const void *blob, uint32_t len, scene_error *e
     if (h->header_bytes != sizeof(scn_header) || (h->total_bytes & 3u)) return fail(err, SCENE_ERR_HEADER, -1, 0);
     if (h->total_bytes > len) return fail(err, SCENE_ERR_SHORT, -1, 0);
     if (crc_update(0, base + 16, h->total_bytes - 16) != h->crc32) return fail(err, SCENE_ERR_CRC, -1, 0);
+    if (h->flags != 0) return fail(err, SCENE_ERR_HEADER, -1, 0);
     if (h->max_depth > SCN_MAX_DEPTH) return fail(err, SCENE_ERR_TREE, -1, 0);
     if (h->player_sector != SCN_NONE && h->player_sector >= h->sec[SCN_SEC_SECTORS].count)
         return fail(err, SCENE_ERR_INDEX, -1, 0);
@@ -185,10 +186,11 @@ scene_status scene_load(scene *s, const void *blob, uint32_t len, scene_error *e
 
 int scene_node_side(const scn_node *n, int32_t x, int32_t y)
 {
-    /* Differences can reach 2^33 raw and deltas 2^32: drop 2 fraction bits of each
-     * so both products stay below 2^61 (classification to 1/16384 unit). */
-    int64_t ex = fx_asr64((int64_t)x - n->x, 2), ey = fx_asr64((int64_t)y - n->y, 2);
-    int64_t cross = fx_asr64(n->dx, 2) * ey - fx_asr64(n->dy, 2) * ex;
+    /* The offset from the partition's point reaches 2^33 raw and the direction
+     * (not normalised) 2^31: dropping 3 fraction bits of the offset keeps each
+     * product below 2^61 and classifies to 1/8192 unit. */
+    int64_t ex = fx_asr64((int64_t)x - n->x, 3), ey = fx_asr64((int64_t)y - n->y, 3);
+    int64_t cross = (int64_t)n->dx * ey - (int64_t)n->dy * ex;
     return cross > 0; /* left of the direction is the back */
 }
 

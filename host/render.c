@@ -15,7 +15,7 @@
 #include "scene_file.h"
 
 static const char usage[] =
-    "usage: render SCENE --at X,Y[,Z] --angle DEG [options]\n"
+    "usage: render SCENE [--at X,Y[,Z]] [--angle DEG] [options]\n"
     "\n"
     "Render one frame of SCENE headless and print its counters as one JSON object.\n"
     "SCENE is a compiled scene (.bsc), a text scene, or FILE.wad:MAP (compiled on the\n"
@@ -23,8 +23,10 @@ static const char usage[] =
     "/usr/share/games/doom).\n"
     "\n"
     "  --at X,Y[,Z]       eye position in map units (decimals allowed; rounded to\n"
-    "                     16.16). Z defaults to the floor under the eye + 41.\n"
+    "                     16.16). Default: the scene's player start. Z defaults to\n"
+    "                     the floor under the eye + 41.\n"
     "  --angle DEG        view angle in degrees, 0 = east, counter-clockwise\n"
+    "                     (default: the player start's angle)\n"
     "  --look PX          vertical shear in pixels, -100..100 (default 0)\n"
     "  --mode MODE        painter (default painter)\n"
     "  --present P        flip | copy8 | copy16 | copy32 (default flip)\n"
@@ -127,7 +129,6 @@ static int parse_args(options *o, int argc, char **argv)
         i += takes;
     }
     if (!o->scene) return die("no scene given (see --help)%s%s", "", "");
-    if (!o->have_at || !o->have_angle) return die("--at and --angle are required (see --help)%s%s", "", "");
     return 0;
 }
 
@@ -204,8 +205,15 @@ int main(int argc, char **argv)
     }
     e.mode = o.mode;
     e.present = o.present;
-    e.cam.view = o.cam;
-    if (!o.have_z) {
+    if (o.have_at) {
+        e.cam.view.x = o.cam.x;
+        e.cam.view.y = o.cam.y;
+    }
+    if (o.have_angle) e.cam.view.angle_deg = o.cam.angle_deg;
+    e.cam.view.look = o.cam.look;
+    if (o.have_z) {
+        e.cam.view.z = o.cam.z;
+    } else {
         e.cam.view.z = CAM_EYE_HEIGHT;
         cam_follow_floor(&e.cam, &e.sc);
     }

@@ -17,7 +17,10 @@ int main(int argc, char **argv)
     printf("_Alignas(4) const uint8_t %s[] = {\n", argv[1]);
     unsigned long n = 0;
     int c;
-    while ((c = fgetc(f)) != EOF) printf("%s0x%02x,%s", (n % 12) ? " " : "    ", c, (++n % 12) ? "" : "\n");
+    while ((c = fgetc(f)) != EOF) {
+        printf("%s0x%02x,%s", (n % 12) ? " " : "    ", c, ((n + 1) % 12) ? "" : "\n");
+        n++;
+    }
     if (ferror(f)) {
         perror(argv[2]);
         return 1;

@@ -1,0 +1,77 @@
+"""Shared helpers for the integration tests: where the programs are, and how to run them.
+
+The tests run the sanitized build (build/san: ASan + UBSan) of every program that
+has one, so every scene and camera the tests try is also checked for undefined
+behaviour and out-of-bounds access. BSPVGA_BIN overrides the folder.
+"""
+import json
+import os
+import struct
+import subprocess
+import zlib
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+BUILD = ROOT / "build"
+SAN = Path(os.environ.get("BSPVGA_BIN", BUILD / "san"))
+WADDIR = Path(os.environ.get("DOOMWADDIR", "/usr/share/games/doom"))
+SAN_ENV = dict(os.environ, ASAN_OPTIONS="detect_leaks=1:abort_on_error=0",
+               UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1")
+
+
+def program(name, sanitized=True):
+    path = (SAN if sanitized else BUILD) / name
+    if not path.exists():
+        pytest.fail(f"{path} is missing: run make first")
+    return str(path)
+
+
+def run(args, check=True, timeout=300, **kw):
+    """Run a program; return the CompletedProcess (text mode)."""
+    proc = subprocess.run([str(a) for a in args], capture_output=True, text=True, timeout=timeout,
+                          env=kw.pop("env", SAN_ENV), **kw)
+    if check and proc.returncode != 0:
+        raise AssertionError(f"{args} exited {proc.returncode}:\n{proc.stderr}")
+    return proc
+
+
+def render(scene, *extra, at=None, angle=None, sanitized=True, check=True):
+    """build/render with a camera (default: the player start); returns the parsed JSON."""
+    cam = (["--at", at] if at is not None else []) + (["--angle", angle] if angle is not None else [])
+    proc = run([program("render", sanitized), scene, *cam, *extra], check=check)
+    assert proc.stdout.count("\n") == 1, proc.stdout
+    return json.loads(proc.stdout)
+
+
+def read_png_indexed(path):
+    """Decode an 8-bit palette PNG as written by host/png.c: (width, height, pixels, palette)."""
+    data = Path(path).read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    pos, idat, width = 8, b"", None
+    palette = None
+    while pos < len(data):
+        (length,) = struct.unpack(">I", data[pos:pos + 4])
+        kind = data[pos + 4:pos + 8]
+        body = data[pos + 8:pos + 8 + length]
+        assert zlib.crc32(kind + body) == struct.unpack(">I", data[pos + 8 + length:pos + 12 + length])[0]
+        if kind == b"IHDR":
+            width, height, depth, ctype = struct.unpack(">IIBB", body[:10])
+            assert (depth, ctype) == (8, 3)
+        elif kind == b"PLTE":
+            palette = body
+        elif kind == b"IDAT":
+            idat += body
+        pos += 12 + length
+    raw = zlib.decompress(idat)
+    rows = [raw[y * (width + 1) + 1:(y + 1) * (width + 1)] for y in range(height)]
+    assert all(raw[y * (width + 1)] == 0 for y in range(height))
+    return width, height, b"".join(rows), palette
+
+
+def freedoom(name):
+    path = WADDIR / name
+    if not path.exists():
+        pytest.fail(f"{path} is missing: run make deps (Debian package freedoom)")
+    return path

@@ -1,0 +1,127 @@
+"""build/render: the headless renderer's contract (flags, JSON, outputs, counters, errors)."""
+import json
+import struct
+
+import pytest
+
+from conftest import ROOT, program, read_png_indexed, render, run
+
+DEFAULT = str(ROOT / "tests/scenes/default.scene")
+
+
+@pytest.fixture(scope="module")
+def compiled(tmp_path_factory):
+    out = tmp_path_factory.mktemp("bsc") / "default.bsc"
+    run([program("bspc"), DEFAULT, "-o", out])
+    return out
+
+
+def test_help():
+    proc = run([program("render"), "--help"])
+    for flag in ("--at", "--angle", "--mode", "--present", "--raw", "--ids", "--repeat", "-o"):
+        assert flag in proc.stdout
+
+
+def test_json_counters_and_camera_echo(compiled):
+    j = render(str(compiled), at="100.3,-20.5", angle="33.25")
+    for key in ("crc32", "pixels_written", "overdraw", "vram_writes", "sysmem_writes", "copy_writes",
+                "bus_cycles", "camera", "mode", "present"):
+        assert key in j
+    # decimals are rounded to 16.16 and echoed exactly as used
+    assert j["camera"]["x"] == round(100.3 * 65536) / 65536
+    assert j["camera"]["y"] == -20.5
+    assert j["camera"]["angle"] == 33.25
+    assert j["mode"] == "painter" and j["present"] == "flip"
+    assert len(j["crc32"]) == 8
+
+
+def test_source_and_compiled_give_the_same_frame(compiled):
+    a = render(DEFAULT)
+    b = render(str(compiled))
+    assert a["crc32"] == b["crc32"] and a["camera"] == b["camera"]
+
+
+@pytest.mark.parametrize("present,copy_writes,vram", [
+    ("flip", 0, None), ("copy8", 64000, 64000), ("copy16", 32000, 32000), ("copy32", 16000, 16000)])
+def test_present_modes_count_like_the_book(compiled, present, copy_writes, vram):
+    j = render(str(compiled), "--present", present)
+    assert j["copy_writes"] == copy_writes
+    if vram is not None:
+        # copy modes draw into system memory: the only VRAM writes are the copy's
+        assert j["vram_writes"] == vram
+        assert j["sysmem_writes"] > 0
+    else:
+        assert j["sysmem_writes"] == 0 and j["vram_writes"] > 0
+    assert j["bus_cycles"] == j["vram_writes"] * j["bus_model"]["vram_cycles"] + \
+        j["sysmem_writes"] * j["bus_model"]["sysmem_cycles"]
+
+
+def test_present_modes_show_the_same_frame(compiled):
+    crcs = {render(str(compiled), "--present", p)["crc32"] for p in ("flip", "copy8", "copy16", "copy32")}
+    assert len(crcs) == 1
+
+
+def test_outputs_agree(compiled, tmp_path):
+    png, raw, ids = tmp_path / "f.png", tmp_path / "f.bin", tmp_path / "ids.bin"
+    j = render(str(compiled), "-o", png, "--raw", raw, "--ids", ids)
+    frame = raw.read_bytes()
+    assert len(frame) == 64000
+    import zlib
+    assert "%08x" % zlib.crc32(frame) == j["crc32"]
+    w, h, pixels, palette = read_png_indexed(png)
+    assert (w, h) == (320, 200) and pixels == frame and len(palette) == 768
+    idbuf = ids.read_bytes()
+    assert len(idbuf) == 64000 * 4
+    vals = struct.unpack("<64000I", idbuf)
+    kinds = {v >> 24 for v in vals}
+    assert kinds <= {0, 1}  # painter draws walls only
+    assert 1 in kinds
+    # every wall pixel's id names a linedef side (index = line * 2 + side)
+    assert all((v & 0xFFFFFF) < 1 << 20 for v in vals)
+
+
+def test_repeat_renders_the_same_frame(compiled):
+    one = render(str(compiled))
+    many = render(str(compiled), "--repeat", "5")
+    assert one["crc32"] == many["crc32"] and one["pixels_written"] == many["pixels_written"]
+    assert many["frames"] == 5
+
+
+@pytest.mark.parametrize("args,needle", [
+    (["--at", "1"], "--at"),
+    (["--at", "1,2,3,4"], "--at"),
+    (["--at", "99999,0"], "--at"),
+    (["--angle", "east"], "--angle"),
+    (["--mode", "raytrace"], "--mode"),
+    (["--present", "copy64"], "--present"),
+    (["--repeat", "0"], "--repeat"),
+    (["--bogus"], "--bogus"),
+])
+def test_bad_arguments(compiled, args, needle):
+    proc = run([program("render"), compiled, *args], check=False)
+    assert proc.returncode != 0 and needle in proc.stderr
+
+
+def test_missing_scene_file(tmp_path):
+    proc = run([program("render"), tmp_path / "nope.bsc"], check=False)
+    assert proc.returncode != 0 and "nope.bsc" in proc.stderr
+
+
+@pytest.mark.parametrize("damage", ["truncate", "crc", "magic", "version"])
+def test_damaged_compiled_scene_is_refused(compiled, tmp_path, damage):
+    data = bytearray(compiled.read_bytes())
+    if damage == "truncate":
+        data = data[:len(data) // 2]
+    elif damage == "crc":
+        data[len(data) // 2] ^= 0x40
+    elif damage == "magic":
+        data[0] ^= 0xFF
+    else:
+        data[4] = 99
+    bad = tmp_path / "bad.bsc"
+    bad.write_bytes(bytes(data))
+    proc = run([program("render"), bad], check=False)
+    assert proc.returncode != 0
+    assert "bad.bsc" in proc.stderr
+    if damage != "magic":  # a wrong magic is read as a text scene, which then fails to parse
+        assert {"truncate": "truncated", "crc": "CRC", "version": "version"}[damage] in proc.stderr

@@ -1,0 +1,232 @@
+#!/usr/bin/env python3
+"""bench_bsp.py - BSP build benchmark over the 68 Freedoom maps (make bench-bsp).
+
+Runs build/bspc --stats on every map of freedoom1.wad (E1M1..E4M9) and
+freedoom2.wad (MAP01..MAP32) with each split strategy, runs zdbsp and glbsp on
+the same WADs when they are installed, reads the nodes shipped inside the
+Freedoom WADs, and prints one table of totals: splits, leaves (subsectors),
+max depth and build time. The table goes to stdout and to build/bench-bsp.md.
+
+For the other builders the figures come from the lumps they write:
+splits = SEGS - linedef sides, leaves = SSECTORS, depth from NODES.
+Python 3 standard library only.
+"""
+import argparse
+import json
+import os
+import shutil
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+
+WADS = ("freedoom1.wad", "freedoom2.wad")
+WAD_DIRS = (os.environ.get("DOOMWADDIR", ""), "/usr/share/games/doom")
+MAP_LUMPS = {"THINGS", "LINEDEFS", "SIDEDEFS", "VERTEXES", "SEGS", "SSECTORS", "NODES",
+             "SECTORS", "REJECT", "BLOCKMAP", "BEHAVIOR", "SCRIPTS"}
+
+
+def find_wad(name):
+    for d in WAD_DIRS:
+        if d and os.path.isfile(os.path.join(d, name)):
+            return os.path.join(d, name)
+    return None
+
+
+def is_map_name(n):
+    return (len(n) == 4 and n[0] == "E" and n[2] == "M" and n[1].isdigit() and n[3].isdigit()) or \
+           (len(n) == 5 and n.startswith("MAP") and n[3:].isdigit())
+
+
+def read_wad(path):
+    """{map name: {lump name: bytes}} in file order."""
+    with open(path, "rb") as f:
+        data = f.read()
+    magic, n, ofs = struct.unpack_from("<4sII", data, 0)
+    if magic not in (b"IWAD", b"PWAD"):
+        raise ValueError(f"{path}: not a WAD")
+    maps, cur = {}, None
+    for i in range(n):
+        pos, size, name = struct.unpack_from("<II8s", data, ofs + 16 * i)
+        name = name.split(b"\0")[0].decode("ascii", "replace").upper()
+        if is_map_name(name):
+            cur = maps.setdefault(name, {})
+        elif cur is not None and name in MAP_LUMPS:
+            cur[name] = data[pos:pos + size]
+        else:
+            cur = None
+    return maps
+
+
+def sides_of(lumps, skip_zero_length=False):
+    """linedef sides of a map (bspc skips zero-length linedefs, so it may ask to)"""
+    ld, vx = lumps["LINEDEFS"], lumps["VERTEXES"]
+    sides = 0
+    for i in range(len(ld) // 14):
+        v1, v2 = struct.unpack_from("<HH", ld, 14 * i)
+        s0, s1 = struct.unpack_from("<HH", ld, 14 * i + 10)
+        if skip_zero_length and 4 * max(v1, v2) + 4 <= len(vx) and \
+                vx[4 * v1:4 * v1 + 4] == vx[4 * v2:4 * v2 + 4]:
+            continue
+        sides += (s0 != 0xFFFF) + (s1 != 0xFFFF)
+    return sides
+
+
+def node_figures(lumps):
+    """(segs, leaves, max depth) of a map's NODES/SSECTORS/SEGS, classic or ZDBSP XNOD."""
+    nodes_lump = lumps.get("NODES", b"")
+    if nodes_lump[:4] == b"XNOD":
+        d, p = nodes_lump, 4
+        orgv, newv = struct.unpack_from("<II", d, p)
+        p += 8 + 8 * newv
+        (nss,) = struct.unpack_from("<I", d, p)
+        p += 4 + 4 * nss
+        (nsegs,) = struct.unpack_from("<I", d, p)
+        p += 4 + 11 * nsegs
+        (nn,) = struct.unpack_from("<I", d, p)
+        p += 4
+        children = []
+        for i in range(nn):
+            c0, c1 = struct.unpack_from("<II", d, p + 20)
+            children.append((c0, c1))
+            p += 28
+        leafbit = 0x80000000
+    else:
+        nsegs = len(lumps.get("SEGS", b"")) // 12
+        nss = len(lumps.get("SSECTORS", b"")) // 4
+        nn = len(nodes_lump) // 28
+        children = [struct.unpack_from("<HH", nodes_lump, 28 * i + 24) for i in range(nn)]
+        leafbit = 0x8000
+    depth = 0
+    if nn:
+        stack = [(nn - 1, 1)]
+        while stack:
+            n, d = stack.pop()
+            depth = max(depth, d)
+            for c in children[n]:
+                if not c & leafbit and c < nn:
+                    stack.append((c, d + 1))
+    return nsegs, nss, depth
+
+
+def wad_totals(maps_by_wad, built_paths):
+    tot = {"maps": 0, "splits": 0, "segs": 0, "leaves": 0, "max_depth": 0}
+    for wadname, maps in maps_by_wad.items():
+        out = read_wad(built_paths[wadname]) if built_paths else maps
+        for m, lumps in maps.items():
+            segs, leaves, depth = node_figures(out[m])
+            tot["maps"] += 1
+            tot["splits"] += segs - sides_of(lumps)
+            tot["segs"] += segs
+            tot["leaves"] += leaves
+            tot["max_depth"] = max(tot["max_depth"], depth)
+    return tot
+
+
+def run_bspc(bspc, wads, maps_by_wad, strategy, tmp):
+    tot = {"maps": 0, "splits": 0, "tjunc": 0, "segs": 0, "leaves": 0, "max_depth": 0,
+           "build_ms": 0.0, "failed": []}
+    out = os.path.join(tmp, "out.bsc")
+    t0 = time.perf_counter()
+    for wadname, maps in maps_by_wad.items():
+        for m, lumps in maps.items():
+            spec = f"{wads[wadname]}:{m}"
+            r = subprocess.run([bspc, spec, "--split", strategy, "--stats", "-o", out],
+                               capture_output=True, text=True)
+            if r.returncode != 0:
+                tot["failed"].append(f"{wadname}:{m}: {r.stderr.strip()}")
+                continue
+            st = json.loads(r.stdout)
+            tot["maps"] += 1
+            tot["splits"] += st["splits"]
+            tot["segs"] += st["segs"]
+            tot["tjunc"] += st["segs"] - st["splits"] - sides_of(lumps, True)
+            tot["leaves"] += st["leaves"]
+            tot["max_depth"] = max(tot["max_depth"], st["max_depth"])
+            tot["build_ms"] += st["build_ms"]
+    tot["wall_s"] = time.perf_counter() - t0
+    return tot
+
+
+def run_external(cmd_for, wads, tmp, label):
+    built, wall = {}, 0.0
+    for wadname, path in wads.items():
+        outp = os.path.join(tmp, f"{label}-{wadname}")
+        t0 = time.perf_counter()
+        r = subprocess.run(cmd_for(path, outp), capture_output=True, text=True)
+        wall += time.perf_counter() - t0
+        if r.returncode != 0 or not os.path.isfile(outp):
+            print(f"bench-bsp: {label} failed on {wadname}: {r.stderr.strip()[:200]}",
+                  file=sys.stderr)
+            return None, wall
+        built[wadname] = outp
+    return built, wall
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--bspc", default="build/bspc")
+    ap.add_argument("--out", default="build/bench-bsp.md")
+    ap.add_argument("--strategies", default="fewest,balanced,mixed")
+    args = ap.parse_args()
+
+    wads = {w: find_wad(w) for w in WADS}
+    missing = [w for w, p in wads.items() if not p]
+    if missing:
+        print(f"bench-bsp: {', '.join(missing)} not found (apt-get install freedoom)", file=sys.stderr)
+        return 1
+    if not os.access(args.bspc, os.X_OK):
+        print(f"bench-bsp: {args.bspc} not built", file=sys.stderr)
+        return 1
+    maps_by_wad = {w: read_wad(p) for w, p in wads.items()}
+    nmaps = sum(len(m) for m in maps_by_wad.values())
+
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for s in args.strategies.split(","):
+            t = run_bspc(args.bspc, wads, maps_by_wad, s, tmp)
+            note = f"build + blob {t['build_ms'] / 1000:.2f} s"
+            if t["failed"]:
+                note += f"; {len(t['failed'])} map(s) failed: " + "; ".join(t["failed"][:3])
+            rows.append((f"bspc --split {s}", t["maps"], t["splits"], t["tjunc"], t["segs"],
+                         t["leaves"], t["max_depth"], f"{t['wall_s']:.2f}", note))
+        if shutil.which("zdbsp"):
+            built, wall = run_external(lambda i, o: ["zdbsp", "-o", o, i], wads, tmp, "zdbsp")
+            if built:
+                t = wad_totals(maps_by_wad, built)
+                rows.append(("zdbsp (defaults)", t["maps"], t["splits"], "-", t["segs"], t["leaves"],
+                             t["max_depth"], f"{wall:.2f}", "whole WADs, with blockmap and reject"))
+        if shutil.which("glbsp"):
+            built, wall = run_external(lambda i, o: ["glbsp", "-q", "-n", i, "-o", o], wads, tmp,
+                                       "glbsp")
+            if built:
+                t = wad_totals(maps_by_wad, built)
+                rows.append(("glbsp -n (normal nodes)", t["maps"], t["splits"], "-", t["segs"],
+                             t["leaves"], t["max_depth"], f"{wall:.2f}",
+                             "whole WADs, also builds GL nodes"))
+        t = wad_totals(maps_by_wad, None)
+        rows.append(("nodes shipped in Freedoom", t["maps"], t["splits"], "-", t["segs"],
+                     t["leaves"], t["max_depth"], "-", "read from the WADs"))
+
+    head = ("builder", "maps", "splits", "T-junction splits", "segs", "leaves", "max depth",
+            "time (s)", "notes")
+    lines = [f"# BSP build over the {nmaps} Freedoom maps", "",
+             "splits: segs cut by partitions (for the other builders: segs - linedef sides). "
+             "bspc also splits segs at T-junctions (vertices on a seg's interior, and split "
+             "points made on one side of a two-sided line), counted apart; the others do not. "
+             "time: wall clock, process start and WAD reading included (bspc: one process per "
+             "map; zdbsp, glbsp: one per WAD).", "",
+             "| " + " | ".join(head) + " |", "|" + "|".join("---" for _ in head) + "|"]
+    for r in rows:
+        lines.append("| " + " | ".join(f"{v:,}" if isinstance(v, int) else str(v) for v in r) + " |")
+    text = "\n".join(lines) + "\n"
+    sys.stdout.write(text)
+    os.makedirs(os.path.dirname(args.out) or ".", exist_ok=True)
+    with open(args.out, "w") as f:
+        f.write(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,217 @@
+/* blob_write.c - serialises the built tree as the compiled-scene blob of
+ * firmware/scene_format.h: little-endian whatever the host, header first,
+ * sections in enum order, each 4-byte aligned, CRC-32 over bytes [16, total). */
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bspc_int.h"
+#include "crc32.h"
+
+_Static_assert(sizeof(scn_header) == 44 + 8 * SCN_SEC_COUNT, "scn_header layout");
+_Static_assert(sizeof(scn_vertex) == 8, "scn_vertex layout");
+_Static_assert(sizeof(scn_sector) == 12, "scn_sector layout");
+_Static_assert(sizeof(scn_line) == 24, "scn_line layout");
+_Static_assert(sizeof(scn_seg) == 16, "scn_seg layout");
+_Static_assert(sizeof(scn_node) == 56, "scn_node layout");
+_Static_assert(sizeof(scn_leaf) == 20, "scn_leaf layout");
+
+typedef struct {
+    uint8_t *p;
+    size_t at;
+} wr;
+
+static void w8(wr *w, uint8_t v) { w->p[w->at++] = v; }
+static void w16(wr *w, uint16_t v)
+{
+    w8(w, (uint8_t)v);
+    w8(w, (uint8_t)(v >> 8));
+}
+static void w32(wr *w, uint32_t v)
+{
+    w16(w, (uint16_t)v);
+    w16(w, (uint16_t)(v >> 16));
+}
+static void wi32(wr *w, int32_t v) { w32(w, (uint32_t)v); }
+
+static void bbox_add(int32_t b[4], int32_t x, int32_t y)
+{
+    if (y > b[0]) b[0] = y; /* top */
+    if (y < b[1]) b[1] = y; /* bottom */
+    if (x < b[2]) b[2] = x; /* left */
+    if (x > b[3]) b[3] = x; /* right */
+}
+
+static void bbox_union(int32_t b[4], const int32_t c[4])
+{
+    if (c[0] > b[0]) b[0] = c[0];
+    if (c[1] < b[1]) b[1] = c[1];
+    if (c[2] < b[2]) b[2] = c[2];
+    if (c[3] > b[3]) b[3] = c[3];
+}
+
+static const int32_t empty_box[4] = {INT32_MIN, INT32_MAX, INT32_MAX, INT32_MIN};
+
+/* bbox of a child: leaf polygon and segs, or the union of a node's children */
+static void child_box(const bs_tree *t, uint32_t child, int32_t (*nodebox)[4], int32_t out[4])
+{
+    memcpy(out, empty_box, sizeof empty_box);
+    if (child & SCN_LEAF_BIT) {
+        const bs_leaf *L = &t->leaves[child & ~SCN_LEAF_BIT];
+        for (uint32_t k = 0; k < L->poly.n; k++) bbox_add(out, L->poly.v[k].x, L->poly.v[k].y);
+        for (uint32_t k = 0; k < L->nsegs; k++) {
+            const bs_seg *g = &t->segs[L->segs[k]];
+            bbox_add(out, g->x1, g->y1);
+            bbox_add(out, g->x2, g->y2);
+        }
+    } else {
+        memcpy(out, nodebox[child], sizeof(int32_t) * 4);
+    }
+}
+
+int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *len, char *err,
+                  size_t errlen)
+{
+    /* node boxes, children before parents (nodes are numbered parent first) */
+    int32_t(*nodebox)[4] = malloc(sizeof *nodebox * (t->nnodes + 1));
+    int32_t(*childbox)[2][4] = malloc(sizeof *childbox * (t->nnodes + 1));
+    if (!nodebox || !childbox) {
+        free(nodebox);
+        free(childbox);
+        return bs_fail(err, errlen, "%s: out of memory", s->name);
+    }
+    for (uint32_t i = t->nnodes; i-- > 0;) {
+        memcpy(nodebox[i], empty_box, sizeof empty_box);
+        for (int c = 0; c < 2; c++) {
+            child_box(t, t->nodes[i].child[c], nodebox, childbox[i][c]);
+            if (childbox[i][c][0] < childbox[i][c][1]) /* empty: no geometry below */
+                memset(childbox[i][c], 0, sizeof childbox[i][c]);
+            else
+                bbox_union(nodebox[i], childbox[i][c]);
+        }
+    }
+
+    uint32_t npv = 0;
+    for (uint32_t i = 0; i < t->nleaves; i++) npv += t->leaves[i].poly.n;
+    uint32_t counts[SCN_SEC_COUNT] = {t->nverts, s->nsectors, s->nlines, t->nsegs,
+                                      t->nnodes, t->nleaves,  npv,       256};
+    static const uint32_t recsz[SCN_SEC_COUNT] = {8, 12, 24, 16, 56, 20, 8, 3};
+    uint32_t off[SCN_SEC_COUNT];
+    uint64_t at = sizeof(scn_header);
+    for (int k = 0; k < SCN_SEC_COUNT; k++) {
+        at = (at + 3) & ~(uint64_t)3;
+        off[k] = (uint32_t)at;
+        at += (uint64_t)counts[k] * recsz[k];
+    }
+    at = (at + 3) & ~(uint64_t)3;
+    if (at > UINT32_MAX) {
+        free(nodebox);
+        free(childbox);
+        return bs_fail(err, errlen, "%s: compiled scene larger than 4 GiB", s->name);
+    }
+    uint8_t *p = calloc((size_t)at, 1);
+    if (!p) {
+        free(nodebox);
+        free(childbox);
+        return bs_fail(err, errlen, "%s: out of memory", s->name);
+    }
+    wr w = {p, 0};
+
+    /* header */
+    w32(&w, SCN_MAGIC);
+    w16(&w, SCN_VERSION);
+    w16(&w, (uint16_t)sizeof(scn_header));
+    w32(&w, (uint32_t)at);
+    w32(&w, 0); /* crc, below */
+    w32(&w, 0); /* flags */
+    wi32(&w, s->player_x);
+    wi32(&w, s->player_y);
+    wi32(&w, s->player_angle);
+    w32(&w, s->player_sector);
+    w32(&w, t->root);
+    w32(&w, t->max_depth);
+    for (int k = 0; k < SCN_SEC_COUNT; k++) {
+        w32(&w, off[k]);
+        w32(&w, counts[k]);
+    }
+
+    w.at = off[SCN_SEC_VERTICES];
+    for (uint32_t i = 0; i < t->nverts; i++) {
+        wi32(&w, t->vx[i]);
+        wi32(&w, t->vy[i]);
+    }
+    w.at = off[SCN_SEC_SECTORS];
+    for (uint32_t i = 0; i < s->nsectors; i++) {
+        const bs_sector *c = &s->sectors[i];
+        wi32(&w, c->floor_h);
+        wi32(&w, c->ceil_h);
+        w8(&w, c->floor_color);
+        w8(&w, c->ceil_color);
+        w8(&w, c->light);
+        w8(&w, c->flags);
+    }
+    w.at = off[SCN_SEC_LINES];
+    for (uint32_t i = 0; i < s->nlines; i++) {
+        const bs_line *l = &s->lines[i];
+        w32(&w, t->line_v[2 * i]);
+        w32(&w, t->line_v[2 * i + 1]);
+        w32(&w, l->sector[0]);
+        w32(&w, l->sector[1]);
+        for (int sd = 0; sd < 2; sd++)
+            for (int part = 0; part < 3; part++) w8(&w, l->color[sd][part]);
+        w16(&w, 0);
+    }
+    w.at = off[SCN_SEC_SEGS];
+    for (uint32_t i = 0; i < t->nleaves; i++) {
+        const bs_leaf *L = &t->leaves[i];
+        for (uint32_t k = 0; k < L->nsegs; k++) {
+            const bs_seg *g = &t->segs[L->segs[k]];
+            w32(&w, g->v1);
+            w32(&w, g->v2);
+            w32(&w, g->line);
+            w32(&w, g->side);
+        }
+    }
+    w.at = off[SCN_SEC_NODES];
+    for (uint32_t i = 0; i < t->nnodes; i++) {
+        const bs_node *N = &t->nodes[i];
+        const bs_pline *P = &t->plines[N->pline];
+        wi32(&w, P->x);
+        wi32(&w, P->y);
+        wi32(&w, N->rev ? -P->dx : P->dx);
+        wi32(&w, N->rev ? -P->dy : P->dy);
+        for (int c = 0; c < 2; c++)
+            for (int k = 0; k < 4; k++) wi32(&w, childbox[i][c][k]);
+        w32(&w, N->child[0]);
+        w32(&w, N->child[1]);
+    }
+    w.at = off[SCN_SEC_LEAVES];
+    uint32_t fs = 0, fp = 0;
+    for (uint32_t i = 0; i < t->nleaves; i++) {
+        const bs_leaf *L = &t->leaves[i];
+        w32(&w, fs);
+        w32(&w, L->nsegs);
+        w32(&w, L->sector);
+        w32(&w, fp);
+        w32(&w, L->poly.n);
+        fs += L->nsegs;
+        fp += L->poly.n;
+    }
+    w.at = off[SCN_SEC_PVERTS];
+    for (uint32_t i = 0; i < t->nleaves; i++)
+        for (uint32_t k = 0; k < t->leaves[i].poly.n; k++) {
+            wi32(&w, t->leaves[i].poly.v[k].x);
+            wi32(&w, t->leaves[i].poly.v[k].y);
+        }
+    w.at = off[SCN_SEC_PALETTE];
+    bs_palette(p + w.at);
+
+    uint32_t crc = crc_update(0, p + 16, (size_t)at - 16);
+    w.at = 12;
+    w32(&w, crc);
+    free(nodebox);
+    free(childbox);
+    *blob = p;
+    *len = (size_t)at;
+    return 0;
+}

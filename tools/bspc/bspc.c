@@ -1,0 +1,163 @@
+/* bspc.c - the compiler's library entry points (bspc.h): resolve the scene spec,
+ * read and validate the scene, build the tree, remove T-junctions, write the blob. */
+#include <ctype.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bspc_int.h"
+#include "geom.h"
+
+bspc_options bspc_defaults(void)
+{
+    bspc_options o;
+    o.split = BSPC_SPLIT_MIXED;
+    o.verbose = 0;
+    return o;
+}
+
+static int readable(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return 0;
+    fclose(f);
+    return 1;
+}
+
+int bspc_find_wad(const char *name, char *out, size_t outlen)
+{
+    if (!name || !*name || !out || outlen == 0) return -1;
+    if (readable(name) || strchr(name, '/')) {
+        if (!readable(name) || strlen(name) >= outlen) return -1;
+        snprintf(out, outlen, "%s", name);
+        return 0;
+    }
+    const char *dirs[2] = {getenv("DOOMWADDIR"), "/usr/share/games/doom"};
+    for (int i = 0; i < 2; i++) {
+        if (!dirs[i] || !*dirs[i]) continue;
+        int n = snprintf(out, outlen, "%s/%s", dirs[i], name);
+        if (n > 0 && (size_t)n < outlen && readable(out)) return 0;
+    }
+    return -1;
+}
+
+static int ends_with_wad(const char *s, size_t n)
+{
+    return n >= 4 && s[n - 4] == '.' && tolower((unsigned char)s[n - 3]) == 'w' &&
+           tolower((unsigned char)s[n - 2]) == 'a' && tolower((unsigned char)s[n - 1]) == 'd';
+}
+
+static uint32_t walk_sector(const bs_tree *t, int32_t x, int32_t y)
+{
+    uint32_t n = t->root;
+    while (n != SCN_NONE && !(n & SCN_LEAF_BIT)) {
+        const bs_node *N = &t->nodes[n];
+        n = N->child[bs_side(&t->plines[N->pline], N->rev, x, y) >= 0 ? 0 : 1];
+    }
+    return n == SCN_NONE ? SCN_NONE : t->leaves[n & ~SCN_LEAF_BIT].sector;
+}
+
+int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, size_t *len,
+                 bspc_stats *stats, char *err, size_t errlen)
+{
+    bspc_options opt = opt_in ? *opt_in : bspc_defaults();
+    if (err && errlen) err[0] = 0;
+    if (!spec || !*spec || !blob || !len) return bs_fail(err, errlen, "bspc: no input scene given");
+    *blob = NULL;
+    *len = 0;
+
+    bs_scene s;
+    bs_tree t;
+    memset(&s, 0, sizeof s);
+    memset(&t, 0, sizeof t);
+    int rc = -1;
+
+    /* "file.wad:MAP01" or a text scene */
+    size_t sl = strlen(spec);
+    const char *colon = strrchr(spec, ':');
+    if (colon && ends_with_wad(spec, (size_t)(colon - spec))) {
+        char wadname[1024], path[1100];
+        size_t wl = (size_t)(colon - spec);
+        if (wl >= sizeof wadname) return bs_fail(err, errlen, "%s: file name too long", spec);
+        memcpy(wadname, spec, wl);
+        wadname[wl] = 0;
+        if (!colon[1])
+            return bs_fail(err, errlen, "%s: no map named after the ':' (e.g. %sMAP01)", spec, spec);
+        if (bspc_find_wad(wadname, path, sizeof path))
+            return bs_fail(err, errlen, "%s: cannot find %s (looked in the current folder, "
+                           "$DOOMWADDIR and /usr/share/games/doom)", spec, wadname);
+        if (bs_read_wad(path, colon + 1, spec, &s, &opt, err, errlen)) goto out;
+    } else if (ends_with_wad(spec, sl)) {
+        return bs_fail(err, errlen, "%s: name a map in the WAD, e.g. %s:MAP01 or %s:E1M1", spec, spec,
+                       spec);
+    } else {
+        if (bs_read_text(spec, &s, &opt, err, errlen)) goto out;
+    }
+
+    if (bs_check_ranges(&s, err, errlen)) goto out;
+    if (s.is_text && bs_check_closed(&s, err, errlen)) goto out;
+    s.player_sector = bs_player_sector(&s);
+    if (s.player_sector == SCN_NONE && s.is_text) {
+        char b1[32], b2[32];
+        bs_fail(err, errlen, "%s:%d: player at (%s, %s) is not inside any sector", s.name,
+                s.player_line, bs_fxstr(s.player_x, b1), bs_fxstr(s.player_y, b2));
+        goto out;
+    }
+
+    double t0 = bs_now_ms();
+    if (bs_build(&s, &opt, &t, err, errlen)) goto out;
+    double t_tree = bs_now_ms();
+    if (bs_tjunc_segs(&t, err, errlen) || bs_tjunc_polys(&t, err, errlen)) goto out;
+    double t_tj = bs_now_ms();
+
+    uint64_t dsum = 0;
+    t.max_depth = 0;
+    for (uint32_t i = 0; i < t.nleaves; i++) {
+        dsum += t.leaves[i].depth;
+        if (t.leaves[i].depth > t.max_depth) t.max_depth = t.leaves[i].depth;
+    }
+    t.mean_depth = t.nleaves ? (double)dsum / t.nleaves : 0.0;
+    if (t.max_depth > SCN_MAX_DEPTH) {
+        bs_fail(err, errlen, "%s: BSP tree %u nodes deep, deeper than %d (try --split balanced)",
+                s.name, t.max_depth, SCN_MAX_DEPTH);
+        goto out;
+    }
+    {
+        /* the sector the renderer will find: that of the player's leaf (it can
+         * differ from the winding-number answer in maps with overlapping sectors) */
+        uint32_t walked = walk_sector(&t, s.player_x, s.player_y);
+        if (s.player_sector == SCN_NONE)
+            bs_warn(&opt, "%s: player start is inside no closed sector; using the sector of its "
+                    "leaf (%d)", s.name, (int)walked);
+        else if (walked != s.player_sector)
+            bs_warn(&opt, "%s: player start: sector %u by its walls, sector %u by its leaf; using "
+                    "the leaf's", s.name, s.player_sector, walked);
+        if (walked != SCN_NONE) s.player_sector = walked;
+    }
+    if (bs_write_blob(&s, &t, blob, len, err, errlen)) goto out;
+    double t1 = bs_now_ms();
+    bs_note(&opt, "%s: times: tree %.2f ms, T-junctions %.2f ms, blob %.2f ms", s.name, t_tree - t0,
+            t_tj - t_tree, t1 - t_tj);
+
+    bs_note(&opt, "%s: %u linedefs, %u segs (%u partition splits, %u T-junction splits), %u nodes, "
+            "%u leaves, %u vertices, depth %u (mean %.2f), %u polygon vertices inserted, %.2f ms",
+            s.name, s.nlines, t.nsegs, t.part_splits, t.tj_splits, t.nnodes, t.nleaves, t.nverts,
+            t.max_depth, t.mean_depth, t.tj_pverts, t1 - t0);
+    if (stats) {
+        memset(stats, 0, sizeof *stats);
+        stats->input_walls = s.nlines;
+        stats->segs = t.nsegs;
+        stats->splits = t.part_splits; /* T-junction pieces are in segs, not here */
+        stats->leaves = t.nleaves;
+        stats->nodes = t.nnodes;
+        stats->vertices = t.nverts;
+        stats->max_depth = t.max_depth;
+        stats->mean_depth = t.mean_depth;
+        stats->build_ms = t1 - t0;
+    }
+    rc = 0;
+out:
+    bs_tree_free(&t);
+    bs_scene_free(&s);
+    return rc;
+}

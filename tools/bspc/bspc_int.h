@@ -1,0 +1,232 @@
+/* bspc_int.h - private types and helpers shared by the BSP compiler's files
+ * (prefix bs_). Not installed, not used outside tools/bspc.
+ *
+ * Pipeline (bspc.c): a source scene (scene_text.c or wad.c) becomes a bs_scene;
+ * scene_check.c validates it and finds the player's sector; bsp_build.c builds
+ * the tree (split choice, exact seg splitting, leaf regions); leaf_poly.c owns
+ * the convex-polygon clipping; tjunc.c removes T-junctions from segs and leaf
+ * polygons; blob_write.c writes firmware/scene_format.h.
+ *
+ * Numbers: every coordinate is 16.16 (one raw unit = 1/65536 map unit) held in
+ * an int32_t. Side tests and intersections use exact integer arithmetic
+ * (__int128 products); the only tolerance is BS_EPS, see geom.h.
+ */
+#ifndef BSPC_INT_H
+#define BSPC_INT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "bspc.h"
+#include "scene_format.h"
+
+__extension__ typedef __int128 bs_i128;
+__extension__ typedef unsigned __int128 bs_u128;
+
+#define BS_COORD_RAW_MAX ((int64_t)SCN_COORD_MAX * 65536)
+#define BS_HEIGHT_RAW_MAX ((int64_t)SCN_HEIGHT_MAX * 65536)
+
+/* ---- errors and warnings (util.c) ---- */
+
+/* Format a one-line message into err; always returns -1. */
+int bs_fail(char *err, size_t errlen, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+/* Print "bspc: warning: ..." on stderr when opt->verbose; otherwise silent. */
+void bs_warn(const bspc_options *opt, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/* Same, without the "warning:" prefix (progress notes). */
+void bs_note(const bspc_options *opt, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/* Grow *p (element size sz) so that it holds at least need elements. 0 or -1. */
+int bs_grow(void *pp, uint32_t *cap, uint32_t need, size_t sz);
+/* A 16.16 value as decimal text (up to 5 fractional digits, trailing zeros cut). */
+const char *bs_fxstr(int32_t v, char buf[32]);
+double bs_now_ms(void);
+
+/* ---- the source scene ---- */
+
+typedef struct {
+    int32_t floor_h, ceil_h; /* 16.16 */
+    uint8_t floor_color, ceil_color, light, flags;
+    int src_line;            /* text: line of the declaration; WAD: 0 */
+    char name[32];           /* text: optional name; WAD: "" */
+} bs_sector;
+
+typedef struct {
+    uint32_t v1, v2;      /* scene vertex indices */
+    uint32_t sector[2];   /* front, back (SCN_NONE) */
+    uint8_t color[2][3];  /* [side][SCN_PART_*] */
+    int src_line;         /* text: line number; WAD: linedef index in the lump */
+} bs_line;
+
+typedef struct {
+    char name[300];                 /* for messages: "a.scene" or "x.wad:MAP01" */
+    int is_text;                    /* messages quote text line numbers */
+    int32_t *vx, *vy;               /* 16.16 */
+    uint32_t nverts, vcap;
+    bs_sector *sectors;
+    uint32_t nsectors, scap;
+    bs_line *lines;
+    uint32_t nlines, lcap;
+    int has_player;
+    int32_t player_x, player_y, player_angle; /* 16.16; angle in degrees */
+    int player_line;
+    uint32_t player_sector;         /* filled by bs_scene_check / bspc.c */
+} bs_scene;
+
+void bs_scene_free(bs_scene *s);
+/* Append a vertex; returns its index or SCN_NONE on allocation failure. */
+uint32_t bs_scene_add_vertex(bs_scene *s, int32_t x, int32_t y);
+
+/* scene_text.c: parse the text format (docs/scene-format.md). */
+int bs_read_text(const char *path, bs_scene *s, const bspc_options *opt, char *err, size_t errlen);
+/* wad.c: read one Doom-format map. wadpath: a resolved file; map: "MAP01"/"E1M1";
+ * display: the spec as the user wrote it, for messages. */
+int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_scene *s,
+                const bspc_options *opt, char *err, size_t errlen);
+
+/* scene_check.c: ranges (both inputs); closed loops and orientation (strict, text
+ * scenes); the player's sector by winding number (SCN_NONE if outside all). */
+int bs_check_ranges(const bs_scene *s, char *err, size_t errlen);
+int bs_check_closed(const bs_scene *s, char *err, size_t errlen);
+uint32_t bs_player_sector(const bs_scene *s);
+
+/* palette.c: the default 256-colour palette: 16 ramps (hues) x 16 shades,
+ * index = ramp * 16 + shade, shade 0 darkest. See docs/scene-format.md. */
+enum {
+    BS_RAMP_GREY, BS_RAMP_RED, BS_RAMP_ORANGE, BS_RAMP_YELLOW, BS_RAMP_LIME,
+    BS_RAMP_GREEN, BS_RAMP_TEAL, BS_RAMP_CYAN, BS_RAMP_BLUE, BS_RAMP_VIOLET,
+    BS_RAMP_MAGENTA, BS_RAMP_BROWN, BS_RAMP_SAND, BS_RAMP_MOSS, BS_RAMP_SLATE,
+    BS_RAMP_PLUM, BS_RAMP_COUNT
+};
+void bs_palette(uint8_t pal[768]);
+const char *bs_ramp_name(int ramp);
+/* "NAME" or "NAME:SHADE" (shade 0..15, default 10) -> index; -1 if unknown. */
+int bs_color_by_name(const char *s);
+/* Doom texture / flat names (up to 8 chars, not NUL-terminated when 8 long). */
+uint8_t bs_wall_color(const char tex[8], int light, int contrast);
+uint8_t bs_flat_color(const char flat[8], int light, int ceiling);
+uint8_t bs_sky_color(void);
+uint8_t bs_neutral_color(int light);
+
+/* ---- geometry (geom.c, geom.h) ---- */
+
+typedef struct {
+    int32_t x, y;     /* a point of the line, 16.16 */
+    int32_t dx, dy;   /* direction as written to scn_node, 16.16 raw; not both 0 */
+    int32_t rdx, rdy; /* the same direction divided by gcd(dx, dy): used by the arithmetic */
+    int64_t thr;      /* |cross| <= thr means "on the line": isqrt(BS_EPS^2 (rdx^2+rdy^2)) */
+    int small;        /* |rdx|, |rdy| < 2^29: cross products fit in 64 bits */
+} bs_pline;
+
+typedef struct {
+    int32_t x, y;
+    uint32_t eline;   /* bs_pline index of the edge from this vertex to the next */
+} bs_pv;
+
+typedef struct {
+    bs_pv *v;
+    uint32_t n, cap;
+} bs_poly;
+
+/* ---- the tree under construction (bsp_build.c) ---- */
+
+typedef struct {
+    int32_t x1, y1, x2, y2; /* copies of the vertex coordinates */
+    uint32_t v1, v2;        /* tree vertex indices */
+    uint32_t line;          /* linedef (also its bs_pline index) */
+    uint32_t side;          /* 0 front, 1 back: the seg runs v2->v1 of the line */
+} bs_seg;
+
+typedef struct {
+    uint32_t pline; /* partition = plines[pline], reversed when rev */
+    uint32_t rev;
+    uint32_t child[2];
+    int32_t bbox[2][4];
+} bs_node;
+
+typedef struct {
+    uint32_t *segs;
+    uint32_t nsegs, cap;
+    uint32_t sector;
+    uint32_t depth;  /* nodes on the path from the root */
+    uint32_t parent; /* node index or SCN_NONE */
+    bs_poly poly;
+} bs_leaf;
+
+typedef struct {
+    /* vertices: scene vertices that lines use, in scene order, then split points */
+    int32_t *vx, *vy;
+    uint32_t nverts, vcap, norig;
+    uint32_t *line_v; /* per line: tree indices of v1, v2 */
+    uint32_t *vhash; /* open addressing: vertex index + 1, 0 empty */
+    uint32_t hcap;
+    bs_pline *plines; /* one per line, the 4 world-box edges, then free partitions */
+    uint32_t nplines, plcap;
+    bs_seg *segs;
+    uint32_t nsegs, segcap, nsides;
+    bs_node *nodes;
+    uint32_t nnodes, nodecap;
+    bs_leaf *leaves;
+    uint32_t nleaves, leafcap;
+    uint32_t root;
+    uint32_t max_depth;
+    double mean_depth;
+    uint32_t part_splits; /* seg splits made by partitions */
+    uint32_t tj_splits;   /* seg splits made by T-junction removal */
+    uint32_t tj_pverts;   /* vertices inserted into leaf polygons */
+    int32_t world[4];     /* xmin, ymin, xmax, ymax of the world box (16.16) */
+} bs_tree;
+
+/* Vertex table: index of (x, y), adding it if new; SCN_NONE on allocation failure. */
+uint32_t bs_vertex(bs_tree *t, int32_t x, int32_t y);
+
+int bs_build(const bs_scene *s, const bspc_options *opt, bs_tree *t, char *err, size_t errlen);
+
+/* split_choice.c: partition choice for a set of segs */
+typedef struct {
+    uint32_t pl, rev; /* the line plines[pl], reversed when rev */
+    /* pl == SCN_NONE: a line on no seg, to be made by the caller: x = c (axis 0,
+     * pointing north) or y = c (axis 1, pointing east) */
+    int axis;
+    int32_t c;
+} bs_part;
+typedef struct bs_chooser bs_chooser;
+bs_chooser *bs_chooser_new(const bs_tree *t, bspc_split strategy);
+void bs_chooser_free(bs_chooser *C);
+/* 0 and *out: a partition for the set; 1: the set is convex (a leaf); -1: out of memory */
+int bs_choose(bs_chooser *C, const uint32_t *segs, uint32_t n, uint32_t depth, bs_part *out);
+/* Does seg g, lying on the line of p, run the same way as p? */
+int bs_same_dir(const bs_tree *t, const bs_seg *g, bs_part p);
+void bs_tree_free(bs_tree *t);
+
+/* leaf_poly.c */
+void bs_poly_free(bs_poly *p);
+int bs_poly_push(bs_poly *p, int32_t x, int32_t y, uint32_t eline);
+/* Split p by the oriented line (pl, rev) into the part on its front (right) and
+ * the part on its back; either may come out empty (n == 0). -1 on allocation failure. */
+int bs_poly_split(const bs_tree *t, const bs_poly *p, uint32_t pl, uint32_t rev, bs_poly *front,
+                  bs_poly *back);
+/* Keep only the front (right) part of p, in place. */
+int bs_poly_clip_front(const bs_tree *t, bs_poly *p, uint32_t pl, uint32_t rev);
+/* Drop repeated points and degenerate polygons (< 3 distinct points, zero area). */
+void bs_poly_tidy(bs_poly *p);
+
+/* tjunc.c */
+int bs_tjunc_segs(bs_tree *t, char *err, size_t errlen);
+int bs_tjunc_polys(bs_tree *t, char *err, size_t errlen);
+
+/* blob_write.c */
+int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *len, char *err,
+                  size_t errlen);
+
+#endif

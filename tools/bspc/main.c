@@ -1,0 +1,134 @@
+/* main.c - build/bspc, the BSP compiler's command line:
+ *   bspc INPUT [-o OUT] [--split fewest|balanced|mixed] [--stats] [-v]
+ * INPUT is a text scene (docs/scene-format.md) or file.wad:MAP01 / file.wad:E1M1. */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bspc.h"
+
+static void usage(FILE *f)
+{
+    fputs("usage: bspc INPUT [-o OUT] [--split fewest|balanced|mixed] [--stats] [-v]\n"
+          "\n"
+          "Compiles a scene into a BSP blob (firmware/scene_format.h).\n"
+          "  INPUT            a text scene (docs/scene-format.md), or a Doom-format map as\n"
+          "                   file.wad:MAP01 or file.wad:E1M1 (a WAD named without a folder is\n"
+          "                   also looked for in $DOOMWADDIR and /usr/share/games/doom)\n"
+          "  -o OUT           output file (default: INPUT's base name with .bsc, in the\n"
+          "                   current folder; file.wad:MAP01 gives file-MAP01.bsc)\n"
+          "  --split S        partition choice: fewest (fewest splits), balanced (best\n"
+          "                   balance) or mixed (weighted, the default)\n"
+          "  --stats          print one JSON object of build figures on stdout\n"
+          "  -v               progress and warnings on stderr\n"
+          "  --help           this text\n",
+          f);
+}
+
+static void default_out(const char *in, char *out, size_t n)
+{
+    const char *base = strrchr(in, '/');
+    base = base ? base + 1 : in;
+    char tmp[1024];
+    snprintf(tmp, sizeof tmp, "%s", base);
+    char *colon = strrchr(tmp, ':');
+    const char *map = NULL;
+    if (colon) {
+        *colon = 0;
+        map = colon + 1;
+    }
+    char *dot = strrchr(tmp, '.');
+    if (dot && dot != tmp) *dot = 0;
+    if (map && *map)
+        snprintf(out, n, "%s-%s.bsc", tmp, map);
+    else
+        snprintf(out, n, "%s.bsc", tmp);
+}
+
+int main(int argc, char **argv)
+{
+    const char *in = NULL, *outp = NULL;
+    int want_stats = 0;
+    bspc_options opt = bspc_defaults();
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            usage(stdout);
+            return 0;
+        } else if (strcmp(a, "-v") == 0 || strcmp(a, "--verbose") == 0) {
+            opt.verbose = 1;
+        } else if (strcmp(a, "--stats") == 0) {
+            want_stats = 1;
+        } else if (strcmp(a, "-o") == 0) {
+            if (++i >= argc) {
+                fprintf(stderr, "bspc: -o needs a file name\n");
+                return 2;
+            }
+            outp = argv[i];
+        } else if (strcmp(a, "--split") == 0 || strncmp(a, "--split=", 8) == 0) {
+            const char *v = a[7] == '=' ? a + 8 : (++i < argc ? argv[i] : NULL);
+            if (!v) {
+                fprintf(stderr, "bspc: --split needs fewest, balanced or mixed\n");
+                return 2;
+            }
+            if (strcmp(v, "fewest") == 0)
+                opt.split = BSPC_SPLIT_FEWEST;
+            else if (strcmp(v, "balanced") == 0)
+                opt.split = BSPC_SPLIT_BALANCED;
+            else if (strcmp(v, "mixed") == 0)
+                opt.split = BSPC_SPLIT_MIXED;
+            else {
+                fprintf(stderr, "bspc: --split %s: expected fewest, balanced or mixed\n", v);
+                return 2;
+            }
+        } else if (a[0] == '-' && a[1]) {
+            fprintf(stderr, "bspc: unknown option %s (see bspc --help)\n", a);
+            return 2;
+        } else if (!in) {
+            in = a;
+        } else {
+            fprintf(stderr, "bspc: more than one input (%s and %s)\n", in, a);
+            return 2;
+        }
+    }
+    if (!in) {
+        usage(stderr);
+        return 2;
+    }
+    char outbuf[1100];
+    if (!outp) {
+        default_out(in, outbuf, sizeof outbuf);
+        outp = outbuf;
+    }
+
+    uint8_t *blob = NULL;
+    size_t len = 0;
+    bspc_stats st;
+    char err[512];
+    if (bspc_compile(in, &opt, &blob, &len, &st, err, sizeof err)) {
+        fprintf(stderr, "bspc: %s\n", err);
+        return 1;
+    }
+    FILE *f = fopen(outp, "wb");
+    if (!f) {
+        fprintf(stderr, "bspc: %s: cannot write: %s\n", outp, strerror(errno));
+        free(blob);
+        return 1;
+    }
+    size_t wrote = fwrite(blob, 1, len, f);
+    int cerr = fclose(f);
+    free(blob);
+    if (wrote != len || cerr) {
+        fprintf(stderr, "bspc: %s: write failed\n", outp);
+        remove(outp);
+        return 1;
+    }
+    if (opt.verbose) fprintf(stderr, "bspc: wrote %s (%zu bytes)\n", outp, len);
+    if (want_stats)
+        printf("{\"input_walls\": %u, \"segs\": %u, \"splits\": %u, \"leaves\": %u, \"nodes\": %u, "
+               "\"vertices\": %u, \"max_depth\": %u, \"mean_depth\": %.3f, \"build_ms\": %.3f}\n",
+               st.input_walls, st.segs, st.splits, st.leaves, st.nodes, st.vertices, st.max_depth,
+               st.mean_depth, st.build_ms);
+    return 0;
+}

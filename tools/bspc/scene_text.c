@@ -1,0 +1,457 @@
+/* scene_text.c - reader of the project's text scene format (docs/scene-format.md).
+ *
+ * One statement per line, '#' starts a comment:
+ *   sector [NAME] floor=H ceil=H [floor_color=C] [ceil_color=C] [light=L] [sky]
+ *   wall X1 Y1 X2 Y2 FRONT [BACK] [mid=C] [upper=C] [lower=C]
+ *        [back_mid=C] [back_upper=C] [back_lower=C]
+ *   player X Y ANGLE
+ * Numbers are decimal (fractions allowed) and become 16.16, rounded to nearest.
+ * Every error names the file, the line and the problem.
+ */
+#include <ctype.h>
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bspc_int.h"
+
+#define MAX_TOK 32
+
+typedef struct {
+    const char *path;
+    int line;
+    char *err;
+    size_t errlen;
+    bs_scene *s;
+    uint32_t *vhash; /* vertex index + 1 */
+    uint32_t hcap;
+} parser;
+
+static int perr(parser *p, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+static int perr(parser *p, const char *fmt, ...)
+{
+    char msg[400];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    return bs_fail(p->err, p->errlen, "%s:%d: %s", p->path, p->line, msg);
+}
+
+/* Exact decimal to 16.16, rounded to nearest (ties away from zero). Accepts
+ * [+-]digits[.digits] or [+-].digits. Returns -1 on bad syntax or a value too
+ * large to represent (|v| >= 2^31 units). */
+static int parse_fx(const char *t, int64_t *out)
+{
+    int neg = 0;
+    if (*t == '+' || *t == '-') neg = (*t++ == '-');
+    int64_t ip = 0;
+    int nd = 0;
+    while (isdigit((unsigned char)*t)) {
+        if (ip > 100000000000LL) return -1;
+        ip = ip * 10 + (*t++ - '0');
+        nd++;
+    }
+    bs_i128 fnum = 0, fden = 1;
+    int nf = 0;
+    if (*t == '.') {
+        t++;
+        while (isdigit((unsigned char)*t)) {
+            if (nf < 30) {
+                fnum = fnum * 10 + (*t - '0');
+                fden *= 10;
+            }
+            t++;
+            nf++;
+        }
+    }
+    if (*t || (nd == 0 && nf == 0)) return -1;
+    if (ip > (int64_t)1 << 31) return -1;
+    /* raw = ip * 65536 + round(fnum * 65536 / fden) */
+    bs_i128 f = fnum * 65536;
+    bs_i128 q = f / fden, r = f % fden;
+    if (2 * r >= fden) q++;
+    int64_t raw = ip * 65536 + (int64_t)q;
+    *out = neg ? -raw : raw;
+    return 0;
+}
+
+static int parse_int(const char *t, long lo, long hi, long *out)
+{
+    char *end;
+    errno = 0;
+    long v = strtol(t, &end, 0);
+    if (end == t || *end || errno || v < lo || v > hi) return -1;
+    *out = v;
+    return 0;
+}
+
+static int parse_color(parser *p, const char *key, const char *val, uint8_t *out)
+{
+    long v;
+    if (isdigit((unsigned char)val[0])) {
+        if (parse_int(val, 0, 255, &v))
+            return perr(p, "%s=%s: a colour is a palette index 0..255 or NAME[:SHADE]", key, val);
+        *out = (uint8_t)v;
+        return 0;
+    }
+    int c = bs_color_by_name(val);
+    if (c < 0)
+        return perr(p, "%s=%s: unknown colour (a palette index 0..255, or a ramp name such as "
+                       "red or red:12, shade 0..15)", key, val);
+    *out = (uint8_t)c;
+    return 0;
+}
+
+static int valid_name(const char *t)
+{
+    if (!isalpha((unsigned char)t[0]) && t[0] != '_') return 0;
+    for (const char *c = t; *c; c++)
+        if (!isalnum((unsigned char)*c) && *c != '_' && *c != '-' && *c != '.') return 0;
+    return strlen(t) < 32;
+}
+
+static int find_sector(parser *p, const char *t, uint32_t *out)
+{
+    bs_scene *s = p->s;
+    if (isdigit((unsigned char)t[0])) {
+        long v;
+        if (parse_int(t, 0, 0x7FFFFFFF, &v) == 0 && (uint32_t)v < s->nsectors) {
+            *out = (uint32_t)v;
+            return 0;
+        }
+        return perr(p, "wall: unknown sector %s (%u sector(s) declared above this line)", t,
+                    s->nsectors);
+    }
+    for (uint32_t i = 0; i < s->nsectors; i++)
+        if (strcmp(s->sectors[i].name, t) == 0) {
+            *out = i;
+            return 0;
+        }
+    return perr(p, "wall: unknown sector '%s' (sectors must be declared before the walls that use them)",
+                t);
+}
+
+static uint32_t hash_xy(int32_t x, int32_t y)
+{
+    uint32_t h = (uint32_t)x * 0x9E3779B1u ^ ((uint32_t)y * 0x85EBCA77u);
+    h ^= h >> 15;
+    return h * 0xC2B2AE3Du;
+}
+
+static int vertex_of(parser *p, int32_t x, int32_t y, uint32_t *out)
+{
+    bs_scene *s = p->s;
+    if ((s->nverts + 1) * 2 > p->hcap) {
+        uint32_t nc = p->hcap ? p->hcap * 2 : 1024;
+        uint32_t *nh = calloc(nc, sizeof *nh);
+        if (!nh) return perr(p, "out of memory");
+        for (uint32_t i = 0; i < s->nverts; i++) {
+            uint32_t h = hash_xy(s->vx[i], s->vy[i]) & (nc - 1);
+            while (nh[h]) h = (h + 1) & (nc - 1);
+            nh[h] = i + 1;
+        }
+        free(p->vhash);
+        p->vhash = nh;
+        p->hcap = nc;
+    }
+    uint32_t h = hash_xy(x, y) & (p->hcap - 1);
+    while (p->vhash[h]) {
+        uint32_t i = p->vhash[h] - 1;
+        if (s->vx[i] == x && s->vy[i] == y) {
+            *out = i;
+            return 0;
+        }
+        h = (h + 1) & (p->hcap - 1);
+    }
+    uint32_t i = bs_scene_add_vertex(s, x, y);
+    if (i == SCN_NONE) return perr(p, "out of memory");
+    p->vhash[h] = i + 1;
+    *out = i;
+    return 0;
+}
+
+/* coordinate token -> 16.16 within the proven range */
+static int coord(parser *p, const char *what, const char *t, int32_t *out)
+{
+    int64_t v;
+    if (parse_fx(t, &v)) return perr(p, "%s: '%s' is not a number", what, t);
+    if (v > BS_COORD_RAW_MAX || v < -BS_COORD_RAW_MAX)
+        return perr(p, "%s = %s out of range (|coordinate| <= %d)", what, t, SCN_COORD_MAX);
+    *out = (int32_t)v;
+    return 0;
+}
+
+static int height(parser *p, const char *what, const char *t, int32_t *out)
+{
+    int64_t v;
+    if (parse_fx(t, &v)) return perr(p, "sector: %s=%s is not a number", what, t);
+    if (v > BS_HEIGHT_RAW_MAX || v < -BS_HEIGHT_RAW_MAX)
+        return perr(p, "sector: %s=%s out of range (|height| <= %d)", what, t, SCN_HEIGHT_MAX);
+    *out = (int32_t)v;
+    return 0;
+}
+
+static int do_sector(parser *p, char **tok, int n)
+{
+    bs_scene *s = p->s;
+    bs_sector sec;
+    memset(&sec, 0, sizeof sec);
+    sec.src_line = p->line;
+    sec.light = 255;
+    sec.floor_color = (uint8_t)(BS_RAMP_BROWN * 16 + 8);
+    sec.ceil_color = (uint8_t)(BS_RAMP_GREY * 16 + 9);
+    int i = 1, have_floor = 0, have_ceil = 0, seen_fc = 0, seen_cc = 0, seen_light = 0;
+    if (i < n && !strchr(tok[i], '=') && strcmp(tok[i], "sky") != 0) {
+        if (!valid_name(tok[i]))
+            return perr(p, "sector: bad name '%s' (a letter or '_' first, then letters, digits, "
+                           "'_', '-', '.'; up to 31 characters)", tok[i]);
+        for (uint32_t k = 0; k < s->nsectors; k++)
+            if (strcmp(s->sectors[k].name, tok[i]) == 0)
+                return perr(p, "sector: name '%s' already used by sector %u (line %d)", tok[i], k,
+                            s->sectors[k].src_line);
+        strcpy(sec.name, tok[i]);
+        i++;
+    }
+    for (; i < n; i++) {
+        char *t = tok[i];
+        if (strcmp(t, "sky") == 0) {
+            sec.flags |= SCN_SECTOR_SKY;
+            continue;
+        }
+        char *eq = strchr(t, '=');
+        if (!eq) return perr(p, "sector: unexpected '%s' (expected KEY=VALUE or sky)", t);
+        *eq = 0;
+        const char *val = eq + 1;
+        long lv;
+        if (strcmp(t, "floor") == 0) {
+            if (have_floor++) return perr(p, "sector: floor given twice");
+            if (height(p, "floor", val, &sec.floor_h)) return -1;
+        } else if (strcmp(t, "ceil") == 0) {
+            if (have_ceil++) return perr(p, "sector: ceil given twice");
+            if (height(p, "ceil", val, &sec.ceil_h)) return -1;
+        } else if (strcmp(t, "floor_color") == 0) {
+            if (seen_fc++) return perr(p, "sector: floor_color given twice");
+            if (parse_color(p, t, val, &sec.floor_color)) return -1;
+        } else if (strcmp(t, "ceil_color") == 0) {
+            if (seen_cc++) return perr(p, "sector: ceil_color given twice");
+            if (parse_color(p, t, val, &sec.ceil_color)) return -1;
+        } else if (strcmp(t, "light") == 0) {
+            if (seen_light++) return perr(p, "sector: light given twice");
+            if (parse_int(val, 0, 255, &lv)) return perr(p, "sector: light=%s: expected 0..255", val);
+            sec.light = (uint8_t)lv;
+        } else {
+            return perr(p, "sector: unknown key '%s' (floor, ceil, floor_color, ceil_color, light, sky)",
+                        t);
+        }
+    }
+    if (!have_floor) return perr(p, "sector: missing floor=HEIGHT");
+    if (!have_ceil) return perr(p, "sector: missing ceil=HEIGHT");
+    if (sec.ceil_h < sec.floor_h) return perr(p, "sector: ceil is below floor");
+    if (bs_grow(&s->sectors, &s->scap, s->nsectors + 1, sizeof sec)) return perr(p, "out of memory");
+    s->sectors[s->nsectors++] = sec;
+    return 0;
+}
+
+static int do_wall(parser *p, char **tok, int n)
+{
+    bs_scene *s = p->s;
+    if (n < 6)
+        return perr(p, "wall: expected 'wall X1 Y1 X2 Y2 FRONT [BACK] [mid=C] [upper=C] [lower=C]'");
+    bs_line ln;
+    memset(&ln, 0, sizeof ln);
+    ln.src_line = p->line;
+    int32_t x1, y1, x2, y2;
+    if (coord(p, "wall: x1", tok[1], &x1) || coord(p, "wall: y1", tok[2], &y1) ||
+        coord(p, "wall: x2", tok[3], &x2) || coord(p, "wall: y2", tok[4], &y2))
+        return -1;
+    if (x1 == x2 && y1 == y2) return perr(p, "wall: zero length (start and end are the same point)");
+    if (find_sector(p, tok[5], &ln.sector[0])) return -1;
+    ln.sector[1] = SCN_NONE;
+    int i = 6;
+    if (i < n && !strchr(tok[i], '=')) {
+        if (find_sector(p, tok[i], &ln.sector[1])) return -1;
+        i++;
+    }
+    int have[6] = {0};
+    uint8_t col[6];
+    static const char *keys[6] = {"upper", "mid", "lower", "back_upper", "back_mid", "back_lower"};
+    for (; i < n; i++) {
+        char *eq = strchr(tok[i], '=');
+        if (!eq) return perr(p, "wall: unexpected '%s' (expected KEY=COLOUR)", tok[i]);
+        *eq = 0;
+        int k;
+        for (k = 0; k < 6; k++)
+            if (strcmp(tok[i], keys[k]) == 0) break;
+        if (k == 6)
+            return perr(p, "wall: unknown key '%s' (mid, upper, lower, back_mid, back_upper, "
+                           "back_lower)", tok[i]);
+        if (have[k]++) return perr(p, "wall: %s given twice", keys[k]);
+        if (parse_color(p, keys[k], eq + 1, &col[k])) return -1;
+        if (k >= 3 && ln.sector[1] == SCN_NONE)
+            return perr(p, "wall: %s given but the wall is one-sided (no BACK sector)", keys[k]);
+    }
+    uint8_t mid = have[1] ? col[1] : (uint8_t)(BS_RAMP_GREY * 16 + 10);
+    ln.color[0][SCN_PART_MIDDLE] = mid;
+    ln.color[0][SCN_PART_UPPER] = have[0] ? col[0] : mid;
+    ln.color[0][SCN_PART_LOWER] = have[2] ? col[2] : mid;
+    ln.color[1][SCN_PART_MIDDLE] = have[4] ? col[4] : ln.color[0][SCN_PART_MIDDLE];
+    ln.color[1][SCN_PART_UPPER] = have[3] ? col[3] : ln.color[0][SCN_PART_UPPER];
+    ln.color[1][SCN_PART_LOWER] = have[5] ? col[5] : ln.color[0][SCN_PART_LOWER];
+    if (vertex_of(p, x1, y1, &ln.v1) || vertex_of(p, x2, y2, &ln.v2)) return -1;
+    if (bs_grow(&s->lines, &s->lcap, s->nlines + 1, sizeof ln)) return perr(p, "out of memory");
+    s->lines[s->nlines++] = ln;
+    return 0;
+}
+
+static int do_player(parser *p, char **tok, int n)
+{
+    bs_scene *s = p->s;
+    if (n != 4) return perr(p, "player: expected 'player X Y ANGLE' (angle in degrees, 0 = east)");
+    if (s->has_player)
+        return perr(p, "player: a second player start (the first is on line %d)", s->player_line);
+    int64_t a;
+    if (coord(p, "player: x", tok[1], &s->player_x) || coord(p, "player: y", tok[2], &s->player_y))
+        return -1;
+    if (parse_fx(tok[3], &a)) return perr(p, "player: angle '%s' is not a number", tok[3]);
+    const int64_t turn = (int64_t)360 << 16;
+    a %= turn;
+    if (a < 0) a += turn;
+    s->player_angle = (int32_t)a;
+    s->has_player = 1;
+    s->player_line = p->line;
+    return 0;
+}
+
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Duplicated walls: the same two points, in either direction. */
+static int check_duplicates(parser *p)
+{
+    bs_scene *s = p->s;
+    if (s->nlines < 2) return 0;
+    struct pair {
+        uint64_t key;
+        uint64_t idx;
+    } *a = malloc(sizeof *a * s->nlines);
+    if (!a) return perr(p, "out of memory");
+    for (uint32_t i = 0; i < s->nlines; i++) {
+        uint64_t v1 = s->lines[i].v1, v2 = s->lines[i].v2;
+        if (v1 > v2) {
+            uint64_t t = v1;
+            v1 = v2;
+            v2 = t;
+        }
+        a[i].key = (v1 << 32) | v2;
+        a[i].idx = i;
+    }
+    qsort(a, s->nlines, sizeof *a, cmp_u64); /* by key only; equal keys are ordered below */
+    int rc = 0;
+    for (uint32_t i = 1; i < s->nlines; i++) {
+        if (a[i].key == a[i - 1].key) {
+            uint32_t i0 = (uint32_t)a[i - 1].idx, i1 = (uint32_t)a[i].idx;
+            if (i0 > i1) {
+                uint32_t t = i0;
+                i0 = i1;
+                i1 = t;
+            }
+            p->line = s->lines[i1].src_line;
+            rc = perr(p, "wall: duplicates the wall on line %d (same two points)",
+                      s->lines[i0].src_line);
+            break;
+        }
+    }
+    free(a);
+    return rc;
+}
+
+int bs_read_text(const char *path, bs_scene *s, const bspc_options *opt, char *err, size_t errlen)
+{
+    (void)opt;
+    FILE *f = fopen(path, "rb");
+    if (!f) return bs_fail(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+    char *buf = NULL;
+    size_t len = 0, cap = 0;
+    for (;;) {
+        if (len + 4096 + 1 > cap) {
+            cap = cap ? cap * 2 : 65536;
+            char *nb = realloc(buf, cap);
+            if (!nb) {
+                free(buf);
+                fclose(f);
+                return bs_fail(err, errlen, "%s: out of memory", path);
+            }
+            buf = nb;
+        }
+        size_t got = fread(buf + len, 1, 4096, f);
+        len += got;
+        if (got < 4096) break;
+    }
+    int ioerr = ferror(f);
+    fclose(f);
+    if (ioerr) {
+        free(buf);
+        return bs_fail(err, errlen, "%s: read error", path);
+    }
+    buf[len] = 0;
+    if (strlen(buf) != len) {
+        free(buf);
+        return bs_fail(err, errlen, "%s: not a text scene (contains NUL bytes)", path);
+    }
+
+    snprintf(s->name, sizeof s->name, "%s", path);
+    s->is_text = 1;
+    s->player_sector = SCN_NONE;
+    parser p = {path, 0, err, errlen, s, NULL, 0};
+    int rc = 0;
+    char *line = buf;
+    while (line && rc == 0) {
+        char *next = strchr(line, '\n');
+        if (next) *next++ = 0;
+        p.line++;
+        char *hash = strchr(line, '#');
+        if (hash) *hash = 0;
+        char *tok[MAX_TOK];
+        int n = 0;
+        for (char *c = line; *c && rc == 0;) {
+            while (*c && isspace((unsigned char)*c)) *c++ = 0;
+            if (!*c) break;
+            if (n == MAX_TOK) {
+                rc = perr(&p, "too many words on one line (at most %d)", MAX_TOK);
+                break;
+            }
+            tok[n++] = c;
+            while (*c && !isspace((unsigned char)*c)) c++;
+        }
+        if (rc || n == 0) {
+            line = next;
+            continue;
+        }
+        if (strcmp(tok[0], "sector") == 0)
+            rc = do_sector(&p, tok, n);
+        else if (strcmp(tok[0], "wall") == 0)
+            rc = do_wall(&p, tok, n);
+        else if (strcmp(tok[0], "player") == 0)
+            rc = do_player(&p, tok, n);
+        else
+            rc = perr(&p, "unknown statement '%s' (expected sector, wall or player)", tok[0]);
+        line = next;
+    }
+    free(buf);
+    free(p.vhash);
+    if (rc) return rc;
+    if (s->nlines == 0) return bs_fail(err, errlen, "%s: no walls", path);
+    if (!s->has_player) return bs_fail(err, errlen, "%s: no player start (add 'player X Y ANGLE')", path);
+    return check_duplicates(&p);
+}
