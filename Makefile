@@ -22,11 +22,11 @@ SAN      := -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-saniti
 # ---- sources -----------------------------------------------------------------
 FW_SRC    := $(sort $(wildcard firmware/*.c)) $(GEN)/fx_tables.c
 HAL_SRC   := hal/fb.c hal/perf.c
-NULL_SRC  := hal/null/hal_null.c
-SDL_SRC   := hal/sdl/hal_sdl.c
+NULL_SRC  := hal/ram_target.c hal/null/hal_null.c
+SDL_SRC   := hal/ram_target.c hal/sdl/hal_sdl.c
 BSPC_LIB  := $(filter-out tools/bspc/main.c,$(sort $(wildcard tools/bspc/*.c)))
-HOST_LIB  := host/png.c host/fxtext.c host/scene_file.c
-FLOATFREE := firmware/% hal/fb.c hal/perf.c hal/null/% $(GEN)/%
+HOST_LIB  := host/png.c host/scene_file.c
+FLOATFREE := firmware/% hal/fb.c hal/perf.c hal/ram_target.c hal/null/% $(GEN)/%
 
 objs = $(patsubst %.c,$(1)/%.o,$(2))
 fwflags = $(if $(filter $(FLOATFREE),$(1)),$(FW_FLAGS))
@@ -46,7 +46,7 @@ $(1)/render: $(call objs,$(1)/obj,host/render.c $(HOST_LIB) $(BSPC_LIB) $(FW_SRC
 	$$(CC) $(2) $$^ -o $$@ -lm
 $(1)/emu: $(call objs,$(1)/obj,host/emu.c $(GEN)/default_scene.c $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(SDL_SRC))
 	$$(CC) $(2) $$^ -o $$@ $$(SDL_LIBS) -lm
-$(1)/test_%: $(call objs,$(1)/obj,tests/unit/test_%.c) $(call objs,$(1)/obj,$(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC) host/fxtext.c)
+$(1)/test_%: $(call objs,$(1)/obj,tests/unit/test_%.c) $(call objs,$(1)/obj,$(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC))
 	$$(CC) $(2) $$^ -o $$@ -lcmocka -lm
 endef
 $(eval $(call variant,$(BUILD),$(REL)))
@@ -94,7 +94,7 @@ run: deps all
 # No floating point in firmware/ and hal/ targets, three ways: no float/double token
 # in the code (comments stripped), the host compile with -mgeneral-regs-only above,
 # and a Cortex-M soft-float compile whose objects may not need any float helper.
-NOFLOAT_SRC := $(FW_SRC) $(HAL_SRC) $(NULL_SRC) $(SDL_SRC) $(EXTRA_NOFLOAT)
+NOFLOAT_SRC := $(sort $(FW_SRC) $(HAL_SRC) $(NULL_SRC) $(SDL_SRC)) $(EXTRA_NOFLOAT)
 nofloat: $(GEN)/fx_tables.c
 	@tools/check_nofloat.sh $(NOFLOAT_SRC)
 

@@ -1,20 +1,17 @@
-/* hal_null.c - the headless target: static 4-aligned VRAM pages, system-memory
- * buffer and palette, scripted input, a deterministic 35 Hz clock, and a
+/* hal_null.c - the headless target: VRAM pages, system-memory buffer and palette
+ * in RAM (hal/ram_target.c), scripted input, a deterministic 35 Hz clock, and a
  * frame-done hook that only counts. Freestanding C11, integer only, no libc.
  * See hal_null.h for the input and time rules.
  */
 #include <stddef.h>
 #include "hal.h"
+#include "ram_target.h"
 #include "hal_null.h"
 
 #define HAL_NULL_TIC_HZ 35u
 
-static _Alignas(4) uint8_t vram[2][HAL_PAGE_BYTES];
-static _Alignas(4) uint8_t sysmem[HAL_PAGE_BYTES];
-static _Alignas(4) uint8_t palette[HAL_PALETTE_BYTES];
 
 static struct {
-    int display_start;
     uint32_t input;
     uint32_t frames;
     uint32_t ticks;      /* ms */
@@ -24,31 +21,6 @@ static struct {
 
 #define HAL_KEY_EDGES ((uint32_t)HAL_KEY_NEXT_MODE | (uint32_t)HAL_KEY_NEXT_PRESENT | \
                        (uint32_t)HAL_KEY_PRINT_COUNTERS)
-
-uint8_t *hal_target_vram(int page)
-{
-    return vram[page ? 1 : 0];
-}
-
-uint8_t *hal_target_sysmem(void)
-{
-    return sysmem;
-}
-
-uint8_t *hal_target_palette(void)
-{
-    return palette;
-}
-
-void hal_target_set_display_start(int page)
-{
-    st.display_start = page ? 1 : 0;
-}
-
-int hal_target_display_start(void)
-{
-    return st.display_start;
-}
 
 uint32_t hal_input(void)
 {
@@ -91,14 +63,7 @@ uint32_t hal_null_frames(void)
 
 void hal_null_reset(void)
 {
-    for (uint32_t p = 0; p < 2; p++)
-        for (uint32_t i = 0; i < HAL_PAGE_BYTES; i++)
-            vram[p][i] = 0;
-    for (uint32_t i = 0; i < HAL_PAGE_BYTES; i++)
-        sysmem[i] = 0;
-    for (uint32_t i = 0; i < HAL_PALETTE_BYTES; i++)
-        palette[i] = 0;
-    st.display_start = 0;
+    hal_ram_target_reset();
     st.input = 0;
     st.frames = 0;
     st.ticks = 0;

@@ -1,5 +1,5 @@
-/* hal_sdl.c - the host window target (SDL2): static VRAM pages, system-memory
- * buffer and palette; the frame-done hook converts the shown page through the
+/* hal_sdl.c - the host window target (SDL2), VRAM pages, system-memory buffer
+ * and palette in RAM (hal/ram_target.c); the frame-done hook converts the shown page through the
  * palette into an ARGB texture and presents it; keyboard input, SDL ticks.
  * A host target: it may use libc, but no floating point (the build compiles
  * hal/ with -mgeneral-regs-only).
@@ -16,14 +16,12 @@
 #include <string.h>
 
 #include "hal.h"
+#include "ram_target.h"
 #include "hal_sdl.h"
 
 #define HAL_SDL_MAX_SCALE 8
 #define HAL_SDL_ASPECT_H 240 /* 320x200 shown as 320x240 */
 
-static _Alignas(4) uint8_t vram[2][HAL_PAGE_BYTES];
-static _Alignas(4) uint8_t sysmem[HAL_PAGE_BYTES];
-static _Alignas(4) uint8_t palette[HAL_PALETTE_BYTES];
 
 #define HAL_SDL_FRAME_MS 14u
 
@@ -32,7 +30,6 @@ static struct {
     SDL_Renderer *ren;
     SDL_Texture *frame;    /* 320x200 ARGB, streaming, nearest */
     SDL_Texture *upscaled; /* 320s x 200s render target, linear; NULL if unsupported */
-    int display_start;
     uint32_t t0;
     uint32_t last_shown; /* SDL ticks when the last frame was shown */
     uint32_t edges; /* edge-triggered bits (and quit) pressed since the last hal_input */
@@ -42,32 +39,6 @@ static struct {
 
 #define HAL_KEY_EDGES ((uint32_t)HAL_KEY_NEXT_MODE | (uint32_t)HAL_KEY_NEXT_PRESENT | \
                        (uint32_t)HAL_KEY_PRINT_COUNTERS)
-
-/* ---- target storage ---------------------------------------------------- */
-uint8_t *hal_target_vram(int page)
-{
-    return vram[page ? 1 : 0];
-}
-
-uint8_t *hal_target_sysmem(void)
-{
-    return sysmem;
-}
-
-uint8_t *hal_target_palette(void)
-{
-    return palette;
-}
-
-void hal_target_set_display_start(int page)
-{
-    sdl.display_start = page ? 1 : 0;
-}
-
-int hal_target_display_start(void)
-{
-    return sdl.display_start;
-}
 
 /* ---- window -------------------------------------------------------------- */
 const char *hal_sdl_error(void)
@@ -269,12 +240,13 @@ void hal_frame_done(void)
 {
     if (!sdl.win)
         return;
+    const uint8_t *palette = hal_target_palette();
     uint32_t lut[256];
     for (int i = 0; i < 256; i++)
         lut[i] = 0xff000000u | (uint32_t)palette[i * 3] << 16 |
                  (uint32_t)palette[i * 3 + 1] << 8 | palette[i * 3 + 2];
 
-    const uint8_t *src = vram[sdl.display_start ? 1 : 0];
+    const uint8_t *src = hal_target_vram(hal_target_display_start());
     void *pixels;
     int pitch;
     if (SDL_LockTexture(sdl.frame, NULL, &pixels, &pitch) == 0) {

@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "bspc_int.h"
+#include "fxtext.h"
 
 #define MAX_TOK 32
 
@@ -43,44 +44,6 @@ static int perr(parser *p, const char *fmt, ...)
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
     return bs_fail(p->err, p->errlen, "%s:%d: %s", p->path, p->line, msg);
-}
-
-/* Exact decimal to 16.16, rounded to nearest (ties away from zero). Accepts
- * [+-]digits[.digits] or [+-].digits. Returns -1 on bad syntax or a value too
- * large to represent (|v| >= 2^31 units). */
-static int parse_fx(const char *t, int64_t *out)
-{
-    int neg = 0;
-    if (*t == '+' || *t == '-') neg = (*t++ == '-');
-    int64_t ip = 0;
-    int nd = 0;
-    while (isdigit((unsigned char)*t)) {
-        if (ip > 100000000000LL) return -1;
-        ip = ip * 10 + (*t++ - '0');
-        nd++;
-    }
-    bs_i128 fnum = 0, fden = 1;
-    int nf = 0;
-    if (*t == '.') {
-        t++;
-        while (isdigit((unsigned char)*t)) {
-            if (nf < 30) {
-                fnum = fnum * 10 + (*t - '0');
-                fden *= 10;
-            }
-            t++;
-            nf++;
-        }
-    }
-    if (*t || (nd == 0 && nf == 0)) return -1;
-    if (ip > (int64_t)1 << 31) return -1;
-    /* raw = ip * 65536 + round(fnum * 65536 / fden) */
-    bs_i128 f = fnum * 65536;
-    bs_i128 q = f / fden, r = f % fden;
-    if (2 * r >= fden) q++;
-    int64_t raw = ip * 65536 + (int64_t)q;
-    *out = neg ? -raw : raw;
-    return 0;
 }
 
 static int parse_int(const char *t, long lo, long hi, long *out)
@@ -182,7 +145,7 @@ static int vertex_of(parser *p, int32_t x, int32_t y, uint32_t *out)
 static int coord(parser *p, const char *what, const char *t, int32_t *out)
 {
     int64_t v;
-    if (parse_fx(t, &v)) return perr(p, "%s: '%s' is not a number", what, t);
+    if (fxtext_parse64(t, &v)) return perr(p, "%s: '%s' is not a number", what, t);
     if (v > BS_COORD_RAW_MAX || v < -BS_COORD_RAW_MAX)
         return perr(p, "%s = %s out of range (|coordinate| <= %d)", what, t, SCN_COORD_MAX);
     *out = (int32_t)v;
@@ -192,7 +155,7 @@ static int coord(parser *p, const char *what, const char *t, int32_t *out)
 static int height(parser *p, const char *what, const char *t, int32_t *out)
 {
     int64_t v;
-    if (parse_fx(t, &v)) return perr(p, "sector: %s=%s is not a number", what, t);
+    if (fxtext_parse64(t, &v)) return perr(p, "sector: %s=%s is not a number", what, t);
     if (v > BS_HEIGHT_RAW_MAX || v < -BS_HEIGHT_RAW_MAX)
         return perr(p, "sector: %s=%s out of range (|height| <= %d)", what, t, SCN_HEIGHT_MAX);
     *out = (int32_t)v;
@@ -320,7 +283,7 @@ static int do_player(parser *p, char **tok, int n)
     int64_t a;
     if (coord(p, "player: x", tok[1], &s->player_x) || coord(p, "player: y", tok[2], &s->player_y))
         return -1;
-    if (parse_fx(tok[3], &a)) return perr(p, "player: angle '%s' is not a number", tok[3]);
+    if (fxtext_parse64(tok[3], &a)) return perr(p, "player: angle '%s' is not a number", tok[3]);
     const int64_t turn = (int64_t)360 << 16;
     a %= turn;
     if (a < 0) a += turn;

@@ -8,6 +8,7 @@
 #include <time.h>
 
 #include "bspc_int.h"
+#include "fxtext.h"
 
 int bs_fail(char *err, size_t errlen, const char *fmt, ...)
 {
@@ -58,27 +59,7 @@ int bs_grow(void *pp, uint32_t *cap, uint32_t need, size_t sz)
 
 const char *bs_fxstr(int32_t v, char buf[32])
 {
-    int64_t a = v;
-    const char *sign = "";
-    if (a < 0) {
-        sign = "-";
-        a = -a;
-    }
-    int64_t ip = a >> 16;
-    int64_t frac = ((a & 0xFFFF) * 100000 + 32768) >> 16; /* 5 digits */
-    if (frac >= 100000) {
-        ip++;
-        frac -= 100000;
-    }
-    if (frac == 0) {
-        snprintf(buf, 32, "%s%lld", sign, (long long)ip);
-    } else {
-        char f[8];
-        snprintf(f, sizeof f, "%05lld", (long long)frac);
-        size_t n = strlen(f);
-        while (n > 0 && f[n - 1] == '0') f[--n] = 0;
-        snprintf(buf, 32, "%s%lld.%s", sign, (long long)ip, f);
-    }
+    fxtext_format(v, buf, 32);
     return buf;
 }
 

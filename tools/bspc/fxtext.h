@@ -1,4 +1,4 @@
-/* fxtext.h - decimal text <-> 16.16 fixed point for host programs, exactly:
+/* fxtext.h - decimal text <-> 16.16 fixed point for the host tools, exactly:
  * parsing rounds to the nearest 1/65536 (ties away from zero) without floating
  * point, and formatting prints the exact decimal value of a 16.16 number. */
 #ifndef HOST_FXTEXT_H
@@ -6,8 +6,12 @@
 
 #include <stdint.h>
 
-/* Parse "[-+]digits[.digits]" (whole string). Returns 0, or -1 if malformed or
- * outside the 16.16 range. */
+/* Parse "[-+]digits[.digits]" or "[-+].digits" (the whole string) to 16.16 raw
+ * units in 64 bits, so callers can name an out-of-range value in their message.
+ * Returns 0, or -1 if malformed or |v| >= 2^31 units. */
+int fxtext_parse64(const char *s, int64_t *out);
+
+/* The same, into an int32_t: -1 also if outside the 16.16 range. */
 int fxtext_parse(const char *s, int32_t *out);
 
 /* Exact decimal of raw/65536 (at most 16 fraction digits, trailing zeros dropped). */

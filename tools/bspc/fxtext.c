@@ -4,38 +4,41 @@
 #include <stdio.h>
 #include <string.h>
 
-int fxtext_parse(const char *s, int32_t *out)
+__extension__ typedef unsigned __int128 fxtext_u128;
+
+int fxtext_parse64(const char *s, int64_t *out)
 {
-    int neg = 0, digits = 0;
+    int neg = 0, digits = 0, frac_digits = 0;
     int64_t whole = 0;
     if (*s == '-' || *s == '+') neg = *s++ == '-';
     for (; *s >= '0' && *s <= '9'; s++, digits++) {
         whole = whole * 10 + (*s - '0');
-        if (whole > 40000) return -1;
+        if (whole > ((int64_t)1 << 31)) return -1;
     }
-    /* fraction as numerator / 10^k with k <= 18, enough to round correctly */
-    int64_t num = 0, den = 1;
-    int frac_digits = 0;
+    /* the fraction as num / den with up to 30 digits: enough to round exactly */
+    fxtext_u128 num = 0, den = 1;
     if (*s == '.') {
         for (s++; *s >= '0' && *s <= '9'; s++, frac_digits++) {
-            if (den < 1000000000000000000LL / 10) {
-                num = num * 10 + (*s - '0');
-                den *= 10;
+            if (frac_digits < 30) {
+                num = num * 10u + (unsigned)(*s - '0');
+                den *= 10u;
             }
         }
     }
     if (*s != '\0' || digits + frac_digits == 0) return -1;
-    /* round(num * 65536 / den): num < den <= 10^18 / 10, so num * 65536 may exceed
-     * 2^63; split the multiply to keep it exact. */
-    int64_t q = (num / den) * 65536;
-    int64_t r = num % den;
-    unsigned __int128 t = (unsigned __int128)r * 65536u;
-    q += (int64_t)(t / (unsigned __int128)den);
-    unsigned __int128 rem = t % (unsigned __int128)den;
-    if (rem * 2u >= (unsigned __int128)den) q++;
+    fxtext_u128 scaled = num * 65536u;
+    int64_t q = (int64_t)(scaled / den);
+    if ((scaled % den) * 2u >= den) q++; /* ties away from zero */
     int64_t v = whole * 65536 + q;
-    if (neg) v = -v;
-    if (v > INT32_MAX || v < INT32_MIN) return -1;
+    if (v >= ((int64_t)1 << 47)) return -1;
+    *out = neg ? -v : v;
+    return 0;
+}
+
+int fxtext_parse(const char *s, int32_t *out)
+{
+    int64_t v;
+    if (fxtext_parse64(s, &v) != 0 || v > INT32_MAX || v < INT32_MIN) return -1;
     *out = (int32_t)v;
     return 0;
 }
