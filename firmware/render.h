@@ -19,6 +19,7 @@ typedef struct {
     uint32_t culled;    /* wall pieces rejected as back-facing */
     uint32_t polygons;  /* polygons that reached the rasteriser */
     uint32_t clipped_away; /* polygons entirely outside the frustum */
+    uint32_t boxes_culled; /* subtrees rejected by their bounding box */
 } render_stats;
 
 const char *render_mode_name(render_mode m);

@@ -1,0 +1,115 @@
+/* surfaces.c - leaf floors, ceilings and wall parts to screen polygons.
+ * Shared 3-D edges give bit-identical screen edges: a wall's bottom edge and the
+ * floor polygon's edge along it are transformed from the same map points and
+ * clipped with the same canonical intersections (clip.c), so the fill rule
+ * leaves neither gap nor overlap between them. */
+#include "surfaces.h"
+
+#include "clip.h"
+
+static void emit(const view_xform *v, clip_poly *p, unsigned mask, const surf_sink *sink, uint8_t colour,
+                 uint32_t id, render_stats *st)
+{
+    if (!clip_polygon(p, v, mask)) {
+        st->clipped_away++;
+        return;
+    }
+    screen_pt s[CLIP_MAX_VERTS];
+    for (int i = 0; i < p->n; i++) s[i] = view_project(v, p->v[i]);
+    st->polygons++;
+    sink->polygon(sink->ctx, s, p->n, colour, id);
+}
+
+/* Front-facing: the eye strictly on the right of a -> b (edge-on is culled).
+ * |b - a| < 2^32 and |eye - a| < 2^33 raw: shifted to 2^31 and 2^30 the products
+ * stay below 2^61. */
+static int faces_eye(const view_xform *v, const scn_vertex *a, const scn_vertex *b)
+{
+    int64_t dx = fx_asr64((int64_t)b->x - a->x, 1), dy = fx_asr64((int64_t)b->y - a->y, 1);
+    int64_t ex = fx_asr64(v->cx - a->x, 3), ey = fx_asr64(v->cy - a->y, 3);
+    return dx * ey - dy * ex < 0;
+}
+
+static void wall_part(const view_xform *v, const scn_vertex *a, const scn_vertex *b, int32_t bottom, int32_t top,
+                      unsigned mask, const surf_sink *sink, uint8_t colour, uint32_t id, render_stats *st)
+{
+    if (top <= bottom) return;
+    clip_poly p;
+    p.n = 4;
+    p.v[0] = view_point(v, a->x, a->y, top);
+    p.v[1] = view_point(v, b->x, b->y, top);
+    p.v[2] = view_point(v, b->x, b->y, bottom);
+    p.v[3] = view_point(v, a->x, a->y, bottom);
+    emit(v, &p, mask, sink, colour, id, st);
+}
+
+static void seg_parts(const scene *sc, const view_xform *v, const scn_seg *g, unsigned mask, const surf_sink *sink,
+                      render_stats *st)
+{
+    const scn_vertex *a = &sc->verts[g->v1], *b = &sc->verts[g->v2];
+    st->segs++;
+    if (!faces_eye(v, a, b)) {
+        st->culled++;
+        return;
+    }
+    const scn_line *l = &sc->lines[g->line];
+    const scn_sector *front = &sc->sectors[l->sector[g->side]];
+    uint32_t back_index = l->sector[g->side ^ 1u];
+    uint32_t id = RAST_ID(RAST_KIND_WALL, g->line * 2u + g->side);
+    const uint8_t *colour = l->color[g->side];
+    if (back_index == SCN_NONE) {
+        wall_part(v, a, b, front->floor_h, front->ceil_h, mask, sink, colour[SCN_PART_MIDDLE], id, st);
+        return;
+    }
+    const scn_sector *back = &sc->sectors[back_index];
+    /* Doom's sky rule: no upper wall between two sky ceilings */
+    int both_sky = (front->flags & back->flags & SCN_SECTOR_SKY) != 0;
+    if (!both_sky && back->ceil_h < front->ceil_h) {
+        int32_t low = back->ceil_h > front->floor_h ? back->ceil_h : front->floor_h;
+        wall_part(v, a, b, low, front->ceil_h, mask, sink, colour[SCN_PART_UPPER], id, st);
+    }
+    if (back->floor_h > front->floor_h) {
+        int32_t high = back->floor_h < front->ceil_h ? back->floor_h : front->ceil_h;
+        wall_part(v, a, b, front->floor_h, high, mask, sink, colour[SCN_PART_LOWER], id, st);
+    }
+}
+
+/* The leaf polygon at height h. Seen from above (floor) a counter-clockwise map
+ * polygon runs counter-clockwise on screen, so floors are emitted reversed;
+ * seen from below (ceiling) it runs clockwise as stored. */
+static void plane(const scene *sc, const view_xform *v, const scn_leaf *f, int32_t h, int reverse, unsigned mask,
+                  const surf_sink *sink, uint8_t colour, uint32_t id, render_stats *st)
+{
+    clip_poly p;
+    uint32_t n = f->num_pverts;
+    if (n < 3 || n > CLIP_MAX_VERTS - 5) return;
+    p.n = (int)n;
+    for (uint32_t i = 0; i < n; i++) {
+        const scn_vertex *q = &sc->pverts[f->first_pvert + (reverse ? n - 1 - i : i)];
+        p.v[i] = view_point(v, q->x, q->y, h);
+    }
+    emit(v, &p, mask, sink, colour, id, st);
+}
+
+void surf_leaf(const scene *sc, const view_xform *v, uint32_t leaf, unsigned mask, const surf_sink *sink,
+               render_stats *st)
+{
+    const scn_leaf *f = &sc->leaves[leaf];
+    st->leaves++;
+    if (f->sector != SCN_NONE) {
+        const scn_sector *sec = &sc->sectors[f->sector];
+        if (v->cz > sec->floor_h)
+            plane(sc, v, f, sec->floor_h, 1, mask, sink, sec->floor_color, RAST_ID(RAST_KIND_FLOOR, f->sector), st);
+        if (v->cz < sec->ceil_h)
+            plane(sc, v, f, sec->ceil_h, 0, mask, sink, sec->ceil_color, RAST_ID(RAST_KIND_CEILING, f->sector), st);
+    }
+    for (uint32_t i = 0; i < f->num_segs; i++) seg_parts(sc, v, &sc->segs[f->first_seg + i], mask, sink, st);
+}
+
+uint32_t surf_max_polygon_verts(const scene *s)
+{
+    uint32_t most = 4;
+    for (uint32_t i = 0; i < s->nleaves; i++)
+        if (s->leaves[i].num_pverts > most) most = s->leaves[i].num_pverts;
+    return most + 5;
+}

@@ -1,0 +1,31 @@
+/* surfaces.h - a leaf's visible surfaces as clipped, projected screen polygons
+ * (prefix surf_): its floor and ceiling (from the leaf's convex polygon, at its
+ * sector's heights) and the visible parts of its front-facing wall pieces. Every
+ * render mode turns leaves into polygons here and differs only in what it does
+ * with them (the sink). */
+#ifndef SURFACES_H
+#define SURFACES_H
+
+#include <stdint.h>
+#include "render.h"
+#include "scene.h"
+#include "view.h"
+
+typedef struct {
+    /* Called once per polygon that survived clipping: n >= 3 screen vertices,
+     * clockwise on screen, inside [0,320] x [0,200]. */
+    void (*polygon)(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id);
+    void *ctx;
+} surf_sink;
+
+/* Emit the leaf's surfaces in an order that is correct back to front within the
+ * leaf (floor and ceiling first, then walls). clip_mask: planes still to clip
+ * against (bsp_walk.h). */
+void surf_leaf(const scene *s, const view_xform *v, uint32_t leaf, unsigned clip_mask, const surf_sink *sink,
+               render_stats *st);
+
+/* The most screen vertices surf_leaf can hand a sink for this scene (bounds the
+ * edge pool of the span renderer). */
+uint32_t surf_max_polygon_verts(const scene *s);
+
+#endif
