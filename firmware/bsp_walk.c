@@ -51,6 +51,7 @@ void walk_tree(const scene *s, const view_xform *v, walk_order order, walk_visit
     int sp = 0;
     walk_stats local = {0, 0};
     if (!st) st = &local;
+    st->nodes = st->boxes_culled = 0;
     if (s->nleaves == 0) return;
     frustum_planes(v, planes);
     stack[sp] = s->root;

@@ -5,7 +5,9 @@ scene_status eng_init(engine *e, const void *blob, uint32_t len, scene_error *er
 {
     scene_status st = scene_load(&e->sc, blob, len, err);
     if (st != SCENE_OK) return st;
-    e->mode = RENDER_PAINTER;
+    e->mode = RENDER_SPANS;
+    e->work.mem = 0;
+    e->work.bytes = 0;
     e->present = HAL_PRESENT_FLIP;
     e->frame = 0;
     e->stats = (render_stats){0};
@@ -14,11 +16,25 @@ scene_status eng_init(engine *e, const void *blob, uint32_t len, scene_error *er
     return SCENE_OK;
 }
 
+uint32_t eng_work_bytes(const engine *e)
+{
+    return render_work_bytes(&e->sc);
+}
+
+int eng_set_work(engine *e, void *mem, uint32_t bytes)
+{
+    uint32_t need = render_work_bytes(&e->sc);
+    if (need == 0 || bytes < need) return -1;
+    e->work.mem = mem;
+    e->work.bytes = bytes;
+    return 0;
+}
+
 void eng_render(engine *e, uint32_t *ids)
 {
     hal_surface surf = hal_begin_frame(e->present);
     rast_target t = {&surf, ids};
-    render_frame(&e->sc, &e->cam.view, e->mode, &t, &e->stats);
+    render_frame(&e->sc, &e->cam.view, e->mode, &t, &e->work, &e->stats);
     hal_present(e->present);
     e->frame++;
 }

@@ -16,11 +16,19 @@ typedef struct {
     hal_present_mode present;
     uint32_t frame;         /* frames rendered since eng_init */
     render_stats stats;     /* of the last frame */
+    render_work work;       /* given by the target: eng_set_work */
 } engine;
 
 /* Validate the compiled scene, load its palette, put the eye at the player start.
  * Returns SCENE_OK or the loader's status (details in err, which may be NULL). */
 scene_status eng_init(engine *e, const void *blob, uint32_t len, scene_error *err);
+
+/* Work memory the loaded scene needs (mode spans), and handing it over: returns 0,
+ * or -1 if bytes is smaller than eng_work_bytes (the scene needs more than this
+ * build provides: refuse it). Until then mode spans draws only the background
+ * and reports stats.refused. */
+uint32_t eng_work_bytes(const engine *e);
+int eng_set_work(engine *e, void *mem, uint32_t bytes);
 
 /* Render the current view into the surface for the present mode and present it.
  * ids may be NULL. Does not call hal_frame_done. */

@@ -1,7 +1,9 @@
 /* render.c - mode dispatch and the parts every mode shares. */
 #include "render.h"
 
-static const char *const mode_names[RENDER_MODE_COUNT] = {"painter"};
+#include "spans.h"
+
+static const char *const mode_names[RENDER_MODE_COUNT] = {"spans", "painter"};
 
 const char *render_mode_name(render_mode m)
 {
@@ -26,7 +28,13 @@ void render_clear(const rast_target *t, uint8_t colour)
     for (int y = 0; y < VIEW_H; y++) rast_span(t, y, 0, VIEW_W, colour, RAST_ID(RAST_KIND_NONE, 0));
 }
 
-void render_frame(const scene *s, const camera *cam, render_mode mode, const rast_target *t, render_stats *stats)
+uint32_t render_work_bytes(const scene *s)
+{
+    return span_work_bytes(s);
+}
+
+void render_frame(const scene *s, const camera *cam, render_mode mode, const rast_target *t,
+                  const render_work *work, render_stats *stats)
 {
     render_stats local;
     render_stats *st = stats ? stats : &local;
@@ -34,8 +42,11 @@ void render_frame(const scene *s, const camera *cam, render_mode mode, const ras
     *st = (render_stats){0};
     view_setup(&v, cam);
     switch (mode) {
-    default:
+    case RENDER_PAINTER:
         painter_render(s, &v, t, st);
+        break;
+    default:
+        spans_render(s, &v, t, st, work ? work->mem : 0, work ? work->bytes : 0);
         break;
     }
 }

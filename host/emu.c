@@ -133,6 +133,15 @@ int main(int argc, char **argv)
         free(blob);
         return 1;
     }
+    uint32_t need = eng_work_bytes(&e);
+    void *work = need ? malloc(need) : NULL;
+    if (!work || eng_set_work(&e, work, need) != 0) {
+        fprintf(stderr, "emu: %s: the scene needs %u bytes of work memory, which could not be had\n",
+                spec ? spec : "built-in scene", need);
+        free(work);
+        free(blob);
+        return 1;
+    }
 
     int rc;
     if (!headless && hal_sdl_init(scale, "bspvga") == 0) {
@@ -143,6 +152,7 @@ int main(int argc, char **argv)
             printf("emu: no display available (%s); rendering a fly-through headless instead\n", hal_sdl_error());
         rc = run_headless(&e, out);
     }
+    free(work);
     free(blob);
     return rc;
 }

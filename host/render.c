@@ -28,7 +28,8 @@ static const char usage[] =
     "  --angle DEG        view angle in degrees, 0 = east, counter-clockwise\n"
     "                     (default: the player start's angle)\n"
     "  --look PX          vertical shear in pixels, -100..100 (default 0)\n"
-    "  --mode MODE        painter (default painter)\n"
+    "  --mode MODE        spans (zero overdraw, the default) or painter (back to\n"
+    "                     front, Listing 62.1)\n"
     "  --present P        flip | copy8 | copy16 | copy32 (default flip)\n"
     "  --split S          BSP split strategy when compiling a source: fewest |\n"
     "                     balanced | mixed (default mixed)\n"
@@ -102,7 +103,7 @@ static int parse_args(options *o, int argc, char **argv)
             o->cam.look = (int32_t)v;
         } else if (!strcmp(a, "--mode")) {
             int m = render_mode_parse(val);
-            if (m < 0) return die("--mode '%s': unknown mode (have: painter)%s", val, "");
+            if (m < 0) return die("--mode '%s': unknown mode (have: spans, painter)%s", val, "");
             o->mode = (render_mode)m;
         } else if (!strcmp(a, "--present")) {
             int m = hal_present_parse(val);
@@ -172,15 +173,17 @@ static void print_json(const options *o, const engine *e, uint32_t crc)
     printf("\"bus_cycles\": %llu, \"bus_model\": {\"vram_cycles\": %u, \"sysmem_cycles\": %u}, ",
            (unsigned long long)hal_perf_tsc(), bus.vram_cycles, bus.sysmem_cycles);
     const render_stats *st = &e->stats;
-    printf("\"nodes\": %u, \"leaves\": %u, \"segs\": %u, \"culled\": %u, \"polygons\": %u, \"frames\": %ld}\n",
-           st->nodes, st->leaves, st->segs, st->culled, st->polygons, o->repeat);
+    printf("\"nodes\": %u, \"boxes_culled\": %u, \"leaves\": %u, \"segs\": %u, \"culled\": %u, "
+           "\"polygons\": %u, \"occluded\": %u, \"edges\": %u, \"spans\": %u, \"work_bytes\": %u, \"frames\": %ld}\n",
+           st->nodes, st->boxes_culled, st->leaves, st->segs, st->culled, st->polygons, st->occluded, st->edges,
+           st->spans, e->work.bytes, o->repeat);
 }
 
 int main(int argc, char **argv)
 {
     options o;
     memset(&o, 0, sizeof o);
-    o.mode = RENDER_PAINTER;
+    o.mode = RENDER_SPANS;
     o.present = HAL_PRESENT_FLIP;
     o.bspc = bspc_defaults();
     o.repeat = 1;
@@ -200,6 +203,14 @@ int main(int argc, char **argv)
     if (len > UINT32_MAX || eng_init(&e, blob, (uint32_t)len, &se) != SCENE_OK) {
         scene_file_describe_error(o.scene, se.status, se.section, se.index, err, sizeof err);
         fprintf(stderr, "render: %s\n", err);
+        free(blob);
+        return 1;
+    }
+    uint32_t need = eng_work_bytes(&e);
+    void *work = need ? malloc(need) : NULL;
+    if (!work || eng_set_work(&e, work, need) != 0) {
+        fprintf(stderr, "render: %s: the scene needs %u bytes of work memory, which could not be had\n", o.scene, need);
+        free(work);
         free(blob);
         return 1;
     }
@@ -241,6 +252,7 @@ int main(int argc, char **argv)
     }
     print_json(&o, &e, crc);
     free(ids);
+    free(work);
     free(blob);
     return failed ? 1 : 0;
 }

@@ -56,7 +56,14 @@ static scene_status load_copy(const uint8_t *src, size_t len, scene_error *err)
         static engine e;
         hal_null_reset();
         assert_int_equal(eng_init(&e, aligned, (uint32_t)len, NULL), SCENE_OK);
-        eng_render(&e, NULL);
+        uint32_t need = eng_work_bytes(&e);
+        void *work = malloc(need ? need : 1);
+        assert_int_equal(eng_set_work(&e, work, need), 0);
+        for (int m = 0; m < RENDER_MODE_COUNT; m++) {
+            e.mode = (render_mode)m;
+            eng_render(&e, NULL);
+        }
+        free(work);
     }
     free(aligned);
     return st;
