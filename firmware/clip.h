@@ -5,6 +5,7 @@
 #ifndef CLIP_H
 #define CLIP_H
 
+#include "scene_format.h"
 #include "view.h"
 
 enum {
@@ -16,7 +17,7 @@ enum {
     CLIP_ALL = 31u
 };
 
-#define CLIP_MAX_VERTS 40 /* input polygons may have up to CLIP_MAX_VERTS - 5 vertices */
+#define CLIP_MAX_VERTS (SCN_MAX_LEAF_VERTS + 5) /* clipping adds at most one vertex per plane */
 
 typedef struct {
     int n;

@@ -99,7 +99,7 @@ static scene_status check_geometry(const scene *s, scene_error *err)
     for (uint32_t i = 0; i < s->nleaves; i++) {
         const scn_leaf *f = &s->leaves[i];
         if ((uint64_t)f->first_seg + f->num_segs > s->nsegs ||
-            (uint64_t)f->first_pvert + f->num_pverts > s->npverts ||
+            (uint64_t)f->first_pvert + f->num_pverts > s->npverts || f->num_pverts > SCN_MAX_LEAF_VERTS ||
             (f->sector != SCN_NONE && f->sector >= s->nsectors))
             return fail(err, SCENE_ERR_INDEX, SCN_SEC_LEAVES, i);
     }

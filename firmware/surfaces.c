@@ -62,11 +62,16 @@ static void seg_parts(const scene *sc, const view_xform *v, const scn_seg *g, un
         return;
     }
     const scn_sector *back = &sc->sectors[back_index];
-    /* Doom's sky rule: no upper wall between two sky ceilings */
-    int both_sky = (front->flags & back->flags & SCN_SECTOR_SKY) != 0;
-    if (!both_sky && back->ceil_h < front->ceil_h) {
+    if (back->ceil_h < front->ceil_h) {
         int32_t low = back->ceil_h > front->floor_h ? back->ceil_h : front->floor_h;
-        wall_part(v, a, b, low, front->ceil_h, mask, sink, colour[SCN_PART_UPPER], id, st);
+        /* Doom's sky rule: between two sky ceilings there is no upper wall but more
+         * sky. The step is drawn as the front sector's sky ceiling, so the view
+         * through it has no hole. */
+        if (front->flags & back->flags & SCN_SECTOR_SKY)
+            wall_part(v, a, b, low, front->ceil_h, mask, sink, front->ceil_color,
+                      RAST_ID(RAST_KIND_CEILING, l->sector[g->side]), st);
+        else
+            wall_part(v, a, b, low, front->ceil_h, mask, sink, colour[SCN_PART_UPPER], id, st);
     }
     if (back->floor_h > front->floor_h) {
         int32_t high = back->floor_h < front->ceil_h ? back->floor_h : front->ceil_h;
@@ -82,7 +87,7 @@ static void plane(const scene *sc, const view_xform *v, const scn_leaf *f, int32
 {
     clip_poly p;
     uint32_t n = f->num_pverts;
-    if (n < 3 || n > CLIP_MAX_VERTS - 5) return;
+    if (n < 3) return; /* degenerate; the loader refuses more than SCN_MAX_LEAF_VERTS */
     p.n = (int)n;
     for (uint32_t i = 0; i < n; i++) {
         const scn_vertex *q = &sc->pverts[f->first_pvert + (reverse ? n - 1 - i : i)];

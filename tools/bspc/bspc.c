@@ -117,6 +117,12 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
         if (t.leaves[i].depth > t.max_depth) t.max_depth = t.leaves[i].depth;
     }
     t.mean_depth = t.nleaves ? (double)dsum / t.nleaves : 0.0;
+    for (uint32_t i = 0; i < t.nleaves; i++)
+        if (t.leaves[i].poly.n > SCN_MAX_LEAF_VERTS) {
+            bs_fail(err, errlen, "%s: leaf %u: floor polygon has %u vertices, more than the renderer's %d",
+                    s.name, i, t.leaves[i].poly.n, SCN_MAX_LEAF_VERTS);
+            goto out;
+        }
     if (t.max_depth > SCN_MAX_DEPTH) {
         bs_fail(err, errlen, "%s: BSP tree %u nodes deep, deeper than %d (try --split balanced)",
                 s.name, t.max_depth, SCN_MAX_DEPTH);
