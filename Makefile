@@ -72,7 +72,7 @@ $(GEN)/default_scene.c: $(BUILD)/default.bsc $(BUILD)/bin2c
 	$(BUILD)/bin2c default_scene $< > $@
 
 # ---- top-level targets ------------------------------------------------------------
-.PHONY: all deps run test unit pytest nofloat bench-bsp clean help
+.PHONY: all deps run test unit pytest nofloat bench bench-bsp clean help
 .DEFAULT_GOAL := all
 
 all: $(PROGRAMS) nofloat
@@ -82,6 +82,7 @@ help:
 	@echo "make            build build/bspc, build/render, build/emu (and check: no floating point)"
 	@echo "make run        walk the built-in scene in a window (headless: fly-through PNGs)"
 	@echo "make test       deps, build, unit tests and pytest, with ASan and UBSan"
+	@echo "make bench      instructions per frame (callgrind), overdraw, VRAM writes, bus cycles on 20 views"
 	@echo "make bench-bsp  bspc over all 68 Freedoom maps per strategy, beside zdbsp and glbsp"
 	@echo "make clean      remove build/"
 
@@ -110,6 +111,9 @@ test: deps
 
 bench-bsp: deps $(BUILD)/bspc
 	$(PY) tools/bench_bsp.py
+
+bench: deps $(BUILD)/bspc $(BUILD)/render
+	$(PY) tools/bench.py
 
 clean:
 	rm -rf $(BUILD)/obj $(BUILD)/san $(BUILD)/gen $(PROGRAMS) $(BUILD)/*.bsc $(BUILD)/gen_tables $(BUILD)/bin2c

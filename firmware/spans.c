@@ -365,23 +365,25 @@ static void scan(span_state *S)
             n = next;
         }
         scan_line(S, active, y);
-        /* drop finished edges, step the rest, and restore x order */
-        sp_edge *sorted = 0, **tail = &sorted;
-        for (sp_edge *e = active, *next; e; e = next) {
-            next = e->next;
-            if (e->end_row <= y + 1) continue;
+        /* drop finished edges, step the rest, and restore x order: stepping
+         * reorders only edges that cross, so an edge is moved back only when it
+         * passed the one before it */
+        sp_edge **link2 = &active, *prev = 0;
+        while (*link2) {
+            sp_edge *e = *link2;
+            if (e->end_row <= y + 1) {
+                *link2 = e->next;
+                continue;
+            }
             edge_advance(e);
-            e->next = 0;
-            *tail = e;
-            tail = &e->next;
+            if (prev && e->x < prev->x) {
+                *link2 = e->next;
+                insert_sorted(&active, e);
+                continue;
+            }
+            prev = e;
+            link2 = &e->next;
         }
-        /* insertion sort: the list is nearly in order already */
-        sp_edge *out = 0;
-        for (sp_edge *e = sorted, *next; e; e = next) {
-            next = e->next;
-            insert_sorted(&out, e);
-        }
-        active = out;
     }
 }
 
