@@ -43,7 +43,7 @@ static int cull_box(const int32_t box[4], const view_xform *v, const walk_plane 
 }
 
 void walk_tree(const scene *s, const view_xform *v, walk_order order, walk_visit visit, void *ctx,
-               walk_stats *st)
+               const occ_columns *occ, walk_stats *st)
 {
     uint32_t stack[SCN_MAX_DEPTH + 2];
     uint8_t masks[SCN_MAX_DEPTH + 2];
@@ -51,7 +51,7 @@ void walk_tree(const scene *s, const view_xform *v, walk_order order, walk_visit
     int sp = 0;
     walk_stats local = {0, 0};
     if (!st) st = &local;
-    st->nodes = st->boxes_culled = 0;
+    st->nodes = st->boxes_culled = st->boxes_hidden = 0;
     if (s->nleaves == 0) return;
     frustum_planes(v, planes);
     stack[sp] = s->root;
@@ -60,6 +60,7 @@ void walk_tree(const scene *s, const view_xform *v, walk_order order, walk_visit
         sp--;
         uint32_t n = stack[sp];
         unsigned mask = masks[sp];
+        if (occ && sp > 0 && occ_full(occ)) return; /* nothing more can show */
         if (n & SCN_LEAF_BIT) {
             if (visit(ctx, n & ~SCN_LEAF_BIT, mask)) return;
             continue;
@@ -72,6 +73,17 @@ void walk_tree(const scene *s, const view_xform *v, walk_order order, walk_visit
         int second = first ^ 1;
         int m2 = cull_box(node->bbox[second], v, planes, mask);
         int m1 = cull_box(node->bbox[first], v, planes, mask);
+        if (occ) {
+            int x0, x1;
+            if (m2 >= 0 && (occ_box_columns(v, node->bbox[second], &x0, &x1), occ_hidden(occ, x0, x1))) {
+                m2 = -1;
+                st->boxes_hidden++;
+            }
+            if (m1 >= 0 && (occ_box_columns(v, node->bbox[first], &x0, &x1), occ_hidden(occ, x0, x1))) {
+                m1 = -1;
+                st->boxes_hidden++;
+            }
+        }
         if (sp + 2 > SCN_MAX_DEPTH + 2) return; /* unreachable for a validated scene */
         if (m2 >= 0) {
             stack[sp] = node->child[second];

@@ -8,6 +8,7 @@
 
 #include <stdint.h>
 #include "scene.h"
+#include "occlusion.h"
 #include "view.h"
 
 typedef enum { WALK_FRONT_TO_BACK, WALK_BACK_TO_FRONT } walk_order;
@@ -18,10 +19,12 @@ typedef int (*walk_visit)(void *ctx, uint32_t leaf, unsigned clip_mask);
 typedef struct {
     uint32_t nodes;        /* nodes visited */
     uint32_t boxes_culled; /* subtrees rejected by their bounding box */
+    uint32_t boxes_hidden; /* subtrees behind closed columns */
 } walk_stats;
 
-/* Walk every leaf that may be visible, in the order asked for. */
+/* Walk every leaf that may be visible, in the order asked for. occ (may be NULL,
+ * front to back only): subtrees whose boxes fall in closed columns are skipped. */
 void walk_tree(const scene *s, const view_xform *v, walk_order order, walk_visit visit, void *ctx,
-               walk_stats *st);
+               const occ_columns *occ, walk_stats *st);
 
 #endif

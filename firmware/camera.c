@@ -1,19 +1,30 @@
-/* camera.c - eye placement and free movement. Speeds are per second and scaled by
- * the frame time, so the walk feels the same at any frame rate. */
+/* camera.c - eye placement, walking with collision (collide.c) and the eye's
+ * height. Speeds are per second and scaled by the frame time, so the walk feels
+ * the same at any frame rate; the easing of the eye over steps is integer and
+ * depends only on the inputs, so a replay gives the same frames. */
 #include "camera.h"
+#include "collide.h"
 #include "hal.h"
 
 #define WALK_SPEED 256     /* units per second */
 #define TURN_SPEED 120     /* degrees per second */
 #define FLY_SPEED 128      /* units per second */
 #define LOOK_SPEED 120     /* pixels per second */
+#define EASE_SNAP (FX_ONE / 16) /* nearer than this, the eye is put on its floor */
+#define EASE_DT_MAX 1000u  /* longer frames ease as one second (keeps products small) */
+#define CEIL_GAP (4 * FX_ONE)   /* the eased eye stays this far under the ceiling */
+
+static void set_eye(cam_state *c)
+{
+    c->view.z = fx_sat32((int64_t)c->eye_floor + CAM_EYE_HEIGHT + c->fly);
+}
 
 void cam_follow_floor(cam_state *c, const scene *s)
 {
-    uint32_t sec = scene_sector_at(s, c->view.x, c->view.y);
-    if (sec == SCN_NONE) return;
-    int64_t z = (int64_t)s->sectors[sec].floor_h + CAM_EYE_HEIGHT + c->fly;
-    c->view.z = fx_sat32(z);
+    fx_t f;
+    if (!col_floor_at(s, c->view.x, c->view.y, &f)) return;
+    c->eye_floor = f;
+    set_eye(c);
 }
 
 void cam_start(cam_state *c, const scene *s)
@@ -24,7 +35,33 @@ void cam_start(cam_state *c, const scene *s)
     c->view.look = 0;
     c->view.z = CAM_EYE_HEIGHT;
     c->fly = 0;
+    c->eye_floor = 0;
+    c->noclip = 0;
+    c->feet = 0;
+    col_move(s, 0, &c->view.x, &c->view.y, &c->feet, 0, 0); /* the floor stood on; no move */
     cam_follow_floor(c, s);
+}
+
+/* Ease the eye's floor toward the floor under the eye: the gap shrinks by
+ * dt / (dt + CAM_EASE_MS) each step (exponential, time constant 60 ms), the eye
+ * never lags more than a step (COL_STEP) below the floor, so it is at least 17
+ * units above it, and never rises to within CEIL_GAP + 41 of the ceiling. */
+static void ease_floor(cam_state *c, const scene *s, uint32_t dt_ms)
+{
+    uint32_t sec = scene_sector_at(s, c->view.x, c->view.y);
+    if (sec == SCN_NONE) return;
+    int64_t target = s->sectors[sec].floor_h, ceil = s->sectors[sec].ceil_h;
+    int64_t e = c->eye_floor, diff = target - e; /* |diff| < 2^32 */
+    int64_t dt = dt_ms > EASE_DT_MAX ? EASE_DT_MAX : dt_ms;
+    if (diff > -EASE_SNAP && diff < EASE_SNAP)
+        e = target;
+    else
+        e += diff * dt / (dt + CAM_EASE_MS); /* < 2^42 */
+    if (e < target - COL_STEP) e = target - COL_STEP;
+    int64_t top = ceil - CAM_EYE_HEIGHT - CEIL_GAP;
+    if (top < target) top = target;
+    if (e > top) e = top;
+    c->eye_floor = (fx_t)e; /* between two heights of the scene: in range */
 }
 
 /* rate (units per second, whole) * dt_ms / 1000 as 16.16. */
@@ -59,20 +96,37 @@ void cam_move(cam_state *c, const scene *s, uint32_t input, uint32_t dt_ms)
     if (input & HAL_KEY_BACK) fwd -= step;
     if (input & HAL_KEY_STRAFE_RIGHT) side += step;
     if (input & HAL_KEY_STRAFE_LEFT) side -= step;
+    int64_t mx = 0, my = 0;
     if (fwd || side) {
         fx_ang_t a = fx_ang_from_deg(c->view.angle_deg);
         int64_t sn = fx_sin(a), cs = fx_cos(a);
-        /* forward (cos, sin), right (sin, -cos); |step| < 2^24, trig 2^30: < 2^55 */
-        c->view.x = clamp_coord(c->view.x + fx_asr64(fwd * cs + side * sn, FX_TRIG_SHIFT));
-        c->view.y = clamp_coord(c->view.y + fx_asr64(fwd * sn - side * cs, FX_TRIG_SHIFT));
+        /* forward (cos, sin), right (sin, -cos); |step| < 2^41 (dt < 2^32 ms),
+         * trig 2^30, two terms: < 2^72 would overflow, so clamp dt's effect first:
+         * |step| is limited to 2^32 (65536 units, the whole world) */
+        if (fwd > ((int64_t)1 << 32)) fwd = (int64_t)1 << 32;
+        if (fwd < -((int64_t)1 << 32)) fwd = -((int64_t)1 << 32);
+        if (side > ((int64_t)1 << 32)) side = (int64_t)1 << 32;
+        if (side < -((int64_t)1 << 32)) side = -((int64_t)1 << 32);
+        mx = fx_asr64(fwd * cs + side * sn, FX_TRIG_SHIFT); /* < 2^63 */
+        my = fx_asr64(fwd * sn - side * cs, FX_TRIG_SHIFT);
+    }
+    if (c->noclip) {
+        c->view.x = clamp_coord(c->view.x + mx);
+        c->view.y = clamp_coord(c->view.y + my);
+        col_move(s, 0, &c->view.x, &c->view.y, &c->feet, 0, 0);
+    } else {
+        col_move(s, 0, &c->view.x, &c->view.y, &c->feet, mx, my);
     }
     if (input & HAL_KEY_FLY_UP) c->fly = fx_sat32((int64_t)c->fly + per_frame(FLY_SPEED, dt_ms));
     if (input & HAL_KEY_FLY_DOWN) c->fly = fx_sat32((int64_t)c->fly - per_frame(FLY_SPEED, dt_ms));
+    if (c->fly < 0) c->fly = 0;
+    if (c->fly > CAM_FLY_MAX) c->fly = CAM_FLY_MAX;
     int32_t look_step = (int32_t)(LOOK_SPEED * dt_ms / 1000u);
     if (look_step < 1) look_step = 1;
     if (input & HAL_KEY_LOOK_UP) c->view.look += look_step;
     if (input & HAL_KEY_LOOK_DOWN) c->view.look -= look_step;
     if (c->view.look > VIEW_LOOK_MAX) c->view.look = VIEW_LOOK_MAX;
     if (c->view.look < -VIEW_LOOK_MAX) c->view.look = -VIEW_LOOK_MAX;
-    cam_follow_floor(c, s);
+    ease_floor(c, s, dt_ms);
+    set_eye(c);
 }

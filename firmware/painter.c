@@ -26,7 +26,7 @@ static void fill_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour,
 static int draw_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
 {
     painter *p = ctx;
-    surf_leaf(p->sc, p->v, leaf, clip_mask, &p->sink, p->st);
+    surf_leaf(p->sc, p->v, leaf, clip_mask, &p->sink, 0, p->st);
     return 0;
 }
 
@@ -36,7 +36,7 @@ void painter_render(const scene *sc, const view_xform *v, const rast_target *t, 
     walk_stats ws;
     p.sink.ctx = &p;
     render_clear(t, PAINTER_BACKGROUND);
-    walk_tree(sc, v, WALK_BACK_TO_FRONT, draw_leaf, &p, &ws);
+    walk_tree(sc, v, WALK_BACK_TO_FRONT, draw_leaf, &p, 0, &ws);
     st->nodes = ws.nodes;
     st->boxes_culled = ws.boxes_culled;
 }

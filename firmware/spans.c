@@ -51,6 +51,8 @@ typedef struct {
     uint32_t nsurfs, max_surfs;
     sp_edge *new_edges[VIEW_H];
     sp_cover cover[VIEW_H];
+    occ_columns occ;
+    int use_occ;
     int full_rows;
     uint32_t key;
     sp_span spans[SPAN_BUFFER];
@@ -225,9 +227,32 @@ static int polygon_rows(const screen_pt *pts, int n, int16_t *top_out, int16_t l
     return bottom - top;
 }
 
+/* Cheap first test: is the polygon's screen bounding box already covered on every
+ * row it spans? (Exact per-row extents are only worked out when it is not.) */
+static int box_covered(const span_state *S, const screen_pt *pts, int n)
+{
+    int32_t xmin = INT32_MAX, xmax = INT32_MIN, ymin = INT32_MAX, ymax = INT32_MIN;
+    for (int i = 0; i < n; i++) {
+        if (pts[i].x < xmin) xmin = pts[i].x;
+        if (pts[i].x > xmax) xmax = pts[i].x;
+        if (pts[i].y < ymin) ymin = pts[i].y;
+        if (pts[i].y > ymax) ymax = pts[i].y;
+    }
+    int x0 = first_sample(xmin), x1 = first_sample(xmax);
+    int y0 = first_sample(ymin), y1 = first_sample(ymax);
+    if (y1 > VIEW_H) y1 = VIEW_H;
+    for (int y = y0 < 0 ? 0 : y0; y < y1; y++)
+        if (!covered(&S->cover[y], x0, x1)) return 0;
+    return 1;
+}
+
 static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id)
 {
     span_state *S = ctx;
+    if (box_covered(S, pts, n)) {
+        S->st->occluded++;
+        return;
+    }
     int16_t lo[VIEW_H], hi[VIEW_H], top;
     int rows = polygon_rows(pts, n, &top, lo, hi);
     int visible = 0;
@@ -264,7 +289,7 @@ static int visit_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
 {
     span_state *S = ctx;
     S->key++;
-    surf_leaf(S->sc, S->v, leaf, clip_mask, &S->sink, S->st);
+    surf_leaf(S->sc, S->v, leaf, clip_mask, &S->sink, S->use_occ ? &S->occ : 0, S->st);
     return S->full_rows == VIEW_H; /* the screen is full: nothing farther can show */
 }
 
@@ -387,6 +412,26 @@ static void scan(span_state *S)
     }
 }
 
+/* 1 if the eye stands inside its leaf's floor polygon (leaf regions also take in
+ * void behind walls) and between its sector's floor and ceiling. */
+static int eye_in_world(const scene *sc, const view_xform *v)
+{
+    const scn_leaf *f = &sc->leaves[scene_leaf_at(sc, (int32_t)v->cx, (int32_t)v->cy)];
+    if (f->sector == SCN_NONE || f->num_pverts < 3) return 0;
+    const scn_sector *sec = &sc->sectors[f->sector];
+    if (v->cz <= sec->floor_h || v->cz >= sec->ceil_h) return 0;
+    for (uint32_t i = 0; i < f->num_pverts; i++) {
+        const scn_vertex *a = &sc->pverts[f->first_pvert + i];
+        const scn_vertex *b = &sc->pverts[f->first_pvert + (i + 1 == f->num_pverts ? 0 : i + 1)];
+        /* counter-clockwise polygon: inside is on the left of every edge; the
+         * shifts keep both products below 2^61 (as in surfaces.c) */
+        int64_t dx = fx_asr64((int64_t)b->x - a->x, 1), dy = fx_asr64((int64_t)b->y - a->y, 1);
+        int64_t ex = fx_asr64(v->cx - a->x, 3), ey = fx_asr64(v->cy - a->y, 3);
+        if (dx * ey - dy * ex < 0) return 0;
+    }
+    return 1;
+}
+
 void spans_render(const scene *sc, const view_xform *v, const rast_target *t, render_stats *st, void *work,
                   uint32_t work_bytes)
 {
@@ -420,9 +465,14 @@ void spans_render(const scene *sc, const view_xform *v, const rast_target *t, re
         S->cover[y].n = 0;
     }
     walk_stats ws;
-    walk_tree(sc, v, WALK_FRONT_TO_BACK, visit_leaf, S, &ws);
+    /* Solid walls close columns only for an eye inside the world: from outside
+     * every sector, or above or below its own sector, one sees past them. */
+    occ_columns *occ = eye_in_world(sc, v) ? &S->occ : 0;
+    occ_reset(&S->occ);
+    S->use_occ = occ != 0;
+    walk_tree(sc, v, WALK_FRONT_TO_BACK, visit_leaf, S, occ, &ws);
     st->nodes = ws.nodes;
-    st->boxes_culled = ws.boxes_culled;
+    st->boxes_culled = ws.boxes_culled + ws.boxes_hidden;
     st->edges = S->nedges;
     scan(S);
     flush_spans(S);

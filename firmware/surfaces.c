@@ -43,14 +43,30 @@ static void wall_part(const view_xform *v, const scn_vertex *a, const scn_vertex
     emit(v, &p, mask, sink, colour, id, st);
 }
 
+/* A wall with no opening hides everything behind it in the columns it covers.
+ * The range it closes is one column narrower at each inner end than its 2-D
+ * extent, so rounding can never close a column the wall does not fill. */
+static void close_columns(occ_columns *occ, int x0, int x1)
+{
+    occ_close(occ, x0 > 0 ? x0 + 1 : 0, x1 < VIEW_W ? x1 - 1 : VIEW_W);
+}
+
 static void seg_parts(const scene *sc, const view_xform *v, const scn_seg *g, unsigned mask, const surf_sink *sink,
-                      render_stats *st)
+                      occ_columns *occ, render_stats *st)
 {
     const scn_vertex *a = &sc->verts[g->v1], *b = &sc->verts[g->v2];
     st->segs++;
     if (!faces_eye(v, a, b)) {
         st->culled++;
         return;
+    }
+    int c0 = 0, c1 = VIEW_W;
+    if (occ) {
+        if (!occ_seg_columns(v, a->x, a->y, b->x, b->y, &c0, &c1) ||
+            occ_hidden(occ, c0 > 0 ? c0 - 1 : 0, c1 < VIEW_W ? c1 + 1 : VIEW_W)) {
+            st->occluded++;
+            return;
+        }
     }
     const scn_line *l = &sc->lines[g->line];
     const scn_sector *front = &sc->sectors[l->sector[g->side]];
@@ -59,6 +75,7 @@ static void seg_parts(const scene *sc, const view_xform *v, const scn_seg *g, un
     const uint8_t *colour = l->color[g->side];
     if (back_index == SCN_NONE) {
         wall_part(v, a, b, front->floor_h, front->ceil_h, mask, sink, colour[SCN_PART_MIDDLE], id, st);
+        if (occ) close_columns(occ, c0, c1);
         return;
     }
     const scn_sector *back = &sc->sectors[back_index];
@@ -77,6 +94,10 @@ static void seg_parts(const scene *sc, const view_xform *v, const scn_seg *g, un
         int32_t high = back->floor_h < front->ceil_h ? back->floor_h : front->ceil_h;
         wall_part(v, a, b, front->floor_h, high, mask, sink, colour[SCN_PART_LOWER], id, st);
     }
+    /* closed door: no opening between the two sectors */
+    int32_t top = back->ceil_h < front->ceil_h ? back->ceil_h : front->ceil_h;
+    int32_t bottom = back->floor_h > front->floor_h ? back->floor_h : front->floor_h;
+    if (occ && top <= bottom) close_columns(occ, c0, c1);
 }
 
 /* The leaf polygon at height h. Seen from above (floor) a counter-clockwise map
@@ -97,7 +118,7 @@ static void plane(const scene *sc, const view_xform *v, const scn_leaf *f, int32
 }
 
 void surf_leaf(const scene *sc, const view_xform *v, uint32_t leaf, unsigned mask, const surf_sink *sink,
-               render_stats *st)
+               occ_columns *occ, render_stats *st)
 {
     const scn_leaf *f = &sc->leaves[leaf];
     st->leaves++;
@@ -108,7 +129,7 @@ void surf_leaf(const scene *sc, const view_xform *v, uint32_t leaf, unsigned mas
         if (v->cz < sec->ceil_h)
             plane(sc, v, f, sec->ceil_h, 0, mask, sink, sec->ceil_color, RAST_ID(RAST_KIND_CEILING, f->sector), st);
     }
-    for (uint32_t i = 0; i < f->num_segs; i++) seg_parts(sc, v, &sc->segs[f->first_seg + i], mask, sink, st);
+    for (uint32_t i = 0; i < f->num_segs; i++) seg_parts(sc, v, &sc->segs[f->first_seg + i], mask, sink, occ, st);
 }
 
 uint32_t surf_max_polygon_verts(const scene *s)

@@ -9,6 +9,7 @@
 #include <stdint.h>
 #include "render.h"
 #include "scene.h"
+#include "occlusion.h"
 #include "view.h"
 
 typedef struct {
@@ -20,9 +21,10 @@ typedef struct {
 
 /* Emit the leaf's surfaces in an order that is correct back to front within the
  * leaf (floor and ceiling first, then walls). clip_mask: planes still to clip
- * against (bsp_walk.h). */
+ * against (bsp_walk.h). occ (may be NULL): closed columns; wall pieces wholly
+ * inside them are skipped, and solid walls close the columns they cover. */
 void surf_leaf(const scene *s, const view_xform *v, uint32_t leaf, unsigned clip_mask, const surf_sink *sink,
-               render_stats *st);
+               occ_columns *occ, render_stats *st);
 
 /* The most screen vertices surf_leaf can hand a sink for this scene (bounds the
  * edge pool of the span renderer). */
