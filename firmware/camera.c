@@ -100,14 +100,13 @@ void cam_move(cam_state *c, const scene *s, uint32_t input, uint32_t dt_ms)
     if (fwd || side) {
         fx_ang_t a = fx_ang_from_deg(c->view.angle_deg);
         int64_t sn = fx_sin(a), cs = fx_cos(a);
-        /* forward (cos, sin), right (sin, -cos); |step| < 2^41 (dt < 2^32 ms),
-         * trig 2^30, two terms: < 2^72 would overflow, so clamp dt's effect first:
-         * |step| is limited to 2^32 (65536 units, the whole world) */
-        if (fwd > ((int64_t)1 << 32)) fwd = (int64_t)1 << 32;
-        if (fwd < -((int64_t)1 << 32)) fwd = -((int64_t)1 << 32);
-        if (side > ((int64_t)1 << 32)) side = (int64_t)1 << 32;
-        if (side < -((int64_t)1 << 32)) side = -((int64_t)1 << 32);
-        mx = fx_asr64(fwd * cs + side * sn, FX_TRIG_SHIFT); /* < 2^63 */
+        /* forward (cos, sin), right (sin, -cos). A long frame can make |step| up to
+         * 2^41; clamped to 2^31 (half the world: col_move cuts it up anyway), each
+         * product is below 2^61 and their sum below 2^62 */
+        const int64_t lim = (int64_t)1 << 31;
+        fwd = fwd > lim ? lim : (fwd < -lim ? -lim : fwd);
+        side = side > lim ? lim : (side < -lim ? -lim : side);
+        mx = fx_asr64(fwd * cs + side * sn, FX_TRIG_SHIFT);
         my = fx_asr64(fwd * sn - side * cs, FX_TRIG_SHIFT);
     }
     if (c->noclip) {

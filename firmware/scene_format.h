@@ -24,7 +24,7 @@
 #define SCN_COORD_MAX 32767 /* |x|, |y| of every vertex, whole units */
 #define SCN_HEIGHT_MAX 16383 /* |floor|, |ceiling| heights, whole units */
 #define SCN_MAX_DEPTH 255    /* deepest node path the walk stack supports */
-#define SCN_MAX_LEAF_VERTS 56 /* most vertices of a leaf floor polygon (clip.h has room for 5 more) */
+#define SCN_MAX_LEAF_VERTS 64 /* most vertices of a leaf floor polygon (clip.h has room for 5 more) */
 
 enum scn_section_id {
     SCN_SEC_VERTICES, /* scn_vertex[]: original vertices first, then split points */
