@@ -1,0 +1,519 @@
+#!/usr/bin/env python3
+"""refrender.py - the float reference renderer: surface ids by ray casting, without the BSP tree.
+
+It reads the SOURCE map (a text scene, docs/scene-format.md, or a Doom-format map `file.wad:MAP01`)
+and casts one ray through the centre of each of the 320x200 pixels, in double precision, against
+every wall of the map. The output is the surface-id buffer of /work/shared/DESIGN.md: 320x200
+uint32, row-major, id = kind << 24 | index (0 nothing, 1 wall = linedef*2 + side, 2 floor = sector,
+3 ceiling = sector). It is the yardstick for the integer renderer's id buffers (tools/accuracy.py).
+
+Reading, numbered exactly as build/bspc numbers them (tools/bspc/scene_text.c, wad.c):
+- text scene: sectors in declaration order, walls in file order; numbers rounded to 16.16
+  (nearest, ties away from zero), as bspc does, so both see the same geometry.
+- WAD: the last marker lump of the name wins; the first THINGS/LINEDEFS/SIDEDEFS/VERTEXES/SECTORS
+  after it; linedefs whose two vertices are at the same point are skipped (the numbers after one
+  shift down); sidedef 0 is the front (sector[0], right of v1 -> v2), sidedef 1 the back; a
+  linedef is two-sided when it has a second sidedef. A ceiling flat F_SKY* is a sky. The player
+  start is the first thing of type 1.
+
+Camera (DESIGN.md "Camera", as the C renderer): x east, y north, angle in degrees, 0 = east,
+counter-clockwise; forward f = (cos a, sin a), right r = (sin a, -cos a). Pixel (px, py):
+xv = (px + 0.5 - 160) / 160, yv = (100 + look - (py + 0.5)) / 160. The ray's map-plane direction
+is d = f + xv * r, so its point at forward depth t (distance along f) is eye + t * d, at height
+eye_z + yv * t. Hits at t < 1/1024 (the near plane) are ignored. The camera values are rounded to
+16.16 first, as build/render rounds them; the trigonometry is exact (double).
+
+What a ray sees (Doom's rules, as the C renderer draws them). The ray's 2-D line is walked from
+the eye's sector through the walls it crosses, in order of depth. The sector sequence does not
+depend on the pixel row, so for each column the crossings are sorted once and every row is
+decided with arrays:
+- inside the current sector S, between two crossings at depths t0 < t1, the ray hits S's floor
+  (kind 2, S) if it goes down through the floor's height there, or S's ceiling (kind 3, S; a sky
+  too) if it goes up through the ceiling's height. (Height is linear in t: the ends decide.)
+- at a crossing of linedef L, "side" is the side of L the eye is on (0 front/right, 1 back/left),
+  N = L's sector on that side, B = the one on the far side. No N (the back of a one-sided wall:
+  only with the eye outside the map): back-face culled, the ray passes. One-sided (no B): the
+  wall, kind 1, L*2 + side. Two-sided: the upper part (height > B.ceil, when B.ceil < N.ceil and
+  not both ceilings sky) or the lower part (height < B.floor, when B.floor > N.floor) is the
+  wall, same id; otherwise the ray goes on into B.
+- Doom's sky rule: between two sky ceilings there is no upper wall; a ray that goes over it
+  (B.ceil < height <= N.ceil) sees sky at once: kind 3 of N (default, `sky_owner="near"`: Doom's
+  visplane owner, and what build/render draws) or of B (`"far"`).
+- after a crossing the current sector is the far-side sector (B, or L's front for a one-sided wall
+  crossed from behind). Past the last crossing the ray meets the current sector's floor or
+  ceiling (yv is never 0), or nothing (kind 0) when there is none.
+For an eye inside its sector and between its floor and ceiling these are exactly the rules above.
+Beyond that (eye outside the map, or outside its sector's heights, or a map whose sectors are not
+closed) the reference draws what is geometrically there, as the C renderer's polygons are: a plane
+is seen only from its own side (a floor from above, a ceiling from below), a wall part only
+between its own bottom and top heights (one-sided: N.floor..N.ceil; upper: max(B.ceil,
+N.floor)..N.ceil; lower: N.floor..min(B.floor, N.ceil)), and N is the line's own sector on the
+eye's side rather than the walk's (the C renderer's seg front sector), so an eye outside all
+sectors starts in none (no floor, no ceiling) and rays pass through walls seen from behind until
+they enter a sector. A wall whose end is exactly on the ray counts as crossed (the ends are
+inclusive). An eye exactly on a wall or vertex crosses it at depth 0, which the near plane
+ignores; each ray then starts in the near-side sector of the first wall it crosses (the sector it
+really goes into) rather than in the eye's sector.
+
+Eye sector (default eye height = its floor + 41, or 41 in none): even-odd ray crossing over each
+sector's lines (a line with the sector on both sides counts twice and cancels); if several
+sectors claim the point (a map whose sectors overlap), the one facing the point across the
+nearest line crossing the ray to +x wins.
+
+usage: tools/refrender.py SCENE --at X,Y[,Z] --angle DEG [--look PX] --ids OUT.bin [--png OUT.png]
+                          [--sky-owner far|near]
+"""
+import argparse
+import os
+import struct
+import sys
+import zlib
+from fractions import Fraction
+
+import numpy as np
+
+W, H = 320, 200
+FOCAL = 160.0
+EYE_HEIGHT = 41.0
+ZNEAR = 1.0 / 1024.0
+KIND_NONE, KIND_WALL, KIND_FLOOR, KIND_CEIL = 0, 1, 2, 3
+NONE = -1
+
+
+class Map:
+    """A source map: lines (v1, v2 as float coordinates, front and back sector), sectors."""
+
+    def __init__(self, name, x1, y1, x2, y2, front, back, floor, ceil, sky, player):
+        self.name = name
+        self.x1, self.y1 = np.asarray(x1, float), np.asarray(y1, float)
+        self.x2, self.y2 = np.asarray(x2, float), np.asarray(y2, float)
+        self.front = np.asarray(front, np.int64)       # sector on the right of v1 -> v2
+        self.back = np.asarray(back, np.int64)         # NONE for one-sided
+        self.floor = np.asarray(floor, float)
+        self.ceil = np.asarray(ceil, float)
+        self.sky = np.asarray(sky, bool)
+        self.player = player                           # (x, y, angle)
+
+    @property
+    def nlines(self):
+        return len(self.front)
+
+    @property
+    def nsectors(self):
+        return len(self.floor)
+
+
+# ---- numbers ------------------------------------------------------------------------------
+
+def fx_round(value):
+    """A decimal string or number rounded to the nearest 1/65536, ties away from zero (fxtext.c)."""
+    f = Fraction(value) * 65536
+    q = abs(f)
+    n = int(q)
+    if (q - n) * 2 >= 1:
+        n += 1
+    return (n if f >= 0 else -n) / 65536.0
+
+
+def _num(tok, what):
+    try:
+        if not tok or tok.lstrip("+-")[:1] not in "0123456789.":
+            raise ValueError
+        return fx_round(tok)
+    except (ValueError, ZeroDivisionError):
+        raise ValueError(f"{what}: '{tok}' is not a number") from None
+
+
+# ---- text scenes --------------------------------------------------------------------------
+
+def read_text(path):
+    names, floor, ceil, sky = {}, [], [], []
+    x1, y1, x2, y2, front, back = [], [], [], [], [], []
+    player = None
+
+    def sector_ref(tok, lineno):
+        if tok[:1].isdigit():      # a number, read as strtol(tok, 0) reads it: 0x.. hex, 0.. octal
+            base = 16 if tok[:2].lower() == "0x" else 8 if tok[:1] == "0" and len(tok) > 1 else 10
+            try:
+                i = int(tok[2:] if base == 16 else tok, base)
+            except ValueError:
+                i = len(floor)
+            if i < len(floor):
+                return i
+        elif tok in names:
+            return names[tok]
+        raise ValueError(f"{path}:{lineno}: wall: unknown sector '{tok}'")
+
+    with open(path, "r", encoding="utf-8", errors="replace") as fh:
+        for lineno, line in enumerate(fh, 1):
+            tok = line.split("#", 1)[0].split()
+            if not tok:
+                continue
+            try:
+                if tok[0] == "sector":
+                    i = 1
+                    if i < len(tok) and "=" not in tok[i] and tok[i] != "sky":
+                        names[tok[i]] = len(floor)
+                        i += 1
+                    kv = {}
+                    is_sky = False
+                    for t in tok[i:]:
+                        if t == "sky":
+                            is_sky = True
+                        elif "=" in t:
+                            k, v = t.split("=", 1)
+                            kv[k] = v
+                    floor.append(_num(kv["floor"], "sector: floor"))
+                    ceil.append(_num(kv["ceil"], "sector: ceil"))
+                    sky.append(is_sky)
+                elif tok[0] == "wall":
+                    a = [_num(t, "wall") for t in tok[1:5]]
+                    if a[0] == a[2] and a[1] == a[3]:
+                        raise ValueError("wall: zero length")
+                    f = sector_ref(tok[5], lineno)
+                    b = NONE
+                    if len(tok) > 6 and "=" not in tok[6]:
+                        b = sector_ref(tok[6], lineno)
+                    x1.append(a[0]); y1.append(a[1]); x2.append(a[2]); y2.append(a[3])
+                    front.append(f); back.append(b)
+                elif tok[0] == "player":
+                    player = (_num(tok[1], "player"), _num(tok[2], "player"),
+                              _num(tok[3], "player") % 360.0)
+                else:
+                    raise ValueError(f"unknown statement '{tok[0]}'")
+            except (KeyError, IndexError) as e:
+                raise ValueError(f"{path}:{lineno}: malformed {tok[0]} ({e})") from None
+            except ValueError as e:
+                msg = str(e)
+                raise ValueError(msg if msg.startswith(path) else f"{path}:{lineno}: {msg}") from None
+    if not front:
+        raise ValueError(f"{path}: no walls")
+    return Map(path, x1, y1, x2, y2, front, back, floor, ceil, sky, player)
+
+
+# ---- WAD maps -----------------------------------------------------------------------------
+
+MAP_LUMPS = {"THINGS", "LINEDEFS", "SIDEDEFS", "VERTEXES", "SEGS", "SSECTORS", "NODES", "SECTORS",
+             "REJECT", "BLOCKMAP", "BEHAVIOR", "SCRIPTS"}
+
+
+def find_wad(name):
+    if os.path.exists(name) or "/" in name:
+        return name if os.path.exists(name) else None
+    for d in (os.environ.get("DOOMWADDIR"), "/usr/share/games/doom"):
+        if d and os.path.exists(os.path.join(d, name)):
+            return os.path.join(d, name)
+    return None
+
+
+def _name8(b):
+    return b.split(b"\0", 1)[0].decode("latin-1").upper()
+
+
+def read_wad(spec):
+    wadname, mapname = spec.rsplit(":", 1)
+    path = find_wad(wadname)
+    if path is None:
+        raise ValueError(f"{spec}: cannot find {wadname} (looked in the current folder, "
+                         "$DOOMWADDIR and /usr/share/games/doom)")
+    data = open(path, "rb").read()
+    if data[:4] not in (b"IWAD", b"PWAD"):
+        raise ValueError(f"{spec}: {path} is not a WAD file")
+    nlumps, dirofs = struct.unpack_from("<II", data, 4)
+    lumps = [(*struct.unpack_from("<II", data, dirofs + 16 * i),
+              _name8(data[dirofs + 16 * i + 8:dirofs + 16 * i + 16])) for i in range(nlumps)]
+    want = mapname.upper()
+    marker = max((i for i, l in enumerate(lumps) if l[2] == want), default=None)
+    if marker is None:
+        raise ValueError(f"{spec}: no map {want} in {path}")
+    got = {}
+    for pos, size, name in lumps[marker + 1:]:
+        if name not in MAP_LUMPS:
+            break
+        if name == "BEHAVIOR":
+            raise ValueError(f"{spec}: Hexen-format map")
+        got.setdefault(name, data[pos:pos + size])
+    for need in ("THINGS", "LINEDEFS", "SIDEDEFS", "VERTEXES", "SECTORS"):
+        if need not in got:
+            raise ValueError(f"{spec}: map has no {need} lump")
+    sec = np.frombuffer(got["SECTORS"], np.dtype([("f", "<i2"), ("c", "<i2"), ("ff", "S8"),
+                                                  ("cf", "S8"), ("light", "<i2"), ("sp", "<i2"),
+                                                  ("tag", "<i2")]))
+    vert = np.frombuffer(got["VERTEXES"], np.dtype([("x", "<i2"), ("y", "<i2")]))
+    lin = np.frombuffer(got["LINEDEFS"], np.dtype([("v1", "<u2"), ("v2", "<u2"), ("fl", "<u2"),
+                                                   ("sp", "<u2"), ("tag", "<u2"), ("s0", "<u2"),
+                                                   ("s1", "<u2")]))
+    side_sec = np.frombuffer(got["SIDEDEFS"], np.dtype([("pad", "V28"), ("sec", "<u2")]))["sec"]
+    thing = np.frombuffer(got["THINGS"], np.dtype([("x", "<i2"), ("y", "<i2"), ("a", "<i2"),
+                                                   ("type", "<u2"), ("fl", "<u2")]))
+    if (lin["v1"] >= len(vert)).any() or (lin["v2"] >= len(vert)).any():
+        raise ValueError(f"{spec}: a linedef's vertex is out of range")
+    if (lin["s0"] == 0xFFFF).any():
+        raise ValueError(f"{spec}: linedef {int(np.argmax(lin['s0'] == 0xFFFF))}: no front sidedef")
+    vx, vy = vert["x"].astype(float), vert["y"].astype(float)
+    x1, y1, x2, y2 = vx[lin["v1"]], vy[lin["v1"]], vx[lin["v2"]], vy[lin["v2"]]
+    keep = (x1 != x2) | (y1 != y2)            # zero-length linedefs are skipped, as in wad.c
+    s0, s1 = lin["s0"].astype(np.int64), lin["s1"].astype(np.int64)
+    if (s0 >= len(side_sec)).any() or ((s1 != 0xFFFF) & (s1 >= len(side_sec))).any():
+        raise ValueError(f"{spec}: a linedef's sidedef is out of range")
+    front = side_sec[s0].astype(np.int64)
+    back = np.where(s1 == 0xFFFF, NONE, side_sec[np.where(s1 == 0xFFFF, 0, s1)].astype(np.int64))
+    if (front >= len(sec)).any() or (back >= len(sec)).any():
+        raise ValueError(f"{spec}: a sidedef's sector is out of range")
+    sky = np.array([_name8(c).startswith("F_SKY") for c in sec["cf"]], bool)
+    player = None
+    starts = np.nonzero(thing["type"] == 1)[0]
+    if len(starts):
+        t = thing[starts[0]]
+        player = (float(t["x"]), float(t["y"]), float(int(t["a"]) % 360))
+    return Map(spec, x1[keep], y1[keep], x2[keep], y2[keep], front[keep], back[keep],
+               sec["f"].astype(float), sec["c"].astype(float), sky, player)
+
+
+_cache = {}
+
+
+def load(spec):
+    """A Map from a scene spec (text scene path or file.wad:MAP), cached by spec."""
+    if isinstance(spec, Map):
+        return spec
+    if spec not in _cache:
+        head, _, tail = spec.rpartition(":")
+        if head.lower().endswith(".wad") and tail:
+            _cache[spec] = read_wad(spec)
+        else:
+            _cache[spec] = read_text(spec)
+    return _cache[spec]
+
+
+# ---- eye sector ---------------------------------------------------------------------------
+
+def sector_at(scene, x, y):
+    """The sector containing (x, y) by even-odd ray crossing (see the header), or None."""
+    m = load(scene)
+    ay, by = m.y1, m.y2
+    crosses = (ay > y) != (by > y)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        xi = m.x1 + (y - ay) * (m.x2 - m.x1) / (by - ay)
+    crosses &= xi > x
+    cnt = np.bincount(m.front[crosses], minlength=m.nsectors)
+    bk = m.back[crosses]
+    cnt += np.bincount(bk[bk >= 0], minlength=m.nsectors)
+    inside = np.nonzero(cnt % 2 == 1)[0]
+    if len(inside) == 0:
+        return None
+    if len(inside) == 1:
+        return int(inside[0])
+    # overlapping sectors: the one facing the point across the nearest crossing line
+    idx = np.nonzero(crosses)[0]
+    for i in idx[np.argsort(xi[idx], kind="stable")]:
+        # the point is on the right (front) of v1 -> v2 when the cross product is negative
+        c = (m.x2[i] - m.x1[i]) * (y - m.y1[i]) - (m.y2[i] - m.y1[i]) * (x - m.x1[i])
+        s = m.front[i] if c < 0 else m.back[i]
+        if s in inside:
+            return int(s)
+    return int(inside[0])
+
+
+eye_sector = sector_at
+
+
+def eye_height(scene, x, y):
+    """The default eye height at (x, y): the floor of its sector + 41, or 41 in none."""
+    s = sector_at(scene, x, y)
+    return EYE_HEIGHT if s is None else float(load(scene).floor[s]) + EYE_HEIGHT
+
+
+# ---- rendering ----------------------------------------------------------------------------
+
+def render_ids(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="near"):
+    """Surface ids of the view from (x, y, z) at angle degrees: numpy uint32 (200, 320).
+
+    z None: the floor of the eye's sector + 41. fx: round the camera to 16.16 first, as
+    build/render does (pass False for the exact values). sky_owner: whose ceiling the sky seen
+    over the missing upper wall between two sky sectors is: "far" (the sector beyond, the
+    default) or "near" (the sector on the eye's side, as Doom's visplanes have it)."""
+    m = load(scene_spec)
+    rnd = fx_round if fx else float
+    x, y, angle = rnd(x), rnd(y), rnd(angle)
+    z = None if z is None else rnd(z)
+    look = int(look)
+    eye_sec = sector_at(m, x, y)
+    if z is None:
+        z = EYE_HEIGHT if eye_sec is None else float(m.floor[eye_sec]) + EYE_HEIGHT
+    a = np.radians(float(angle) % 360.0)
+    fxd, fyd = np.cos(a), np.sin(a)
+    rx, ry = fyd, -fxd
+    xv = (np.arange(W) + 0.5 - W / 2) / FOCAL                 # (320,)
+    yv = (H / 2 + look - (np.arange(H) + 0.5)) / FOCAL        # (200,)
+    dx, dy = fxd + xv * rx, fyd + xv * ry                      # ray directions per column
+
+    # every column against every line: E + t d = A + u w
+    wx, wy = m.x2 - m.x1, m.y2 - m.y1
+    ax, ay = m.x1 - x, m.y1 - y                                # A - E
+    denom = dx[:, None] * wy[None, :] - dy[:, None] * wx[None, :]
+    tnum = ax * wy - ay * wx                                   # (A - E) x w, per line
+    unum = ax[None, :] * dy[:, None] - ay[None, :] * dx[:, None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = tnum[None, :] / denom
+        u = unum / denom
+    hit = (denom != 0) & (u >= 0) & (u <= 1) & (t >= ZNEAR)
+    # side of each line the eye is on: 0 front (right of v1 -> v2), 1 back
+    side = ((wx * (-ay) - wy * (-ax)) >= 0).astype(np.int64)   # cross(w, E - A) >= 0
+    near = np.where(side == 0, m.front, m.back)
+    far = np.where(side == 0, m.back, m.front)
+    wall_id = (KIND_WALL << 24) | (np.arange(m.nlines, dtype=np.int64) * 2 + side)
+
+    fl = np.append(m.floor, np.nan)      # index NONE (-1) -> nan: no floor, no ceiling
+    ce = np.append(m.ceil, np.nan)
+    sk = np.append(m.sky, False)
+    out = np.zeros((H, W), np.uint32)
+    start = NONE if eye_sec is None else eye_sec
+    # the eye exactly on a wall (or vertex): which sector a ray starts in depends on its direction;
+    # take the near-side sector of the first wall it crosses
+    cross = wx * (-ay) - wy * (-ax)
+    along = -(ax * wx + ay * wy)
+    wlen2 = wx * wx + wy * wy
+    on_wall = bool(np.any((np.abs(cross) <= 1e-9 * wlen2) & (along >= 0) & (along <= wlen2)))
+    for px in range(W):
+        li = np.nonzero(hit[px])[0]
+        tk = t[px, li]
+        order = np.argsort(tk, kind="stable")
+        li, tk = li[order], tk[order]
+        k = len(li)
+        nsec, bsec = near[li], far[li]
+        # the walk: sector of interval j (before crossing j; interval k is past the last)
+        cur = np.empty(k + 1, np.int64)
+        cur[0] = nsec[0] if on_wall and k else start
+        cur[1:] = bsec        # after a crossing: the far side's sector (NONE past a one-sided
+                              # wall the ray missed: only with the eye outside the map)
+        t0 = np.concatenate(([ZNEAR], tk))                     # (k+1,)
+        t1 = np.concatenate((tk, [np.inf]))
+        z0 = z + yv[:, None] * t0[None, :]                     # (200, k+1)
+        with np.errstate(invalid="ignore"):
+            z1 = z + yv[:, None] * t1[None, :]
+        z1 = np.where(np.isinf(t1)[None, :], np.sign(yv)[:, None] * np.inf, z1)
+        # crossings
+        zc = z0[:, 1:]                                         # height at each crossing
+        nf, nc, ns = fl[nsec][None, :], ce[nsec][None, :], sk[nsec][None, :]
+        bf, bc, bs = fl[bsec][None, :], ce[bsec][None, :], sk[bsec][None, :]
+        one_sided = (bsec < 0)[None, :]
+        # a wall part is hit where the ray is within its heights (always so for an eye inside
+        # its sector: a ray that left a sector's height range met its floor or ceiling first)
+        mid = one_sided & (zc >= nf) & (zc <= nc)
+        upper = ~(ns & bs) & (bc < nc) & (zc > np.maximum(bc, nf)) & (zc <= nc)
+        lower = (bf > nf) & (zc < np.minimum(bf, nc)) & (zc >= nf)
+        wall_stop = mid | upper | lower                        # no near sector: nan, culled
+        # Doom's sky rule: a ray that goes over the missing upper wall between two sky
+        # ceilings meets sky at once
+        over_sky = ns & bs & (zc > bc) & (zc <= nc) & ~wall_stop
+        sky_id = (KIND_CEIL << 24) | (nsec if sky_owner == "near" else bsec)
+        cf, cc = fl[cur][None, :], ce[cur][None, :]
+        # a plane is seen from its own side only: the ray goes down through the floor or up
+        # through the ceiling inside the interval (so only when the eye is on that side)
+        floor_hit = (z0 >= cf) & (z1 < cf)
+        ceil_hit = (z0 <= cc) & (z1 > cc)
+        plane_stop = floor_hit | ceil_hit                      # nan compares false: none
+        plane_id = np.where(ceil_hit, (KIND_CEIL << 24) | cur[None, :],
+                            (KIND_FLOOR << 24) | cur[None, :])
+        # events in depth order: interval 0, crossing 0, interval 1, ..., interval k
+        ev = np.empty((H, 2 * k + 1), bool)
+        ev[:, 0::2] = plane_stop
+        ev[:, 1::2] = wall_stop | over_sky
+        ids = np.empty((H, 2 * k + 1), np.int64)
+        ids[:, 0::2] = plane_id
+        ids[:, 1::2] = np.where(over_sky, sky_id[None, :], wall_id[li][None, :])
+        first = np.argmax(ev, axis=1)
+        col = ids[np.arange(H), first]
+        col[~ev[np.arange(H), first]] = 0
+        out[:, px] = col.astype(np.uint32)
+    return out
+
+
+# ---- output -------------------------------------------------------------------------------
+
+def write_ids(path, ids):
+    np.ascontiguousarray(ids, dtype="<u4").tofile(path)
+
+
+def read_ids(path):
+    a = np.fromfile(path, dtype="<u4")
+    if a.size != W * H:
+        raise ValueError(f"{path}: {a.size * 4} bytes, expected {W * H * 4} (320x200 uint32)")
+    return a.reshape(H, W).astype(np.uint32)
+
+
+def false_colour(ids):
+    """RGB (200, 320, 3) uint8: black for nothing, walls bright, floors dark, ceilings mid;
+    the hue is a hash of the id, so neighbouring surfaces differ."""
+    ids = ids.astype(np.uint64)
+    h = (ids * np.uint64(2654435761)) & np.uint64(0xFFFFFFFF)
+    h ^= h >> np.uint64(15)
+    rgb = np.stack([(h >> np.uint64(s)) & np.uint64(0xFF) for s in (0, 8, 16)], -1).astype(float)
+    kind = (ids >> np.uint64(24)).astype(np.int64)
+    lo = np.array([0, 96, 16, 56, 96])[np.clip(kind, 0, 4)][..., None]
+    hi = np.array([0, 255, 120, 180, 255])[np.clip(kind, 0, 4)][..., None]
+    return (lo + rgb * (hi - lo) / 255.0).astype(np.uint8)
+
+
+def write_png_rgb(path, rgb):
+    """An 8-bit RGB PNG with zlib and struct only."""
+    h, w, _ = rgb.shape
+    raw = b"".join(b"\0" + rgb[y].tobytes() for y in range(h))
+
+    def chunk(kind, body):
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+
+    png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
+           + chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
+    with open(path, "wb") as fh:
+        fh.write(png)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(
+        prog="refrender.py",
+        description="Reference renderer: ray-cast surface ids of a source map (no BSP tree), "
+                    "320x200 little-endian uint32, kind << 24 | index.")
+    ap.add_argument("scene", help="text scene, or FILE.wad:MAP01 / FILE.wad:E1M1")
+    ap.add_argument("--at", help="X,Y[,Z] eye position (default: the player start; Z: the "
+                                 "floor of the eye's sector + 41)")
+    ap.add_argument("--angle", help="degrees, 0 = east, counter-clockwise "
+                                               "(default: the player start's)")
+    ap.add_argument("--look", type=int, default=0, help="vertical shear in pixels, -100..100")
+    ap.add_argument("--ids", required=True, help="output id buffer")
+    ap.add_argument("--png", help="also write a false-colour PNG of the ids")
+    ap.add_argument("--sky-owner", choices=("far", "near"), default="near",
+                    help="sky seen over the missing upper wall between two sky sectors: the "
+                         "ceiling of the eye's side (near, default) or of the sector beyond (far)")
+    argv = list(sys.argv[1:] if argv is None else argv)
+    for i in range(len(argv) - 1):     # let "--at -192,-160" through argparse
+        if argv[i] in ("--at", "--angle", "--look") and argv[i + 1].startswith("-"):
+            argv[i:i + 2] = [argv[i] + "=" + argv[i + 1], ""]
+    a = ap.parse_args([v for v in argv if v != ""])
+    try:
+        m = load(a.scene)
+        px, py, pa = m.player if m.player else (0.0, 0.0, 0.0)
+        z = None
+        if a.at:
+            parts = a.at.split(",")
+            if len(parts) not in (2, 3):
+                ap.error("--at: expected X,Y or X,Y,Z")
+            px, py = parts[0], parts[1]            # strings: rounded to 16.16 exactly
+            z = parts[2] if len(parts) == 3 else None
+        if a.angle is not None:
+            pa = a.angle
+        if not -100 <= a.look <= 100:
+            ap.error("--look: expected -100..100")
+        ids = render_ids(m, px, py, z, pa, a.look, sky_owner=a.sky_owner)
+        write_ids(a.ids, ids)
+        if a.png:
+            write_png_rgb(a.png, false_colour(ids))
+    except (OSError, ValueError) as e:
+        print(f"refrender: {e}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
