@@ -120,14 +120,7 @@ void hal_fill_span(const hal_surface *s, int y, int x, int len, uint8_t colour)
         n8++;
     }
 
-    int dest = s->in_vram ? HAL_DEST_VRAM : HAL_DEST_SYSMEM;
-    if (n8)
-        hal_perf_add_writes(1, dest, n8, 0);
-    if (n16)
-        hal_perf_add_writes(2, dest, n16, 0);
-    if (n32)
-        hal_perf_add_writes(4, dest, n32, 0);
-    hal_perf_add_pixels((uint32_t)len);
+    hal_perf_add_span(s->in_vram ? HAL_DEST_VRAM : HAL_DEST_SYSMEM, n8, n16, n32, (uint32_t)len);
 }
 
 /* The copies: the system-memory buffer and the pages are 4-aligned and

@@ -117,6 +117,24 @@ void hal_perf_add_writes(unsigned width_bytes, int dest, uint32_t count, int is_
         perf.total[HAL_EV_COPY_WRITES] += n;
 }
 
+void hal_perf_add_span(int dest, uint32_t n8, uint32_t n16, uint32_t n32, uint32_t pixels)
+{
+    uint64_t n = (uint64_t)n8 + n16 + n32;
+    perf.total[HAL_EV_WRITES] += n;
+    perf.total[HAL_EV_BYTES] += pixels;
+    perf.total[HAL_EV_WRITES8] += n8;
+    perf.total[HAL_EV_WRITES16] += n16;
+    perf.total[HAL_EV_WRITES32] += n32;
+    perf.total[HAL_EV_PIXELS] += pixels;
+    if (dest == HAL_DEST_VRAM) {
+        perf.total[HAL_EV_VRAM_WRITES] += n;
+        perf.tsc += n * perf.bus.vram_cycles;
+    } else {
+        perf.total[HAL_EV_SYSMEM_WRITES] += n;
+        perf.tsc += n * perf.bus.sysmem_cycles;
+    }
+}
+
 void hal_perf_add_pixels(uint32_t count)
 {
     perf.total[HAL_EV_PIXELS] += count;
