@@ -374,7 +374,7 @@ typedef struct {
     gpt p, q;        /* the path */
     int64_t z;       /* floor stood on at the start of the sub-step */
     int blocked;     /* some wall blocks the path */
-    int stuck;       /* p already overlaps a blocking wall */
+    int stuck;       /* a blocking wall that p already overlaps holds the move */
     int touched;     /* fmax, cmin hold something */
     int64_t fmax, cmin; /* over the sectors touched at q */
 } path_ck;
@@ -416,8 +416,7 @@ static void check_seg(void *ctx, uint32_t si)
         if (sweep_near(c->p, c->q, a, b, m->r, m->r2)) c->blocked = 1;
         return;
     }
-    c->stuck = 1;
-    if (escape_blocked(c->p, c->q, a, b, ln->sector[1] == SCN_NONE)) c->blocked = 1;
+    if (escape_blocked(c->p, c->q, a, b, ln->sector[1] == SCN_NONE)) c->blocked = c->stuck = 1;
 }
 
 /* Is the path p -> q (16.16) clear for a body that stood on floor z at the start
@@ -647,6 +646,7 @@ static int sight_leaf(void *vctx, uint32_t leaf)
         if (ln->sector[1] == SCN_NONE) return 1;
         const scn_sector *f = &s->sectors[ln->sector[0]], *k = &s->sectors[ln->sector[1]];
         int64_t lo = max64(f->floor_h, k->floor_h), hi = min64(f->ceil_h, k->ceil_h);
+        if (hi <= lo) return 1; /* closed (a shut door): nothing passes, not even on the edge */
         int64_t o1 = orient(a, b, c->p), o2 = orient(a, b, c->q);
         if (o1 != o2) { /* crosses at t = o1 / (o1 - o2), in [0, 1] */
             int64_t num = o1, den = o1 - o2;

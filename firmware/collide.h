@@ -38,7 +38,7 @@ col_body col_player(void);
 
 /* col_move result bits */
 #define COL_BLOCKED 1u /* some part of the move was stopped or turned into a slide */
-#define COL_STUCK 2u   /* the start position already overlapped a blocking wall */
+#define COL_STUCK 2u   /* a blocking wall the body already overlapped at the start held part of it */
 
 /* Move the body at (*x, *y) by (dx, dy) (16.16; any values: the move is clamped
  * to +-2^33 raw and every position to +-SCN_COORD_MAX units), colliding with the
@@ -50,7 +50,8 @@ col_body col_player(void);
  * ceiling - higher floor) is lower than height, or the lower ceiling is less than
  * height above z. The body may not come nearer than radius to a blocking wall;
  * where it overlaps several sectors, the lowest ceiling must still be height
- * above the highest floor.
+ * above the highest floor. Since z is fixed for a sub-step, a sub-step climbs at
+ * most one step (as each P_TryMove does in Doom).
  *
  * The move is cut into sub-steps no longer than min(radius, 16 units); each
  * sub-step is clear only if the whole straight path of the circle keeps its
@@ -68,7 +69,13 @@ col_body col_player(void);
  * *floor_z (may be NULL) receives the floor the body stands on afterwards: the
  * highest floor of every sector its circle overlaps, which is the floor of the
  * leaf under the centre unless the circle overhangs a higher floor. body may be
- * NULL for col_player(). Returns COL_* bits. */
+ * NULL for col_player(); the value *floor_z holds on entry is kept only when the
+ * body is over no sector at all. Returns COL_* bits.
+ *
+ * Cost: a box walk of the tree and one pass over the candidate segs per
+ * sub-step, about 15 passes when a sub-step is blocked (the cut to 1/4096 and
+ * the slide). Stack: under 3 KB on a Cortex-M3 (gcc -fstack-usage: 128
+ * candidate seg indices, a tree-walk stack of SCN_MAX_DEPTH + 2 entries). */
 uint32_t col_move(const scene *s, const col_body *body, fx_t *x, fx_t *y, fx_t *floor_z, int64_t dx,
                   int64_t dy);
 
@@ -80,8 +87,9 @@ int col_floor_at(const scene *s, fx_t x, fx_t y, fx_t *floor);
  * one-sided wall it touches blocks (its end points included: grazing a corner
  * blocks); a two-sided wall blocks where the segment's height as it crosses is
  * above the lower ceiling or below the higher floor of the wall's two sectors
- * (a height exactly on the edge of the opening passes). Exact on the 1/4096
- * grid; x, y any fx_t (clamped to the world), z any fx_t. */
+ * (a height exactly on the edge of the opening passes; a closed opening,
+ * ceiling <= floor, blocks at every height). Exact on the 1/4096 grid; x, y any
+ * fx_t (clamped to the world), z any fx_t. */
 int col_line_of_sight(const scene *s, fx_t x1, fx_t y1, fx_t z1, fx_t x2, fx_t y2, fx_t z2);
 
 #endif
