@@ -2,7 +2,8 @@
  * Each edge is walked top to bottom with an integer DDA (whole step plus a
  * remainder against the edge's height), so x at every scan line is exactly
  * floor(true x) in 16.16: no error accumulates however long the edge is, and
- * two polygons sharing an edge compute the same x on every line. */
+ * two polygons sharing an edge compute the same x on every line, whichever
+ * renderer walks it. */
 #include "raster.h"
 
 void rast_span(const rast_target *t, int y, int x0, int x1, uint8_t colour, uint32_t id)
@@ -15,13 +16,6 @@ void rast_span(const rast_target *t, int y, int x0, int x1, uint8_t colour, uint
     }
 }
 
-/* Pixel index of the first sample at or right of (or below) a 16.16 coordinate:
- * ceil(v - 0.5). v is never negative here. */
-static inline int32_t first_sample(int32_t v)
-{
-    return (v + 32767) >> 16;
-}
-
 /* Floor division for a positive divisor. */
 static inline int64_t floor_div(int64_t a, int64_t b)
 {
@@ -29,29 +23,33 @@ static inline int64_t floor_div(int64_t a, int64_t b)
     return (a % b < 0) ? q - 1 : q;
 }
 
+int rast_edge_setup(rast_edge *e, int32_t xa, int32_t ya, int32_t xb, int32_t yb)
+{
+    int32_t row = rast_first_sample(ya), end = rast_first_sample(yb);
+    if (row < 0 || end > VIEW_H) return 0; /* outside the contract: draw nothing */
+    if (row >= end) return 0;
+    /* |dx| < 2^25 and the first sample is under one row below ya: the products
+     * stay below 2^42 */
+    int64_t dx = (int64_t)xb - xa, dy = (int64_t)yb - ya;
+    int64_t num = (((int64_t)row << 16) + 32768 - ya) * dx;
+    int64_t x = floor_div(num, dy);
+    int64_t step = floor_div(dx * 65536, dy);
+    e->x = (int32_t)(xa + x);
+    e->rem = (int32_t)(num - x * dy); /* in [0, dy) */
+    e->step = (int32_t)step;
+    e->srem = (int32_t)(dx * 65536 - step * dy);
+    e->dy = (int32_t)dy;
+    e->row = (int16_t)row;
+    e->end_row = (int16_t)end;
+    return 1;
+}
+
 /* Record x at every sample row of edge (xa,ya)->(xb,yb), ya < yb, into xs[]. */
 static void walk_edge(int32_t *xs, int32_t xa, int32_t ya, int32_t xb, int32_t yb)
 {
-    int32_t row = first_sample(ya), end = first_sample(yb);
-    if (row < 0 || end > VIEW_H) return; /* outside the contract: draw nothing */
-    if (row >= end) return;
-    int64_t dx = (int64_t)xb - xa, dy = (int64_t)yb - ya;
-    int64_t yc = ((int64_t)row << 16) + 32768;
-    int64_t num = (yc - ya) * dx;          /* < 2^16 * 2^25 */
-    int64_t x = floor_div(num, dy);
-    int64_t rem = num - x * dy;            /* in [0, dy) */
-    int64_t step = floor_div(dx * 65536, dy);
-    int64_t srem = dx * 65536 - step * dy; /* in [0, dy) */
-    int64_t cur = xa + x;
-    for (; row < end; row++) {
-        xs[row] = (int32_t)cur;
-        cur += step;
-        rem += srem;
-        if (rem >= dy) {
-            rem -= dy;
-            cur++;
-        }
-    }
+    rast_edge e;
+    if (!rast_edge_setup(&e, xa, ya, xb, yb)) return;
+    for (; e.row < e.end_row; rast_edge_step(&e)) xs[e.row] = e.x;
 }
 
 uint32_t rast_convex(const rast_target *t, const screen_pt *pts, int n, uint8_t colour, uint32_t id)
@@ -63,7 +61,7 @@ uint32_t rast_convex(const rast_target *t, const screen_pt *pts, int n, uint8_t 
         if (pts[i].y < ymin) ymin = pts[i].y;
         if (pts[i].y > ymax) ymax = pts[i].y;
     }
-    int32_t top = first_sample(ymin), bottom = first_sample(ymax);
+    int32_t top = rast_first_sample(ymin), bottom = rast_first_sample(ymax);
     if (top < 0) top = 0;
     if (bottom > VIEW_H) bottom = VIEW_H;
     if (top >= bottom) return 0;
@@ -78,7 +76,7 @@ uint32_t rast_convex(const rast_target *t, const screen_pt *pts, int n, uint8_t 
     }
     uint32_t drawn = 0;
     for (int32_t y = top; y < bottom; y++) {
-        int32_t x0 = first_sample(left[y]), x1 = first_sample(right[y]);
+        int32_t x0 = rast_first_sample(left[y]), x1 = rast_first_sample(right[y]);
         if (x0 < 0) x0 = 0;
         if (x1 > VIEW_W) x1 = VIEW_W;
         if (x1 > x0) {

@@ -9,11 +9,8 @@
 #define BACKGROUND_COLOUR 0
 
 typedef struct sp_edge {
-    int32_t x;                 /* 16.16 at the current row's sample centre */
-    int32_t step, rem, srem, dy; /* exact DDA: x += step, rem += srem, carry at dy */
-    int16_t end_row;           /* first row not covered */
+    rast_edge d;               /* the DDA the fill rule is defined by (raster.h) */
     uint8_t leading;           /* left edge of its polygon: the surface starts here */
-    uint8_t pad;
     struct sp_surf *surf;
     struct sp_edge *next;
 } sp_edge;
@@ -143,50 +140,10 @@ static void cover(span_state *S, int y, int x0, int x1)
 
 /* ---- edges ---------------------------------------------------------------- */
 
-static inline int32_t first_sample(int32_t v)
-{
-    return (v + 32767) >> 16;
-}
-
-static inline int64_t floor_div(int64_t a, int64_t b)
-{
-    int64_t q = a / b;
-    return (a % b < 0) ? q - 1 : q;
-}
-
-/* Set up the exact DDA of edge (xa,ya)->(xb,yb), ya < yb (as raster.c walks it).
- * Returns the first row, or -1 if the edge covers no sample row. */
-static int edge_setup(sp_edge *e, int32_t xa, int32_t ya, int32_t xb, int32_t yb)
-{
-    int32_t row = first_sample(ya), end = first_sample(yb);
-    if (row >= end || row < 0 || end > VIEW_H) return -1;
-    int64_t dx = (int64_t)xb - xa, dy = (int64_t)yb - ya;
-    int64_t num = (((int64_t)row << 16) + 32768 - ya) * dx;
-    int64_t x = floor_div(num, dy);
-    int64_t step = floor_div(dx * 65536, dy);
-    e->x = (int32_t)(xa + x);
-    e->rem = (int32_t)(num - x * dy);
-    e->step = (int32_t)step;
-    e->srem = (int32_t)(dx * 65536 - step * dy);
-    e->dy = (int32_t)dy;
-    e->end_row = (int16_t)end;
-    return row;
-}
-
-static inline void edge_advance(sp_edge *e)
-{
-    e->x += e->step;
-    e->rem += e->srem;
-    if (e->rem >= e->dy) {
-        e->rem -= e->dy;
-        e->x++;
-    }
-}
-
 /* Insert into a list kept sorted by x. */
 static void insert_sorted(sp_edge **list, sp_edge *e)
 {
-    while (*list && (*list)->x < e->x) list = &(*list)->next;
+    while (*list && (*list)->d.x < e->d.x) list = &(*list)->next;
     e->next = *list;
     *list = e;
 }
@@ -200,7 +157,7 @@ static int polygon_rows(const screen_pt *pts, int n, int16_t *top_out, int16_t l
         if (pts[i].y < ymin) ymin = pts[i].y;
         if (pts[i].y > ymax) ymax = pts[i].y;
     }
-    int top = first_sample(ymin), bottom = first_sample(ymax);
+    int top = rast_first_sample(ymin), bottom = rast_first_sample(ymax);
     if (top < 0) top = 0;
     if (bottom > VIEW_H) bottom = VIEW_H;
     for (int y = top; y < bottom; y++) {
@@ -211,16 +168,15 @@ static int polygon_rows(const screen_pt *pts, int n, int16_t *top_out, int16_t l
         screen_pt a = pts[i], b = pts[(i + 1 == n) ? 0 : i + 1];
         if (a.y == b.y) continue;
         int leading = a.y > b.y;
-        sp_edge e;
-        int row = leading ? edge_setup(&e, b.x, b.y, a.x, a.y) : edge_setup(&e, a.x, a.y, b.x, b.y);
-        if (row < 0) continue;
-        for (; row < e.end_row; row++) {
-            int col = first_sample(e.x);
+        rast_edge e;
+        if (!(leading ? rast_edge_setup(&e, b.x, b.y, a.x, a.y) : rast_edge_setup(&e, a.x, a.y, b.x, b.y)))
+            continue;
+        for (; e.row < e.end_row; rast_edge_step(&e)) {
+            int col = rast_first_sample(e.x);
             if (col < 0) col = 0;
             if (col > VIEW_W) col = VIEW_W;
-            if (leading) lo[row] = (int16_t)col;
-            else hi[row] = (int16_t)col;
-            edge_advance(&e);
+            if (leading) lo[e.row] = (int16_t)col;
+            else hi[e.row] = (int16_t)col;
         }
     }
     *top_out = (int16_t)top;
@@ -238,8 +194,8 @@ static int box_covered(const span_state *S, const screen_pt *pts, int n)
         if (pts[i].y < ymin) ymin = pts[i].y;
         if (pts[i].y > ymax) ymax = pts[i].y;
     }
-    int x0 = first_sample(xmin), x1 = first_sample(xmax);
-    int y0 = first_sample(ymin), y1 = first_sample(ymax);
+    int x0 = rast_first_sample(xmin), x1 = rast_first_sample(xmax);
+    int y0 = rast_first_sample(ymin), y1 = rast_first_sample(ymax);
     if (y1 > VIEW_H) y1 = VIEW_H;
     for (int y = y0 < 0 ? 0 : y0; y < y1; y++)
         if (!covered(&S->cover[y], x0, x1)) return 0;
@@ -275,12 +231,12 @@ static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, 
         if (a.y == b.y) continue;
         sp_edge *e = &S->edges[S->nedges];
         int leading = a.y > b.y; /* going up the screen: a left edge (raster.c) */
-        int row = leading ? edge_setup(e, b.x, b.y, a.x, a.y) : edge_setup(e, a.x, a.y, b.x, b.y);
-        if (row < 0) continue;
+        if (!(leading ? rast_edge_setup(&e->d, b.x, b.y, a.x, a.y) : rast_edge_setup(&e->d, a.x, a.y, b.x, b.y)))
+            continue;
         e->leading = (uint8_t)leading;
         e->surf = s;
         S->nedges++;
-        insert_sorted(&S->new_edges[row], e);
+        insert_sorted(&S->new_edges[e->d.row], e);
     }
     for (int y = top; y < top + rows; y++) cover(S, y, lo[y], hi[y]);
 }
@@ -331,7 +287,7 @@ static void scan_line(span_state *S, sp_edge *active, int y)
     sp_surf *top = &S->background;
     int cur = 0;
     for (sp_edge *e = active; e; e = e->next) {
-        int col = first_sample(e->x);
+        int col = rast_first_sample(e->d.x);
         if (col < 0) col = 0;
         if (col > VIEW_W) col = VIEW_W;
         sp_surf *s = e->surf;
@@ -382,7 +338,7 @@ static void scan(span_state *S)
         sp_edge **link = &active;
         sp_edge *n = S->new_edges[y];
         while (n) {
-            while (*link && (*link)->x < n->x) link = &(*link)->next;
+            while (*link && (*link)->d.x < n->d.x) link = &(*link)->next;
             sp_edge *next = n->next;
             n->next = *link;
             *link = n;
@@ -396,12 +352,12 @@ static void scan(span_state *S)
         sp_edge **link2 = &active, *prev = 0;
         while (*link2) {
             sp_edge *e = *link2;
-            if (e->end_row <= y + 1) {
+            if (e->d.end_row <= y + 1) {
                 *link2 = e->next;
                 continue;
             }
-            edge_advance(e);
-            if (prev && e->x < prev->x) {
+            rast_edge_step(&e->d);
+            if (prev && e->d.x < prev->d.x) {
                 *link2 = e->next;
                 insert_sorted(&active, e);
                 continue;

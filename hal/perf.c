@@ -93,6 +93,18 @@ uint64_t hal_perf_tsc(void)
     return perf.tsc;
 }
 
+/* n transactions landing in VRAM or system memory, and their modelled cycles. */
+static void count_destination(int dest, uint64_t n)
+{
+    if (dest == HAL_DEST_VRAM) {
+        perf.total[HAL_EV_VRAM_WRITES] += n;
+        perf.tsc += n * perf.bus.vram_cycles;
+    } else {
+        perf.total[HAL_EV_SYSMEM_WRITES] += n;
+        perf.tsc += n * perf.bus.sysmem_cycles;
+    }
+}
+
 void hal_perf_add_writes(unsigned width_bytes, int dest, uint32_t count, int is_copy)
 {
     hal_event by_width;
@@ -106,13 +118,7 @@ void hal_perf_add_writes(unsigned width_bytes, int dest, uint32_t count, int is_
     perf.total[HAL_EV_WRITES] += n;
     perf.total[HAL_EV_BYTES] += n * width_bytes;
     perf.total[by_width] += n;
-    if (dest == HAL_DEST_VRAM) {
-        perf.total[HAL_EV_VRAM_WRITES] += n;
-        perf.tsc += n * perf.bus.vram_cycles;
-    } else {
-        perf.total[HAL_EV_SYSMEM_WRITES] += n;
-        perf.tsc += n * perf.bus.sysmem_cycles;
-    }
+    count_destination(dest, n);
     if (is_copy)
         perf.total[HAL_EV_COPY_WRITES] += n;
 }
@@ -126,13 +132,7 @@ void hal_perf_add_span(int dest, uint32_t n8, uint32_t n16, uint32_t n32, uint32
     perf.total[HAL_EV_WRITES16] += n16;
     perf.total[HAL_EV_WRITES32] += n32;
     perf.total[HAL_EV_PIXELS] += pixels;
-    if (dest == HAL_DEST_VRAM) {
-        perf.total[HAL_EV_VRAM_WRITES] += n;
-        perf.tsc += n * perf.bus.vram_cycles;
-    } else {
-        perf.total[HAL_EV_SYSMEM_WRITES] += n;
-        perf.tsc += n * perf.bus.sysmem_cycles;
-    }
+    count_destination(dest, n);
 }
 
 void hal_perf_add_pixels(uint32_t count)
