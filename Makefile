@@ -26,7 +26,15 @@ NULL_SRC  := hal/ram_target.c hal/null/hal_null.c
 SDL_SRC   := hal/ram_target.c hal/sdl/hal_sdl.c
 BSPC_LIB  := $(filter-out tools/bspc/main.c,$(sort $(wildcard tools/bspc/*.c)))
 HOST_LIB  := host/png.c host/scene_file.c
-FLOATFREE := firmware/% hal/fb.c hal/perf.c hal/ram_target.c hal/null/% $(GEN)/%
+FLOATFREE := firmware/% hal/fb.c hal/perf.c hal/ram_target.c hal/null/% hal/serial/% hal/mps2/% $(GEN)/%
+
+# Each subsystem with rules of its own keeps them in mk/NAME.mk. They may add
+# sources to LINK_SRC (the frame link, linked into host programs and unit tests),
+# UNIT_EXTRA (more sources for the unit tests) and EXTRA_NOFLOAT_SRC.
+LINK_SRC   :=
+UNIT_EXTRA :=
+EXTRA_NOFLOAT_SRC :=
+-include $(sort $(wildcard mk/*.mk))
 
 objs = $(patsubst %.c,$(1)/%.o,$(2))
 fwflags = $(if $(filter $(FLOATFREE),$(1)),$(FW_FLAGS))
@@ -46,7 +54,7 @@ $(1)/render: $(call objs,$(1)/obj,host/render.c $(HOST_LIB) $(BSPC_LIB) $(FW_SRC
 	$$(CC) $(2) $$^ -o $$@ -lm
 $(1)/emu: $(call objs,$(1)/obj,host/emu.c $(GEN)/default_scene.c $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(SDL_SRC))
 	$$(CC) $(2) $$^ -o $$@ $$(SDL_LIBS) -lm
-$(1)/test_%: $(call objs,$(1)/obj,tests/unit/test_%.c) $(call objs,$(1)/obj,$(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC))
+$(1)/test_%: $(call objs,$(1)/obj,tests/unit/test_%.c) $(call objs,$(1)/obj,$(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC) $(LINK_SRC) $(UNIT_EXTRA))
 	$$(CC) $(2) $$^ -o $$@ -lcmocka -lm
 endef
 $(eval $(call variant,$(BUILD),$(REL)))
@@ -95,7 +103,7 @@ run: deps all
 # No floating point in firmware/ and hal/ targets, three ways: no float/double token
 # in the code (comments stripped), the host compile with -mgeneral-regs-only above,
 # and a Cortex-M soft-float compile whose objects may not need any float helper.
-NOFLOAT_SRC := $(sort $(FW_SRC) $(HAL_SRC) $(NULL_SRC) $(SDL_SRC)) $(EXTRA_NOFLOAT)
+NOFLOAT_SRC := $(sort $(FW_SRC) $(HAL_SRC) $(NULL_SRC) $(SDL_SRC) $(LINK_SRC) $(EXTRA_NOFLOAT_SRC)) $(EXTRA_NOFLOAT)
 nofloat: $(GEN)/fx_tables.c
 	@tools/check_nofloat.sh $(NOFLOAT_SRC)
 

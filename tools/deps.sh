@@ -10,7 +10,10 @@ PACKAGES=(
   gcc make libc6-dev          # host build
   libsdl2-dev                 # hal/sdl: the host window
   libcmocka-dev               # C unit tests
-  gcc-arm-none-eabi           # Cortex-M soft-float build (no-float check)
+  gcc-arm-none-eabi           # Cortex-M build (firmware, no-float check)
+  qemu-system-arm             # the Cortex-M3 board (mps2-an385) the firmware runs on in tests
+  libglib2.0-dev pkg-config   # building the QEMU instruction-counting plugin
+  libusb-1.0-0-dev            # host/flash: USB DFU
   freedoom                    # real maps: freedoom1.wad, freedoom2.wad
   zdbsp glbsp                 # other BSP compilers, for make bench-bsp
   valgrind                    # instruction counts
