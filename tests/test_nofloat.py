@@ -25,16 +25,13 @@ def test_tree_is_clean():
     "int probe(int a) { double x = a; (void)x; return a; }\n",
 ])
 def test_float_in_a_file_fails(tmp_path, src, snippet):
-    # A copy of a real file with a float added, checked beside the tree (the copy
-    # keeps its folder so the include paths are those of the original).
-    copy = ROOT / src.replace(".c", "_floatprobe.c")
+    # A copy of a real file with a float added, checked with the tree's include
+    # paths; it lives outside the tree so no concurrent build picks it up.
+    copy = tmp_path / src.replace("/", "_").replace(".c", "_floatprobe.c")
     shutil.copy(ROOT / src, copy)
-    try:
-        with open(copy, "a") as f:
-            f.write(snippet)
-        proc = nofloat(str(copy.relative_to(ROOT)))
-    finally:
-        copy.unlink()
+    with open(copy, "a") as f:
+        f.write(snippet)
+    proc = nofloat(str(copy))
     assert proc.returncode != 0
     assert "floating point" in proc.stdout
 
@@ -50,11 +47,8 @@ def test_host_flags_reject_float_arithmetic(tmp_path):
 
 def test_arm_link_check_catches_soft_float_helpers(tmp_path):
     # float arithmetic hidden behind a macro still shows up as an __aeabi_ helper
-    src = ROOT / "firmware" / "zz_floatprobe.c"
+    src = tmp_path / "zz_floatprobe.c"
     src.write_text("#define REAL float\nint probe(int a) { REAL x = (REAL)a; return (int)(x * 3); }\n")
-    try:
-        proc = nofloat(str(src.relative_to(ROOT)))
-    finally:
-        src.unlink()
+    proc = nofloat(str(src))
     assert proc.returncode != 0
     assert "__aeabi_" in proc.stdout or "floating point" in proc.stdout
