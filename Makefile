@@ -11,7 +11,7 @@ SDL_CFLAGS := $(shell sdl2-config --cflags 2>/dev/null)
 SDL_LIBS   := $(shell sdl2-config --libs 2>/dev/null)
 
 WARN     := -Wall -Wextra -Wshadow -Wstrict-prototypes -Wno-missing-field-initializers
-INC      := -Ifirmware -Ihal -Ihal/null -Ihal/sdl -Itools/bspc -Ihost
+INC      := -Ifirmware -Ihal -Ihal/null -Ihal/sdl -Ihal/serial -Itools/bspc -Ihost
 # Firmware and HAL: freestanding, integer-only (any float or double is an error on
 # the host: -mgeneral-regs-only), no libc calls synthesised from loops.
 FW_FLAGS := -ffreestanding -mgeneral-regs-only -fno-strict-aliasing -fno-tree-loop-distribute-patterns
@@ -31,7 +31,7 @@ FLOATFREE := firmware/% hal/fb.c hal/perf.c hal/ram_target.c hal/null/% hal/seri
 # Each subsystem with rules of its own keeps them in mk/NAME.mk. They may add
 # sources to LINK_SRC (the frame link, linked into host programs and unit tests),
 # UNIT_EXTRA (more sources for the unit tests) and EXTRA_NOFLOAT_SRC.
-LINK_SRC   :=
+LINK_SRC   := $(wildcard hal/serial/*.c)
 UNIT_EXTRA :=
 EXTRA_NOFLOAT_SRC :=
 -include $(sort $(wildcard mk/*.mk))
@@ -43,7 +43,7 @@ fwflags = $(if $(filter $(FLOATFREE),$(1)),$(FW_FLAGS))
 define variant
 $(1)/obj/%.o: %.c $(GEN)/fx_tables.c
 	@mkdir -p $$(@D)
-	$$(CC) $$(BASE) $(2) $$(call fwflags,$$<) $$(if $$(filter hal/sdl/% host/emu.c,$$<),$$(SDL_CFLAGS)) -MMD -MP -c $$< -o $$@
+	$$(CC) $$(BASE) $(2) $$(call fwflags,$$<) $$(if $$(filter hal/sdl/% host/emu.c host/display.c,$$<),$$(SDL_CFLAGS)) -MMD -MP -c $$< -o $$@
 $(1)/obj/$(GEN)/%.o: $(GEN)/%.c
 	@mkdir -p $$(@D)
 	$$(CC) $$(BASE) $(2) $$(FW_FLAGS) -c $$< -o $$@
@@ -54,7 +54,9 @@ $(1)/render: $(call objs,$(1)/obj,host/render.c $(HOST_LIB) $(BSPC_LIB) $(FW_SRC
 	$$(CC) $(2) $$^ -o $$@ -lm
 $(1)/emu: $(call objs,$(1)/obj,host/emu.c $(GEN)/default_scene.c $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(SDL_SRC))
 	$$(CC) $(2) $$^ -o $$@ $$(SDL_LIBS) -lm
-$(1)/test_%: $(call objs,$(1)/obj,tests/unit/test_%.c) $(call objs,$(1)/obj,$(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC) $(LINK_SRC) $(UNIT_EXTRA))
+$(1)/display: $(call objs,$(1)/obj,host/display.c host/png.c firmware/crc32.c $(HAL_SRC) $(SDL_SRC) $(sort $(LINK_SRC)))
+	$$(CC) $(2) $$^ -o $$@ $$(SDL_LIBS)
+$(1)/test_%: $(call objs,$(1)/obj,tests/unit/test_%.c) $(call objs,$(1)/obj,$(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC) $(sort $(LINK_SRC) $(UNIT_EXTRA)))
 	$$(CC) $(2) $$^ -o $$@ -lcmocka -lm
 endef
 $(eval $(call variant,$(BUILD),$(REL)))
@@ -103,7 +105,7 @@ run: deps all
 # No floating point in firmware/ and hal/ targets, three ways: no float/double token
 # in the code (comments stripped), the host compile with -mgeneral-regs-only above,
 # and a Cortex-M soft-float compile whose objects may not need any float helper.
-NOFLOAT_SRC := $(sort $(FW_SRC) $(HAL_SRC) $(NULL_SRC) $(SDL_SRC) $(LINK_SRC) $(EXTRA_NOFLOAT_SRC)) $(EXTRA_NOFLOAT)
+NOFLOAT_SRC = $(sort $(FW_SRC) $(HAL_SRC) $(NULL_SRC) $(SDL_SRC) $(LINK_SRC) $(EXTRA_NOFLOAT_SRC)) $(EXTRA_NOFLOAT)
 nofloat: $(GEN)/fx_tables.c
 	@tools/check_nofloat.sh $(NOFLOAT_SRC)
 

@@ -1,0 +1,48 @@
+/* args.h - run-time options of the firmware (prefix args_), read from the
+ * semihosting command line (QEMU: -append "OPTIONS", or -semihosting-config
+ * ...,arg=firmware,arg=OPT,...). The first word is the program's name and is
+ * skipped. Options (same spelling and rounding as build/render):
+ *
+ *   --frames N          render N frames (default: the camera path's length)
+ *   --path NAME         the camera path: default or map01 (default: the build's)
+ *   --at X,Y[,Z]        a fixed view instead of a path: the eye at X,Y (decimals
+ *                       rounded to 16.16, ties away from zero); Z absolute, or by
+ *                       default the floor under the eye + 41. Each frame is then
+ *                       rendered from the same camera (eng_render, no movement).
+ *   --angle DEG         the fixed view's angle (default: the player start's)
+ *   --look PX           the fixed view's vertical look, pixels
+ *   --mode spans|painter, --present flip|copy8|copy16|copy32
+ *   --no-stream         render without sending frames (for instruction counts)
+ *   --acks auto|on|off  frame-link flow control (stream.h; default auto)
+ *   --no-tick           stop the SysTick (no tick interrupts: instruction counts
+ *                       of identical frames are then identical; hal_ticks_ms stays 0;
+ *                       frame-link flow control is off, as its timeout needs the tick)
+ *   --fault             (tests) execute an undefined instruction after start-up,
+ *                       to show the fault handler's report and exit status
+ */
+#ifndef MPS2_ARGS_H
+#define MPS2_ARGS_H
+
+#include <stdint.h>
+
+typedef struct {
+    int32_t frames;             /* -1: the path's length */
+    int32_t linger_ms;          /* wait this long after the last frame before exiting (0) */
+    const char *path;           /* NULL: the build's */
+    int have_at, have_z, have_angle;
+    int32_t x, y, z, angle_deg; /* 16.16 */
+    int32_t look;
+    int mode, present;          /* -1: the engine's defaults */
+    int no_stream, no_tick, fault;
+    int acks;                   /* stream_acks */
+} fw_args;
+
+/* Parse line (modified in place: words are NUL-terminated where they stand).
+ * Returns 0, or -1 with a message in err. */
+int args_parse(fw_args *a, char *line, char *err, int errsize);
+
+/* Decimal text to 16.16, exactly as the host tools round (tools/bspc/fxtext.c).
+ * Returns 0, or -1 if malformed or out of range. */
+int args_parse_fx(const char *s, int32_t *out);
+
+#endif

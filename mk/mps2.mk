@@ -1,0 +1,149 @@
+# mps2.mk - the Cortex-M3 firmware on QEMU's mps2-an385 board (hal/mps2), the
+# instruction-counting QEMU plugin (tools/qemu_plugin), and how to run them.
+#
+#   make firmware [SCENE=...] [CAMPATH=default|map01] [WORK_BYTES=N] [STREAM=framelink|raw] [ARM_OUT=DIR]
+#       -> $(ARM_OUT)/firmware.elf (default build/arm/firmware.elf): the scene
+#          (text scene, WAD map "file.wad:MAP01" or a compiled .bsc, default
+#          tests/scenes/default.scene) compiled by build/bspc and built in, the
+#          work area sized from it by build/render (or WORK_BYTES), and a camera
+#          path (default: map01 for a MAP01 scene, else default).
+#   make run-firmware [UART=FILE|stdio] [RUN_ARGS="--frames 10 ..."]
+#       runs it in qemu-system-arm; the UART (the frame stream) goes to
+#       build/arm/uart.bin (or stdout with UART=stdio), the firmware's messages
+#       (semihosting) to the terminal; QEMU's exit status is the firmware's.
+#   make insn-plugin  -> build/insn_count.so
+#   make bench-m3     instructions per frame on the Cortex-M3 for the 20 bench views
+#                     (tools/qemu_plugin/bench_m3.py -> build/bench-m3.md); make bench runs it too
+#   make count-m3 [SCENE=...] [RUN_ARGS=...]  per-frame counts of the firmware as built
+#
+# Integer-only: compiled soft-float (-mfloat-abi=soft), and the link fails if
+# the image contains any floating-point helper from libgcc.
+
+ARM_OUT  ?= $(BUILD)/arm
+SCENE    ?= tests/scenes/default.scene
+CAMPATH  ?= $(if $(findstring MAP01,$(SCENE)),map01,default)
+WORK_BYTES ?=
+QEMU_ARM ?= qemu-system-arm
+UART     ?= $(ARM_OUT)/uart.bin
+RUN_ARGS ?=
+
+ARMNM    := arm-none-eabi-nm
+ARMSIZE  := arm-none-eabi-size
+# The frame encoding on the UART (hal/mps2/stream.h): the frame link (hal/serial)
+# when its encoder is in the tree, else raw records; STREAM= chooses.
+STREAM   ?= $(if $(wildcard hal/serial/fl_encoder.c),framelink,raw)
+ifeq ($(STREAM),framelink)
+MPS2_LINK_SRC := $(sort $(wildcard hal/serial/*.c))
+else ifeq ($(STREAM),raw)
+MPS2_LINK_SRC :=
+else
+$(error mk/mps2.mk: STREAM=$(STREAM): framelink or raw)
+endif
+MPS2_ALL_SRC := $(sort $(wildcard hal/mps2/*.c))
+MPS2_SRC := $(filter-out hal/mps2/stream_%.c,$(MPS2_ALL_SRC)) $(if $(filter raw,$(STREAM)),hal/mps2/stream_raw.c,hal/mps2/stream_fl.c)
+ARM_CFLAGS := -std=c11 -O2 -g -mcpu=cortex-m3 -mthumb -mfloat-abi=soft -ffreestanding -nostdlib \
+              -fno-strict-aliasing -fno-tree-loop-distribute-patterns -ffunction-sections -fdata-sections \
+              $(WARN) -Ifirmware -Ihal -Ihal/mps2 -Ihal/serial
+ARM_SRC  := $(FW_SRC) $(HAL_SRC) $(MPS2_SRC) $(MPS2_LINK_SRC)
+# Objects that do not depend on the scene; ARM_OBJ may be shared by several ARM_OUTs.
+ARM_OBJ  ?= $(ARM_OUT)/obj
+ARM_OBJS := $(patsubst %.c,$(ARM_OBJ)/%.o,$(ARM_SRC)) $(ARM_OUT)/fw_scene.o
+# The soft-float helpers (as in tools/check_nofloat.sh) that may not be linked in.
+ARM_FLOAT_HELPERS := '^__aeabi_([fd]|[a-z]*2[fd]$$)|^__(add|sub|mul|div|neg|fix|fixuns|float|floatun|extend|trunc|cmp|eq|ne|lt|le|gt|ge|unord|pow|powi)[sdtx]f[0-9]?$$'
+
+# hal/mps2 is a target like the others: no floating point. `make nofloat` checks
+# it on its own (its hal_* functions would clash with hal/null's in the shared
+# check's combined link); the firmware link below checks the whole image.
+.PHONY: nofloat-mps2
+nofloat: nofloat-mps2
+nofloat-mps2: $(GEN)/fx_tables.c
+	@printf 'hal/mps2: '; tools/check_nofloat.sh $(filter-out hal/mps2/stream_fl.c,$(MPS2_ALL_SRC))
+
+.PHONY: firmware run-firmware insn-plugin bench-m3 count-m3 FORCE
+FORCE:
+
+firmware: $(ARM_OUT)/firmware.elf
+
+$(ARM_OBJ)/%.o: %.c $(GEN)/fx_tables.c
+	@mkdir -p $(@D)
+	$(ARMCC) $(ARM_CFLAGS) -MMD -MP -c $< -o $@
+
+# What the built-in part depends on; rewritten only when it changes.
+$(ARM_OUT)/config: FORCE
+	@mkdir -p $(@D)
+	@echo 'SCENE=$(SCENE) CAMPATH=$(CAMPATH) WORK_BYTES=$(WORK_BYTES) STREAM=$(STREAM)' | cmp -s - $@ || \
+	  echo 'SCENE=$(SCENE) CAMPATH=$(CAMPATH) WORK_BYTES=$(WORK_BYTES) STREAM=$(STREAM)' > $@
+
+$(ARM_OUT)/scene.bsc: $(ARM_OUT)/config $(BUILD)/bspc $(wildcard $(firstword $(subst :, ,$(SCENE))))
+	@mkdir -p $(@D)
+	@case '$(SCENE)' in \
+	  *.bsc) echo "mps2: $(SCENE) is compiled already: built in as it is"; cp '$(SCENE)' $@ ;; \
+	  *) $(BUILD)/bspc '$(SCENE)' -o $@ ;; \
+	esac
+
+# The work area: what build/render says the scene needs (mode spans), unless
+# WORK_BYTES is given. A scene build/render cannot load gets none: the firmware
+# then refuses it at start with the loader's message.
+$(ARM_OUT)/work_bytes: $(ARM_OUT)/scene.bsc $(BUILD)/render
+	@if [ -n '$(WORK_BYTES)' ]; then echo '$(WORK_BYTES)' > $@; \
+	elif n=$$($(BUILD)/render $< 2>/dev/null | sed -n 's/.*"work_bytes": \([0-9]*\).*/\1/p') && [ -n "$$n" ]; then \
+	  echo "$$n" > $@; \
+	else echo "mps2: build/render cannot load $(SCENE): no work area built in (the firmware will refuse the scene)"; \
+	  echo 0 > $@; fi
+
+$(ARM_OUT)/gen/fw_scene.c: $(ARM_OUT)/scene.bsc $(ARM_OUT)/work_bytes $(BUILD)/bin2c
+	@mkdir -p $(@D)
+	@n=$$(cat $(ARM_OUT)/work_bytes); name=$$(printf '%s' '$(SCENE)' | sed 's/[\\"]/\\&/g'); \
+	{ $(BUILD)/bin2c fw_scene $< && \
+	  echo "const char fw_scene_name[] = \"$$name\";" && \
+	  echo "const char fw_campath_name[] = \"$(CAMPATH)\";" && \
+	  echo "/* the work area: $$n bytes at 0x21020000 in PSRAM (hal/mps2/mps2.ld) */" && \
+	  echo "_Alignas(8) uint8_t fw_work[$$n > 0 ? $$n : 1] __attribute__((section(\".work\")));" && \
+	  echo "const uint32_t fw_work_bytes = $${n}u;"; } > $@.tmp && mv $@.tmp $@
+
+$(ARM_OUT)/fw_scene.o: $(ARM_OUT)/gen/fw_scene.c
+	@mkdir -p $(@D)
+	$(ARMCC) $(ARM_CFLAGS) -c $< -o $@
+
+$(ARM_OUT)/firmware.elf: $(ARM_OBJS) hal/mps2/mps2.ld $(ARM_OUT)/config
+	$(ARMCC) $(ARM_CFLAGS) -T hal/mps2/mps2.ld -Wl,--gc-sections -Wl,-Map=$(ARM_OUT)/firmware.map \
+	  $(ARM_OBJS) -lgcc -o $@.tmp
+	@helpers=$$($(ARMNM) $@.tmp | awk '{print $$NF}' | grep -E $(ARM_FLOAT_HELPERS)); \
+	if [ -n "$$helpers" ]; then echo "mps2: the firmware links floating-point helpers (it must be integer-only):"; \
+	  echo "$$helpers" | sed 's/^/    /'; rm -f $@.tmp; exit 1; fi
+	@mv $@.tmp $@
+	@$(ARMSIZE) $@ | sed 's/^/mps2: /'
+	@echo "mps2: $@: scene $(SCENE), camera path $(CAMPATH), work area $$(cat $(ARM_OUT)/work_bytes) bytes, stream $(STREAM)"
+
+# ---- running it -----------------------------------------------------------------
+# -nographic would put the UART and QEMU's monitor together on stdio, where a
+# 0x01 byte of a frame starts a monitor escape: the UART goes to a file (or to a
+# plain stdio with UART=stdio) and the monitor is off.
+MPS2_QEMU = $(QEMU_ARM) -M mps2-an385 -nographic -monitor none \
+            -semihosting-config enable=on,target=native -kernel $(ARM_OUT)/firmware.elf
+
+run-firmware: $(ARM_OUT)/firmware.elf
+	@echo "mps2: UART -> $(UART); firmware messages below; exit status = the firmware's"
+	$(MPS2_QEMU) -serial $(if $(filter stdio,$(UART)),stdio,file:$(UART)) $(if $(RUN_ARGS),-append '$(RUN_ARGS)')
+
+# ---- instruction counts (TCG plugin) ----------------------------------------------
+$(BUILD)/insn_count.so: tools/qemu_plugin/insn_count.c tools/qemu_plugin/qemu_plugin_api.h
+	@mkdir -p $(@D)
+	$(CC) -std=c11 -O2 -g -Wall -Wextra -fPIC -shared -fvisibility=hidden $< -o $@
+
+insn-plugin: $(BUILD)/insn_count.so
+
+bench-m3: $(BUILD)/bspc $(BUILD)/render $(BUILD)/insn_count.so
+	$(PY) tools/qemu_plugin/bench_m3.py
+
+# make bench reports the Cortex-M3 figures too.
+bench: bench-m3
+
+# Per-frame instruction counts of the firmware as built, to $(ARM_OUT)/insns.txt.
+count-m3: $(ARM_OUT)/firmware.elf $(BUILD)/insn_count.so
+	@begin=$$($(ARMNM) $(ARM_OUT)/firmware.elf | awk '$$3=="fw_mark_frame_begin"{print "0x"$$1}'); \
+	end=$$($(ARMNM) $(ARM_OUT)/firmware.elf | awk '$$3=="fw_mark_frame_end"{print "0x"$$1}'); \
+	$(MPS2_QEMU) -serial null -plugin $(BUILD)/insn_count.so,begin=$$begin,end=$$end,out=$(ARM_OUT)/insns.txt \
+	  -append '--no-stream $(RUN_ARGS)' && cat $(ARM_OUT)/insns.txt
+
+-include $(shell find $(ARM_OBJ) -name '*.d' 2>/dev/null)

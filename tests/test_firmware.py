@@ -1,0 +1,278 @@
+"""The Cortex-M3 firmware (hal/mps2) under QEMU's mps2-an385: it runs its camera path and
+exits 0 through semihosting, streams frames the host renders bit for bit alike, refuses a
+damaged built-in scene or too small a work area with a message on the UART and a non-zero
+exit status, reports faults, and the instruction-counting plugin gives per-frame counts.
+
+Builds go through make (mk/mps2.mk); variants go to their own ARM_OUT folders under build/.
+"""
+import json
+import os
+import re
+import select
+import shutil
+import socket
+import struct
+import subprocess
+import time
+import zlib
+
+import pytest
+
+from conftest import BUILD, ROOT
+
+QEMU = shutil.which("qemu-system-arm")
+TIMEOUT = 60
+pytestmark = pytest.mark.skipif(QEMU is None, reason="qemu-system-arm missing: run make deps")
+
+EXIT_SCENE, EXIT_FAULT, EXIT_WORK = 2, 3, 4
+
+
+def make(*args):
+    proc = subprocess.run(["make", "-s", "-j2", "--no-print-directory", *args], cwd=ROOT, capture_output=True,
+                          text=True, timeout=300)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    return proc
+
+
+def build(arm_out=None, *extra):
+    out = BUILD / "arm" if arm_out is None else arm_out
+    make("firmware", f"ARM_OUT={out}", *extra)
+    return out / "firmware.elf"
+
+
+def qemu(elf, uart, args="", plugin=None, timeout=TIMEOUT):
+    """Run the firmware; UART0 to the file uart. Returns (exit status, semihosting text, UART bytes)."""
+    cmd = [QEMU, "-M", "mps2-an385", "-nographic", "-monitor", "none",
+           "-semihosting-config", "enable=on,target=native", "-kernel", str(elf),
+           "-serial", f"file:{uart}"]
+    if args:
+        cmd += ["-append", args]
+    if plugin:
+        cmd += ["-plugin", plugin]
+    proc = subprocess.run(cmd, capture_output=True, timeout=timeout)
+    return proc.returncode, proc.stderr.decode(errors="replace"), uart.read_bytes()
+
+
+def raw_frames(data):
+    """Frames of hal/mps2/stream.c's raw encoding: [(info dict, pixels)], the palette."""
+    i = data.index(b"RAWP")
+    palette = data[i + 4:i + 4 + 768]
+    frames, pos = [], i + 4 + 768
+    while (j := data.find(b"RAWF", pos)) >= 0:
+        f, x, y, z, a, look, mode, present, crc = struct.unpack("<IiiiiiBBxxI", data[j + 4:j + 36])
+        pixels = data[j + 36:j + 36 + 64000]
+        assert len(pixels) == 64000
+        frames.append((dict(frame=f, x=x, y=y, z=z, angle=a, look=look, mode=mode, present=present, crc32=crc),
+                       pixels))
+        pos = j + 36 + 64000
+    end = data.find(b"RAWE", pos)
+    assert end >= 0, "no end record"
+    assert struct.unpack("<I", data[end + 4:end + 8])[0] == len(frames)
+    return frames, palette
+
+
+def fx_text(raw):
+    """Exact decimal of a 16.16 value (what build/render parses back to the same raw value)."""
+    sign = "-" if raw < 0 else ""
+    raw = abs(raw)
+    whole, frac = raw >> 16, raw & 0xFFFF
+    if not frac:
+        return f"{sign}{whole}"
+    return f"{sign}{whole}." + f"{frac * 152587890625:016d}".rstrip("0")
+
+
+def symbol(elf, name):
+    out = subprocess.run(["arm-none-eabi-nm", str(elf)], capture_output=True, text=True, check=True).stdout
+    for line in out.splitlines():
+        parts = line.split()
+        if len(parts) == 3 and parts[2] == name:
+            return int(parts[0], 16)
+    raise AssertionError(f"{name} not in {elf}")
+
+
+@pytest.fixture(scope="module")
+def firmware():
+    """What `make firmware` builds (build/arm/firmware.elf)."""
+    return build()
+
+
+@pytest.fixture(scope="module")
+def raw_firmware():
+    """The default scene and path with the raw stream encoding, which these tests read directly."""
+    return build(BUILD / "firmware-test" / "arm-raw", "STREAM=raw")
+
+
+def test_make_firmware_runs_and_exits_0(firmware, tmp_path):
+    """`make firmware`'s image runs its whole camera path, streaming, and exits 0 in time."""
+    status, log, uart = qemu(firmware, tmp_path / "uart.bin")
+    assert status == 0, log
+    assert "firmware: done, 204 frames" in log
+    assert len(uart) > 204 * 100
+    if "stream framelink" not in log:
+        return
+    # The frame link: the C decoder shows every frame, each checked against its CRC-32.
+    fltool = BUILD / "fltool"
+    if not fltool.exists():
+        pytest.skip("build/fltool (the frame link's host tool) is not built")
+    shown = tmp_path / "shown.bin"
+    proc = subprocess.run([str(fltool), "decode", str(tmp_path / "uart.bin"), "--frames-out", str(shown)],
+                          capture_output=True, text=True, check=True)
+    events = [json.loads(line) for line in proc.stdout.splitlines()]
+    counters = events[-1]["counters"]
+    assert counters["frames_shown"] == 204 and counters["msgs_bad"] == 0, counters
+    frames = [e for e in events if e.get("event") == "frame"]
+    assert [e["frame"] for e in frames] == list(range(204))
+    data = shown.read_bytes()
+    for i, e in enumerate(frames):
+        assert f"{zlib.crc32(data[i * 64000:(i + 1) * 64000]):08x}" == e["info"]["crc32"]
+
+
+def test_frames_stream_and_match_the_host_renderer(raw_firmware, tmp_path):
+    """Each frame goes over the UART with its information, and every target renders the same
+    frame from the same camera: build/render, given the camera the firmware reports, gives
+    the same CRC-32."""
+    status, log, uart = qemu(raw_firmware, tmp_path / "uart.bin", "--frames 100")
+    assert status == 0, log
+    assert "firmware: done, 100 frames" in log
+    frames, palette = raw_frames(uart)
+    assert [info["frame"] for info, _ in frames] == list(range(100))
+    assert len(set(palette)) > 16
+    for info, pixels in frames:
+        assert zlib.crc32(pixels) == info["crc32"]
+        assert (info["mode"], info["present"]) == (0, 0)  # spans, flip
+    assert frames[0][0]["crc32"] == frames[1][0]["crc32"]  # the path starts standing still
+    assert len({info["crc32"] for info, _ in frames}) > 90  # then moves
+    # the messages also go to the UART, as text outside the frames
+    assert uart.startswith(b"firmware: mps2-an385 Cortex-M3")
+    for info, _ in frames[::11]:
+        cam = [fx_text(info["x"]), fx_text(info["y"]), fx_text(info["z"])]
+        proc = subprocess.run([str(BUILD / "render"), str(BUILD / "default.bsc"), "--at", ",".join(cam),
+                               "--angle", fx_text(info["angle"]), "--look", str(info["look"])],
+                              capture_output=True, text=True, check=True)
+        assert int(json.loads(proc.stdout)["crc32"], 16) == info["crc32"], info
+
+
+def test_fixed_view_and_present_modes(raw_firmware, tmp_path):
+    """Run-time options: a fixed view renders the same frame as build/render there, in every present mode."""
+    ref = json.loads(subprocess.run([str(BUILD / "render"), str(BUILD / "default.bsc"), "--at", "700.5,120",
+                                     "--angle", "33.25", "--look", "-20"],
+                                    capture_output=True, text=True, check=True).stdout)
+    for present in ("flip", "copy8", "copy32"):
+        status, log, uart = qemu(raw_firmware, tmp_path / f"{present}.bin",
+                                 f"--at 700.5,120 --angle 33.25 --look -20 --frames 2 --present {present}")
+        assert status == 0, log
+        frames, _ = raw_frames(uart)
+        assert [info["crc32"] for info, _ in frames] == [int(ref["crc32"], 16)] * 2
+        assert [info["present"] for info, _ in frames] == [["flip", "copy8", "copy16", "copy32"].index(present)] * 2
+
+
+def test_damaged_scene_is_refused(tmp_path):
+    """A firmware built around a damaged blob exits non-zero with a clear message on the UART."""
+    work = BUILD / "firmware-test"
+    work.mkdir(parents=True, exist_ok=True)
+    blob = bytearray((BUILD / "default.bsc").read_bytes())
+    blob[len(blob) // 2] ^= 0x5A
+    (work / "damaged.bsc").write_bytes(bytes(blob))
+    elf = build(work / "arm-damaged", f"SCENE={work / 'damaged.bsc'}", "STREAM=raw")
+    status, log, uart = qemu(elf, tmp_path / "uart.bin")
+    assert status == EXIT_SCENE, log
+    text = uart.decode(errors="replace")
+    assert "is invalid: bad CRC-32; refusing to run" in text, text
+    assert "RAWF" not in text
+
+
+def test_too_little_work_memory_is_refused(tmp_path):
+    elf = build(BUILD / "firmware-test" / "arm-small", "WORK_BYTES=4096", "STREAM=raw")
+    status, log, uart = qemu(elf, tmp_path / "uart.bin")
+    assert status == EXIT_WORK, log
+    text = uart.decode(errors="replace")
+    assert "bytes of work memory; this build has 4096" in text, text
+
+
+def test_fault_is_reported(firmware, tmp_path):
+    status, log, uart = qemu(firmware, tmp_path / "uart.bin", "--fault")
+    assert status == EXIT_FAULT, log
+    text = uart.decode(errors="replace")
+    assert "FAULT: UsageFault: pc=0x" in text and "cfsr=0x00010000" in text, text  # UNDEFINSTR
+
+
+def test_bad_option_is_refused(firmware, tmp_path):
+    status, log, uart = qemu(firmware, tmp_path / "uart.bin", "--frames many")
+    assert status == 5 and "--frames 'many'" in uart.decode(errors="replace")
+
+
+def test_instruction_counts_per_frame(firmware, tmp_path):
+    """The plugin counts guest instructions between the firmware's frame markers."""
+    make("insn-plugin")
+    begin, end = symbol(firmware, "fw_mark_frame_begin"), symbol(firmware, "fw_mark_frame_end")
+    out = tmp_path / "insns.txt"
+    plugin = f"{BUILD / 'insn_count.so'},begin={begin:#x},end={end:#x},out={out}"
+    # the path's first 12 frames (2 standing, 7 turning, 3 walking), without the tick
+    status, log, _ = qemu(firmware, tmp_path / "uart.bin", "--frames 12 --no-tick --no-stream", plugin)
+    assert status == 0, log
+    rows = [list(map(int, line.split())) for line in out.read_text().splitlines() if not line.startswith("#")]
+    assert [r[0] for r in rows] == list(range(12))
+    render = [r[1] for r in rows]
+    assert all(100_000 < n < 20_000_000 for n in render), render
+    assert render[0] == render[1]  # the same frame twice: the same count
+    assert all(r[2] >= r[1] for r in rows)
+    # a fixed view: every frame identical, to the instruction
+    out.unlink()
+    status, log, _ = qemu(firmware, tmp_path / "uart.bin", "--at 300,150 --angle 10 --frames 4 --no-tick", plugin)
+    assert status == 0, log
+    rows = [list(map(int, line.split())) for line in out.read_text().splitlines() if not line.startswith("#")]
+    assert len(rows) == 4 and len({r[1] for r in rows}) == 1, rows
+    # streaming costs instructions outside the render markers
+    assert all(r[2] > r[1] + 64000 for r in rows[:-1]), rows
+
+
+def test_pty_started_paused_loses_nothing(raw_firmware, tmp_path):
+    """On a pty QEMU drops what the guest writes while no reader has it open: started paused
+    (-S) and continued over QMP once the reader is there, every byte arrives."""
+    sock = tmp_path / "qmp.sock"
+    qemu_proc = subprocess.Popen([QEMU, "-M", "mps2-an385", "-nographic", "-monitor", "none", "-S",
+                                  "-qmp", f"unix:{sock},server=on,wait=off",
+                                  "-semihosting-config", "enable=on,target=native", "-kernel", str(raw_firmware),
+                                  "-serial", "pty", "-append", "--frames 3 --linger 1000"],
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        pty, deadline = None, time.time() + 10
+        while pty is None and time.time() < deadline:  # "char device redirected to /dev/pts/N"
+            ready, _, _ = select.select([qemu_proc.stdout, qemu_proc.stderr], [], [], 1)
+            for f in ready:
+                m = re.search(rb"(/dev/pts/\d+)", f.readline())
+                pty = m.group(1).decode() if m else pty
+        assert pty, "QEMU did not name its pty"
+        fd = os.open(pty, os.O_RDWR | os.O_NOCTTY)
+        import tty
+        tty.setraw(fd)
+        while not sock.exists() and time.time() < deadline:
+            time.sleep(0.05)
+        qmp = socket.socket(socket.AF_UNIX)
+        qmp.connect(str(sock))
+        f = qmp.makefile("rw")
+        f.readline()
+        for cmd in ("qmp_capabilities", "cont"):
+            f.write(json.dumps({"execute": cmd}) + "\n")
+            f.flush()
+            f.readline()
+        data = b""
+        while True:
+            ready, _, _ = select.select([fd], [], [], 3)
+            if not ready:
+                break
+            try:
+                chunk = os.read(fd, 65536)
+            except OSError:  # QEMU closed the pty
+                break
+            if not chunk:
+                break
+            data += chunk
+        assert qemu_proc.wait(timeout=TIMEOUT) == 0
+    finally:
+        if qemu_proc.poll() is None:
+            qemu_proc.kill()
+            qemu_proc.wait()
+    assert data.startswith(b"firmware: mps2-an385")
+    frames, _ = raw_frames(data)
+    assert len(frames) == 3 and all(zlib.crc32(p) == info["crc32"] for info, p in frames)
