@@ -63,7 +63,7 @@ $(eval $(call variant,$(BUILD),$(REL)))
 $(eval $(call variant,$(BUILD)/san,$(SAN)))
 
 UNIT_TESTS := $(patsubst tests/unit/%.c,%,$(wildcard tests/unit/test_*.c))
-PROGRAMS   := $(BUILD)/bspc $(BUILD)/render $(BUILD)/emu
+PROGRAMS   := $(BUILD)/bspc $(BUILD)/render $(BUILD)/emu $(BUILD)/display
 SAN_PROGS  := $(BUILD)/san/bspc $(BUILD)/san/render $(addprefix $(BUILD)/san/,$(UNIT_TESTS))
 
 # ---- generated sources ----------------------------------------------------------
@@ -82,7 +82,7 @@ $(GEN)/default_scene.c: $(BUILD)/default.bsc $(BUILD)/bin2c
 	$(BUILD)/bin2c default_scene $< > $@
 
 # ---- top-level targets ------------------------------------------------------------
-.PHONY: all deps run test unit pytest nofloat bench bench-bsp clean help
+.PHONY: all deps run test unit pytest nofloat bench bench-faults bench-bsp clean help
 .DEFAULT_GOAL := all
 
 all: $(PROGRAMS) nofloat
@@ -124,6 +124,10 @@ bench-bsp: deps $(BUILD)/bspc
 
 bench: deps $(BUILD)/bspc $(BUILD)/render
 	$(PY) tools/bench.py
+
+bench: bench-faults
+bench-faults: deps firmware
+	$(PY) tools/bench_faults.py
 
 clean:
 	rm -rf $(BUILD)/obj $(BUILD)/san $(BUILD)/gen $(PROGRAMS) $(BUILD)/*.bsc $(BUILD)/gen_tables $(BUILD)/bin2c

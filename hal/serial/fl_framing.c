@@ -1,0 +1,167 @@
+/* fl_framing.c - messages on the wire: header, CRC-32, COBS stuffing with a
+ * 0x00 delimiter after every message (writer and streaming reader), and the
+ * frame information's byte layout. docs/frame-link.md, "Framing". */
+#include "crc32.h"
+#include "fl_internal.h"
+
+/* ---- writer ----------------------------------------------------------------- */
+
+void fl_writer_init(fl_writer *w, fl_put_fn put, void *ctx)
+{
+    w->put = put;
+    w->ctx = ctx;
+    w->crc = 0;
+    w->bytes = 0;
+    w->n = 0;
+}
+
+static void flush_block(fl_writer *w, uint8_t code)
+{
+    w->blk[0] = code;
+    if (w->put) w->put(w->ctx, w->blk, (uint32_t)w->n + 1);
+    w->bytes += (uint32_t)w->n + 1;
+    w->n = 0;
+}
+
+/* COBS-stuff n bytes (no CRC update). */
+static void stuff(fl_writer *w, const uint8_t *p, uint32_t n)
+{
+    for (uint32_t i = 0; i < n; i++) {
+        uint8_t b = p[i];
+        if (b == 0) {
+            flush_block(w, (uint8_t)(w->n + 1));
+        } else {
+            w->blk[++w->n] = b;
+            if (w->n == 254) flush_block(w, 0xFF);
+        }
+    }
+}
+
+void fl_writer_bytes(fl_writer *w, const uint8_t *p, uint32_t n)
+{
+    w->crc = crc_update(w->crc, p, n);
+    stuff(w, p, n);
+}
+
+void fl_writer_begin(fl_writer *w, uint8_t type, uint32_t frame_no, uint32_t payload_len)
+{
+    uint8_t h[FL_HEADER_BYTES];
+    h[0] = FL_VERSION;
+    h[1] = type;
+    fl_put32(h + 2, frame_no);
+    h[6] = (uint8_t)payload_len;
+    h[7] = (uint8_t)(payload_len >> 8);
+    h[8] = (uint8_t)(payload_len >> 16);
+    w->crc = 0;
+    w->n = 0;
+    fl_writer_bytes(w, h, FL_HEADER_BYTES);
+}
+
+void fl_writer_end(fl_writer *w)
+{
+    uint8_t c[FL_CRC_BYTES];
+    fl_put32(c, w->crc);
+    stuff(w, c, FL_CRC_BYTES);
+    flush_block(w, (uint8_t)(w->n + 1)); /* the last block; its phantom zero is not data */
+    uint8_t z = 0;
+    if (w->put) w->put(w->ctx, &z, 1);
+    w->bytes++;
+}
+
+void fl_writer_message(fl_writer *w, uint8_t type, uint32_t frame_no, const uint8_t *payload, uint32_t n)
+{
+    fl_writer_begin(w, type, frame_no, n);
+    fl_writer_bytes(w, payload, n);
+    fl_writer_end(w);
+}
+
+/* ---- reader ----------------------------------------------------------------- */
+
+void fl_reader_init(fl_reader *r, uint8_t *buf, uint32_t cap)
+{
+    r->buf = buf;
+    r->cap = cap;
+    r->len = 0;
+    r->left = 0;
+    r->last_code = 0;
+    r->started = 0;
+    r->broken = 0;
+}
+
+static inline void append(fl_reader *r, uint8_t b)
+{
+    if (r->len < r->cap) r->buf[r->len++] = b;
+    else r->broken = FL_R_LONG;
+}
+
+int fl_reader_byte(fl_reader *r, uint8_t b)
+{
+    if (b == 0) {
+        int res = 0;
+        if (r->started) {
+            if (r->broken) res = -(int)r->broken;
+            else if (r->left) res = -(int)FL_R_FRAMING; /* the last block was cut short */
+            else res = 1;
+        }
+        r->started = 0;
+        r->broken = 0;
+        r->left = 0;
+        r->last_code = 0;
+        if (res != 1) r->len = 0;
+        return res;
+    }
+    if (!r->started) {
+        r->started = 1;
+        r->len = 0;
+    }
+    if (r->broken) return 0;
+    if (r->left == 0) { /* a code byte: the previous block's phantom zero is data unless it was full */
+        if (r->last_code && r->last_code != 0xFF) append(r, 0);
+        r->last_code = b;
+        r->left = (uint8_t)(b - 1);
+    } else {
+        append(r, b);
+        r->left--;
+    }
+    return 0;
+}
+
+fl_reason fl_msg_check(const uint8_t *buf, uint32_t len, fl_msg *m)
+{
+    if (len < FL_HEADER_BYTES + FL_CRC_BYTES) return FL_R_SHORT;
+    if (crc_update(0, buf, len - FL_CRC_BYTES) != fl_get32(buf + len - FL_CRC_BYTES)) return FL_R_CRC;
+    if (buf[0] != FL_VERSION) return FL_R_VERSION;
+    uint32_t plen = (uint32_t)buf[6] | (uint32_t)buf[7] << 8 | (uint32_t)buf[8] << 16;
+    if (plen != len - FL_HEADER_BYTES - FL_CRC_BYTES) return FL_R_LENGTH;
+    m->type = buf[1];
+    m->frame_no = fl_get32(buf + 2);
+    m->payload = buf + FL_HEADER_BYTES;
+    m->len = plen;
+    return FL_R_NONE;
+}
+
+/* ---- frame information -------------------------------------------------------- */
+
+void fl_info_pack(uint8_t *o, const fl_frame_info *in)
+{
+    fl_put32(o + 0, (uint32_t)in->x);
+    fl_put32(o + 4, (uint32_t)in->y);
+    fl_put32(o + 8, (uint32_t)in->z);
+    fl_put32(o + 12, (uint32_t)in->angle);
+    fl_put32(o + 16, (uint32_t)in->look);
+    o[20] = in->mode;
+    o[21] = in->present;
+    fl_put32(o + 22, in->crc);
+}
+
+void fl_info_unpack(fl_frame_info *out, const uint8_t *i)
+{
+    out->x = (int32_t)fl_get32(i + 0);
+    out->y = (int32_t)fl_get32(i + 4);
+    out->z = (int32_t)fl_get32(i + 8);
+    out->angle = (int32_t)fl_get32(i + 12);
+    out->look = (int32_t)fl_get32(i + 16);
+    out->mode = i[20];
+    out->present = i[21];
+    out->crc = fl_get32(i + 22);
+}

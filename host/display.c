@@ -1,0 +1,284 @@
+/* display.c - build/display: the display board. Reads the frame link from a
+ * serial port (a tty, a pty, a TCP socket, or a captured stream file), decodes
+ * it with the one C decoder (hal/serial), answers with acks and keyframe
+ * requests, and shows each frame that passed every check in an SDL window or
+ * writes it as a PNG file. Prints what it received. */
+#include <errno.h>
+#include <fcntl.h>
+#include <netdb.h>
+#include <poll.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <termios.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "framelink.h"
+#include "hal.h"
+#include "hal_sdl.h"
+#include "png.h"
+
+static const char usage[] =
+    "usage: display PORT [--png DIR] [--frames N] [--idle-timeout S] [--baud B] [--window] [--json]\n"
+    "\n"
+    "Receive the frame link (docs/frame-link.md) on PORT and show its frames.\n"
+    "PORT is a serial device or pty (/dev/ttyUSB0, /dev/pts/3: set raw at --baud), a TCP\n"
+    "socket (socket://127.0.0.1:5555), a file holding a captured stream, or - (stdin).\n"
+    "Acks and keyframe requests go back on the same port (not to files or stdin).\n"
+    "\n"
+    "  --png DIR          write each frame shown as DIR/frame_NNNNN.png (frame number)\n"
+    "  --window           show the frames in an SDL window (the default without --png;\n"
+    "                     Esc or closing the window stops)\n"
+    "  --frames N         stop after N frames shown (default: until the stream ends)\n"
+    "  --idle-timeout S   stop when nothing arrives for S seconds (default 10)\n"
+    "  --baud B           serial speed for a tty (default 115200)\n"
+    "  --json             print the final counters as one JSON object on stdout\n"
+    "  -h, --help         this text\n"
+    "\n"
+    "A frame is shown only if its message passed its CRC and its rebuilt pixels match\n"
+    "the CRC-32 the sender put in it; damaged frames are counted and dropped.\n";
+
+typedef struct {
+    int fd;
+    int writable;          /* acks can go back */
+    const char *png_dir;
+    int window;
+    long max_frames;
+    uint64_t frame_bytes;  /* wire bytes of the frame messages shown (approx: bytes between frames) */
+    uint64_t bytes_at_last;
+    long shown;
+    uint8_t palette[HAL_PALETTE_BYTES];
+    int quit;
+    fl_decoder dec;
+} board;
+
+static void put_back(void *ctx, const uint8_t *p, uint32_t n)
+{
+    board *b = ctx;
+    if (!b->writable) return;
+    while (n > 0) {
+        ssize_t w = write(b->fd, p, n);
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) return; /* the sender went away: nothing to tell it */
+        p += w;
+        n -= (uint32_t)w;
+    }
+}
+
+static void show_frame(board *b, const fl_event *ev)
+{
+    b->shown++;
+    b->frame_bytes += b->dec.count.bytes - b->bytes_at_last;
+    b->bytes_at_last = b->dec.count.bytes;
+    if (b->png_dir) {
+        char path[4096];
+        snprintf(path, sizeof path, "%s/frame_%05u.png", b->png_dir, (unsigned)ev->frame_no);
+        if (png_write_indexed(path, b->dec.frame, FL_W, FL_H, b->palette) != 0)
+            fprintf(stderr, "display: %s: cannot write: %s\n", path, strerror(errno));
+    }
+    if (b->window) {
+        hal_set_palette(b->palette);
+        uint8_t *page = hal_target_vram(0);
+        for (int i = 0; i < FL_FRAME_BYTES; i++) page[i] = b->dec.frame[i];
+        hal_target_set_display_start(0);
+        hal_frame_done();
+        if (hal_input() & HAL_KEY_QUIT) b->quit = 1;
+    }
+    if (b->max_frames > 0 && b->shown >= b->max_frames) b->quit = 1;
+}
+
+static void on_event(void *ctx, const fl_event *ev)
+{
+    board *b = ctx;
+    switch (ev->kind) {
+    case FL_EV_PALETTE:
+        memcpy(b->palette, ev->palette, sizeof b->palette);
+        break;
+    case FL_EV_FRAME:
+        show_frame(b, ev);
+        break;
+    default:
+        break;
+    }
+}
+
+static int open_socket(const char *spec, char *err, size_t errlen)
+{
+    char host[256];
+    const char *colon = strrchr(spec, ':');
+    if (!colon || colon == spec || (size_t)(colon - spec) >= sizeof host) {
+        snprintf(err, errlen, "socket://%s: expected socket://HOST:PORT", spec);
+        return -1;
+    }
+    memcpy(host, spec, (size_t)(colon - spec));
+    host[colon - spec] = '\0';
+    struct addrinfo hints = {0}, *res = NULL;
+    hints.ai_socktype = SOCK_STREAM;
+    int rc = getaddrinfo(host, colon + 1, &hints, &res);
+    if (rc != 0) {
+        snprintf(err, errlen, "socket://%s: %s", spec, gai_strerror(rc));
+        return -1;
+    }
+    int fd = -1;
+    for (struct addrinfo *a = res; a && fd < 0; a = a->ai_next) {
+        fd = socket(a->ai_family, a->ai_socktype, a->ai_protocol);
+        if (fd >= 0 && connect(fd, a->ai_addr, a->ai_addrlen) != 0) {
+            snprintf(err, errlen, "socket://%s: cannot connect: %s", spec, strerror(errno));
+            close(fd);
+            fd = -1;
+        }
+    }
+    freeaddrinfo(res);
+    return fd;
+}
+
+static speed_t baud_code(long baud)
+{
+    switch (baud) {
+    case 9600: return B9600;
+    case 19200: return B19200;
+    case 38400: return B38400;
+    case 57600: return B57600;
+    case 115200: return B115200;
+    case 230400: return B230400;
+    case 460800: return B460800;
+    case 921600: return B921600;
+    default: return 0;
+    }
+}
+
+/* Open PORT; sets *writable when acks can be sent back on it. */
+static int open_port(const char *port, long baud, int *writable, char *err, size_t errlen)
+{
+    *writable = 0;
+    if (!strcmp(port, "-")) return 0;
+    if (!strncmp(port, "socket://", 9)) {
+        int fd = open_socket(port + 9, err, errlen);
+        *writable = fd >= 0;
+        return fd;
+    }
+    int fd = open(port, O_RDWR | O_NOCTTY);
+    if (fd < 0 && (errno == EACCES || errno == EROFS || errno == EISDIR)) fd = open(port, O_RDONLY);
+    else if (fd >= 0) *writable = 1;
+    if (fd < 0) {
+        snprintf(err, errlen, "%s: cannot open: %s", port, strerror(errno));
+        return -1;
+    }
+    struct stat st;
+    if (fstat(fd, &st) == 0 && S_ISREG(st.st_mode)) *writable = 0; /* a captured stream */
+    if (isatty(fd)) {
+        struct termios t;
+        speed_t sp = baud_code(baud);
+        if (!sp) {
+            snprintf(err, errlen, "%s: unsupported speed %ld", port, baud);
+            close(fd);
+            return -1;
+        }
+        if (tcgetattr(fd, &t) == 0) {
+            cfmakeraw(&t);
+            cfsetispeed(&t, sp);
+            cfsetospeed(&t, sp);
+            tcsetattr(fd, TCSANOW, &t);
+        }
+    }
+    return fd;
+}
+
+static void print_summary(const board *b, int json)
+{
+    const fl_counters *c = &b->dec.count;
+    unsigned long per_frame = b->shown ? (unsigned long)(b->frame_bytes / (uint64_t)b->shown) : 0;
+    if (json) {
+        printf("{\"frames_shown\": %u, \"frames_dropped\": %u, \"frames_missed\": %u, \"msgs_ok\": %u, "
+               "\"msgs_bad\": %u, \"resyncs\": %u, \"keyreqs_sent\": %u, \"acks_sent\": %u, \"bytes\": %u, "
+               "\"bytes_per_frame\": %lu}\n",
+               c->frames_shown, c->frames_dropped, c->frames_missed, c->msgs_ok, c->msgs_bad, c->resyncs,
+               c->keyreqs_sent, c->acks_sent, c->bytes, per_frame);
+    } else {
+        fprintf(stderr,
+                "display: %u frames shown, %u bad messages, %u frames dropped, %u missed, %u resyncs, "
+                "%u keyframe requests, %u bytes (%lu per frame shown)\n",
+                c->frames_shown, c->msgs_bad, c->frames_dropped, c->frames_missed, c->resyncs, c->keyreqs_sent,
+                c->bytes, per_frame);
+    }
+}
+
+int main(int argc, char **argv)
+{
+    static board b;
+    static uint8_t frame[FL_FRAME_BYTES], work[FL_DEC_WORK_BYTES];
+    const char *port = NULL;
+    long idle_s = 10, baud = 115200;
+    int json = 0, want_window = 0;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            fputs(usage, stdout);
+            return 0;
+        } else if (!strcmp(a, "--json")) {
+            json = 1;
+        } else if (!strcmp(a, "--window")) {
+            want_window = 1;
+        } else if (i + 1 < argc && !strcmp(a, "--png")) {
+            b.png_dir = argv[++i];
+        } else if (i + 1 < argc && !strcmp(a, "--frames")) {
+            b.max_frames = atol(argv[++i]);
+        } else if (i + 1 < argc && !strcmp(a, "--idle-timeout")) {
+            idle_s = atol(argv[++i]);
+        } else if (i + 1 < argc && !strcmp(a, "--baud")) {
+            baud = atol(argv[++i]);
+        } else if (a[0] == '-' && a[1] != '\0') {
+            fprintf(stderr, "display: unknown option or missing value: '%s' (see --help)\n", a);
+            return 2;
+        } else if (!port) {
+            port = a;
+        } else {
+            fprintf(stderr, "display: more than one port given: '%s'\n", a);
+            return 2;
+        }
+    }
+    if (!port) {
+        fprintf(stderr, "display: no port given (see --help)\n");
+        return 2;
+    }
+    if (b.png_dir && mkdir(b.png_dir, 0777) != 0 && errno != EEXIST) {
+        fprintf(stderr, "display: %s: cannot create: %s\n", b.png_dir, strerror(errno));
+        return 1;
+    }
+    b.window = want_window || !b.png_dir;
+    if (b.window && hal_sdl_init(HAL_SDL_DEFAULT_SCALE, "bspvga display board") != 0) {
+        fprintf(stderr, "display: no window: %s%s\n", hal_sdl_error(),
+                b.png_dir ? "" : " (use --png DIR to write the frames as files)");
+        if (!b.png_dir) return 1;
+        b.window = 0;
+    }
+    char err[512];
+    b.fd = open_port(port, baud, &b.writable, err, sizeof err);
+    if (b.fd < 0) {
+        fprintf(stderr, "display: %s\n", err);
+        return 1;
+    }
+    fl_dec_init(&b.dec, frame, work, on_event, &b, put_back, &b);
+
+    uint8_t buf[4096];
+    while (!b.quit) {
+        struct pollfd p = {b.fd, POLLIN, 0};
+        int r = poll(&p, 1, (int)(idle_s * 1000));
+        if (r < 0 && errno == EINTR) continue;
+        if (r == 0) {
+            fprintf(stderr, "display: nothing received for %ld s; stopping\n", idle_s);
+            break;
+        }
+        ssize_t n = read(b.fd, buf, sizeof buf);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) break; /* end of stream (EOF, or EIO when a pty's other end closes) */
+        fl_dec_feed(&b.dec, buf, (uint32_t)n);
+    }
+    print_summary(&b, json);
+    if (b.window) hal_sdl_quit();
+    if (b.fd > 0) close(b.fd);
+    return 0;
+}

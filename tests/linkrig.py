@@ -1,0 +1,176 @@
+"""The firmware under QEMU with its UART on a pty or a TCP socket, and a fault-injecting relay.
+
+Used by the capture tests and by tools/bench_faults.py. QEMU's pty drops what the guest writes
+while no reader has the pty open, so QEMU starts paused (-S) and is continued over QMP once the
+reader is attached; on TCP QEMU waits for the client (server=on,wait=on) before it runs at all.
+"""
+import json
+import os
+import random
+import re
+import select
+import shutil
+import socket
+import subprocess
+import threading
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+ARM = ROOT / "build" / "arm"
+QEMU = shutil.which("qemu-system-arm") or "qemu-system-arm"
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def qemu_cmd(elf, serial, args="", extra=()):
+    return [QEMU, "-M", "mps2-an385", "-nographic", "-monitor", "none",
+            "-semihosting-config", "enable=on,target=native", "-kernel", str(elf),
+            "-serial", serial, *extra] + (["-append", args] if args else [])
+
+
+class Firmware:
+    """A running firmware. kind 'pty' (self.port is the pty path) or 'tcp' (self.port is a
+    socket:// URL). Call start() once the reader is attached (pty: continues QEMU over QMP)."""
+
+    def __init__(self, kind, args="", elf=None, tmp=None):
+        self.kind = kind
+        elf = elf or ARM / "firmware.elf"
+        self.log = []
+        if kind == "pty":
+            self.qmp_path = str(Path(tmp or "/tmp") / f"qmp-{os.getpid()}-{id(self)}.sock")
+            cmd = qemu_cmd(elf, "pty", args, ["-S", "-qmp", f"unix:{self.qmp_path},server=on,wait=off"])
+        else:
+            p = free_port()
+            cmd = qemu_cmd(elf, f"tcp:127.0.0.1:{p},server=on,wait=on", args)
+            self.port = f"socket://127.0.0.1:{p}"
+        self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        if kind == "pty":
+            self.port = self._find_pty()
+        else:
+            self._wait_listening(p)
+
+    def _find_pty(self):
+        deadline = time.time() + 15
+        buf = b""
+        while time.time() < deadline:
+            ready, _, _ = select.select([self.proc.stdout, self.proc.stderr], [], [], 0.5)
+            for f in ready:
+                buf += os.read(f.fileno(), 4096)
+            m = re.search(rb"(/dev/pts/\d+)", buf)
+            if m:
+                self.log.append(buf.decode(errors="replace"))
+                return m.group(1).decode()
+        self.kill()
+        raise RuntimeError(f"QEMU named no pty: {buf!r}")
+
+    def _wait_listening(self, port):
+        """QEMU says "waiting for connection" on stderr once its server socket is up (a probe
+        connection would itself become the one client QEMU accepts)."""
+        deadline = time.time() + 15
+        buf = b""
+        while time.time() < deadline and self.proc.poll() is None:
+            ready, _, _ = select.select([self.proc.stderr], [], [], 0.5)
+            if ready:
+                buf += os.read(self.proc.stderr.fileno(), 4096)
+                if b"waiting for connection" in buf:
+                    self.log.append(buf.decode(errors="replace"))
+                    return
+        self.kill()
+        raise RuntimeError(f"QEMU did not listen on its TCP serial port: {buf!r}")
+
+    def start(self):
+        if self.kind != "pty":
+            return
+        deadline = time.time() + 10
+        while not os.path.exists(self.qmp_path) and time.time() < deadline:
+            time.sleep(0.05)
+        with socket.socket(socket.AF_UNIX) as s:
+            s.connect(self.qmp_path)
+            f = s.makefile("rw")
+            f.readline()  # greeting
+            for cmd in ("qmp_capabilities", "cont"):
+                f.write(json.dumps({"execute": cmd}) + "\n")
+                f.flush()
+                f.readline()
+
+    def wait(self, timeout=120):
+        try:
+            out, err = self.proc.communicate(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            self.kill()
+            out, err = self.proc.communicate()
+        self.log.append((out + err).decode(errors="replace"))
+        return self.proc.returncode
+
+    def kill(self):
+        if self.proc.poll() is None:
+            self.proc.kill()
+
+
+class FaultyRelay:
+    """Relays bytes from `upstream` (a TCP address the firmware serves) to whoever connects to
+    self.port, damaging the firmware->receiver direction at a rate per byte: bit flips, dropped
+    bytes and truncated messages (a run of bytes up to the next message delimiter lost), in
+    equal shares. The receiver->firmware direction (acks, keyframe requests) passes intact."""
+
+    def __init__(self, upstream_port, rate, seed=1):
+        self.rate, self.rng = rate, random.Random(seed)
+        self.flips = self.drops = self.truncations = 0
+        self.listener = socket.socket()
+        self.listener.bind(("127.0.0.1", 0))
+        self.listener.listen(1)
+        self.port = f"socket://127.0.0.1:{self.listener.getsockname()[1]}"
+        self.upstream_port = upstream_port
+        self.thread = threading.Thread(target=self._run, daemon=True)
+        self.thread.start()
+
+    def _damage(self, data):
+        out = bytearray()
+        skipping = False
+        for b in data:
+            if skipping:
+                if b == 0:
+                    skipping = False
+                    out.append(b)
+                continue
+            if self.rng.random() < self.rate:
+                kind = self.rng.randrange(3)
+                if kind == 0:
+                    out.append(b ^ (1 << self.rng.randrange(8)))
+                    self.flips += 1
+                elif kind == 1:
+                    self.drops += 1
+                else:
+                    self.truncations += 1
+                    skipping = b != 0
+                    if not skipping:
+                        out.append(b)
+                continue
+            out.append(b)
+        return bytes(out)
+
+    def _run(self):
+        down, _ = self.listener.accept()
+        up = socket.create_connection(("127.0.0.1", self.upstream_port))
+        socks = [up, down]
+        try:
+            while True:
+                ready, _, _ = select.select(socks, [], [], 1.0)
+                for s in ready:
+                    data = s.recv(65536)
+                    if not data:
+                        return
+                    if s is up:
+                        down.sendall(self._damage(data))
+                    else:
+                        up.sendall(data)
+        except OSError:
+            return
+        finally:
+            up.close()
+            down.close()

@@ -1,0 +1,211 @@
+#!/usr/bin/env python3
+"""bench_link.py - how many bytes a frame costs on the frame link, and what the encoder costs.
+
+For a fly-through of freedoom2.wad:MAP01 (build/fltool walk: the firmware's own camera and
+collision, 20 frames per second, an autopilot following the corridors from the player start;
+or any file of raw 64,000-byte frames given with --raw), it reports:
+
+  * the mean bytes per frame on the wire (COBS, header, frame information, CRC: everything the
+    UART carries) with a keyframe every N frames, for several N, beside raw (64,000) and zlib
+    at level 9 - on each frame alone, and on each frame XORed with the frame before (the first
+    frame alone) - and the frames per second 115,200 baud (8N1: 11,520 bytes/s) carries;
+  * the encoder's instructions per frame on x86-64 (callgrind: fltool bench with --repeat 3
+    minus --repeat 1, halved; the whole fl_enc_frame: scan, coding, COBS, message CRC), and
+    what the CRC-32 of the 64,000 pixel bytes (firmware/crc32.c, for fl_frame_info.crc) adds;
+  * the same on the Cortex-M3 (QEMU mps2-an385 with build/insn_count.so, tools/flbench_m3:
+    the frames in slices of 40, each slice starting with a keyframe), checked to send the
+    very bytes the host encoder sends;
+  * the renderer's instructions per frame on x86-64 for a sample of the same frames (build/render
+    with each frame's camera, --repeat 3 minus --repeat 1, halved), for the ratio.
+
+Usage: bench_link.py [--raw FRAMES.raw] [--frames 200] [--out build/bench-link.md] [--no-m3]
+(make bench-link).
+"""
+import argparse
+import json
+import os
+import re
+import shutil
+import statistics
+import subprocess
+import sys
+import zlib
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+BUILD = ROOT / "build"
+FRAME = 64000
+BAUD_BYTES = 115200 // 10
+
+
+def sh(args, **kw):
+    return subprocess.run([str(a) for a in args], capture_output=True, text=True, check=True, **kw)
+
+
+def callgrind(args):
+    """Instructions executed by a program under callgrind."""
+    proc = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null"] + [str(a) for a in args],
+                          capture_output=True, text=True, check=True)
+    m = re.search(r"Collected\s*:\s*(\d+)", proc.stderr)
+    if not m:
+        raise RuntimeError(proc.stderr[-2000:])
+    return int(m.group(1))
+
+
+def link_sizes(fltool, raw, info, palette, key_interval, tmp):
+    stream = tmp / f"stream_k{key_interval}.bin"
+    args = [fltool, "encode", raw, "--out", stream, "--key-interval", key_interval, "--sizes"]
+    if info:
+        args += ["--info", info]
+    if palette:
+        args += ["--palette", palette]
+    out = sh(args).stdout
+    sizes = [json.loads(l) for l in out.splitlines()]
+    total = stream.stat().st_size
+    return sizes, total - sum(s["bytes"] for s in sizes)
+
+
+def m3_counts(frames_raw, n, fltool):
+    """Encoder and CRC instructions per frame on the Cortex-M3, in slices of 40 frames."""
+    bench = BUILD / "flbench"
+    bench.mkdir(parents=True, exist_ok=True)
+    plugin = BUILD / "insn_count.so"
+    enc, crc = [], []
+    for start in range(0, n, 40):
+        count = min(40, n - start)
+        (bench / "frames.raw").write_bytes(frames_raw[start * FRAME:(start + count) * FRAME])
+        sh(["make", "-s", "--no-print-directory", "build/flbench/m3.elf"], cwd=ROOT)
+        elf = bench / "m3.elf"
+        syms = sh(["arm-none-eabi-nm", elf]).stdout.split("\n")
+        addr = {l.split()[2]: "0x" + l.split()[0] for l in syms if len(l.split()) == 3}
+        out = bench / "insns.txt"
+        proc = subprocess.run(["qemu-system-arm", "-M", "mps2-an385", "-nographic", "-monitor", "none", "-serial",
+                               "null", "-semihosting-config", "enable=on,target=native", "-kernel", str(elf), "-plugin",
+                               f"{plugin},begin={addr['fl_mark_begin']},end={addr['fl_mark_end']},out={out}"],
+                              capture_output=True, text=True, timeout=600)
+        if proc.returncode != 0:
+            raise RuntimeError(proc.stderr)
+        said = [l for l in (proc.stdout + proc.stderr).splitlines() if l.startswith("stream bytes")]
+        host = sh([fltool, "digest", bench / "frames.raw"]).stdout.strip()
+        if said != [host]:
+            raise RuntimeError(f"the Cortex-M3 sent other bytes than the host: {said} vs {host}")
+        rows = [l.split() for l in out.read_text().splitlines() if l and not l.startswith("#")]
+        counts = [int(r[1]) for r in rows]
+        enc += counts[:count]
+        crc += counts[count:2 * count]
+    return enc, crc
+
+
+def render_cost(render, scene, lines, sample):
+    """x86 instructions of build/render per frame for a sample of the walk's cameras."""
+    costs = []
+    for l in lines[::max(1, len(lines) // sample)][:sample]:
+        c = l["camera"]
+        cam = ["--at", f"{c['x']},{c['y']},{c['z']}", "--angle", str(c["angle"]), "--look", str(c["look"])]
+        one = callgrind([render, scene, *cam, "--repeat", 1])
+        three = callgrind([render, scene, *cam, "--repeat", 3])
+        costs.append((three - one) / 2)
+    return costs
+
+
+def fmt(n):
+    return f"{n:,.0f}"
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--raw", help="raw frames (64,000 bytes each) instead of a MAP01 walk")
+    ap.add_argument("--info", help="frames.jsonl for --raw (cameras)")
+    ap.add_argument("--scene", default="freedoom2.wad:MAP01")
+    ap.add_argument("--frames", type=int, default=200, help="frames of the walk (default 200)")
+    ap.add_argument("--out", default=str(BUILD / "bench-link.md"))
+    ap.add_argument("--no-m3", action="store_true", help="skip the Cortex-M3 counts")
+    ap.add_argument("--no-callgrind", action="store_true", help="skip the x86 instruction counts")
+    ap.add_argument("--render-sample", type=int, default=8, help="walk frames whose render cost is measured")
+    a = ap.parse_args(argv)
+
+    fltool = BUILD / "fltool"
+    work = BUILD / "bench-link"
+    work.mkdir(parents=True, exist_ok=True)
+    lines, palette = [], None
+    if a.raw:
+        raw_path, info = Path(a.raw), a.info
+    else:
+        sh([fltool, "walk", a.scene, "--frames", a.frames, "--out", work])
+        raw_path, info, palette = work / "frames.raw", work / "frames.jsonl", work / "palette.bin"
+    if info:
+        lines = [json.loads(l) for l in Path(info).read_text().splitlines()]
+    raw = raw_path.read_bytes()
+    n = len(raw) // FRAME
+    frames = [raw[k * FRAME:(k + 1) * FRAME] for k in range(n)]
+
+    # ---- bytes ------------------------------------------------------------------------
+    alone = [len(zlib.compress(f, 9)) for f in frames]
+    xored = [alone[0]] + [len(zlib.compress(bytes(x ^ y for x, y in zip(frames[k], frames[k - 1])), 9))
+                          for k in range(1, n)]
+    rows = []
+    for ki in (64, 16, 8, 1, 0):
+        sizes, once = link_sizes(fltool, raw_path, info, palette, ki, work)
+        b = [s["bytes"] for s in sizes]
+        keys = [s["bytes"] for s in sizes if s["type"] == "key"]
+        rows.append((ki, statistics.mean(b), max(b), len(keys), statistics.mean(keys) if keys else 0, once))
+    mean64 = rows[0][1]
+
+    out = []
+    out.append(f"# Frame link: {n} frames of {'a fly-through of ' + a.scene if not a.raw else raw_path}\n")
+    out.append("Bytes per frame on the wire (everything the UART carries for a frame message: COBS, header, "
+               "frame information, frame check, CRC), beside raw frames and zlib at level 9; frames per second "
+               "at 115,200 baud (8N1, 11,520 bytes/s).\n")
+    out.append("| coding | mean bytes/frame | max | keyframes (mean bytes) | fps at 115,200 baud |")
+    out.append("|---|---|---|---|---|")
+    out.append(f"| raw frames | {fmt(FRAME)} | {fmt(FRAME)} | - | {BAUD_BYTES / FRAME:.2f} |")
+    out.append(f"| zlib -9, each frame alone | {fmt(statistics.mean(alone))} | {fmt(max(alone))} | - | "
+               f"{BAUD_BYTES / statistics.mean(alone):.1f} |")
+    out.append(f"| zlib -9, each frame XOR the one before | {fmt(statistics.mean(xored))} | {fmt(max(xored))} | - | "
+               f"{BAUD_BYTES / statistics.mean(xored):.1f} |")
+    for ki, mean, mx, nk, mk, once in rows:
+        what = {0: "keyframe only when needed", 1: "every frame a keyframe"}.get(ki, f"keyframe every {ki}")
+        out.append(f"| frame link, {what} | **{mean:,.1f}** | {fmt(mx)} | {nk} ({fmt(mk)}) | {BAUD_BYTES / mean:.1f} |")
+    out.append(f"\nOnce per stream: hello and palette, {rows[0][5]} bytes. Goal: at most about 570 bytes per frame "
+               f"(20 fps) and no more than zlib -9: the link needs {mean64 / statistics.mean(xored) * 100:.0f}% of zlib "
+               f"on the XOR and {mean64 / statistics.mean(alone) * 100:.0f}% of zlib on frames alone.\n")
+
+    # ---- instructions --------------------------------------------------------------------
+    if not a.no_callgrind and shutil.which("valgrind"):
+        one = callgrind([fltool, "bench", raw_path, "--repeat", 1])
+        three = callgrind([fltool, "bench", raw_path, "--repeat", 3])
+        enc = (three - one) / (2 * n)
+        one_c = callgrind([fltool, "bench", raw_path, "--repeat", 1, "--crc"])
+        three_c = callgrind([fltool, "bench", raw_path, "--repeat", 3, "--crc"])
+        crc = (three_c - one_c) / (2 * n) - enc
+        out.append("Instructions per frame (the encoder: fl_enc_frame, everything from the pixels to the bytes "
+                   "handed to the UART; the pixel CRC-32: crc_update over the 64,000 bytes, for "
+                   "fl_frame_info.crc, which a sender may leave out with no_crc - the frame check protects "
+                   "the frame either way):\n")
+        out.append("| where | encoder | pixel CRC-32 (optional) | renderer (spans) | encoder / renderer |")
+        out.append("|---|---|---|---|---|")
+        rend = render_cost(BUILD / "render", a.scene, lines, a.render_sample) if lines and not a.raw else []
+        rmed = statistics.median(rend) if rend else 0
+        ratio = f"{enc / rmed * 100:.1f}%" if rmed else "-"
+        out.append(f"| x86-64 (callgrind) | **{fmt(enc)}** | {fmt(crc)} | {fmt(rmed) if rmed else '-'} "
+                   f"(median of {len(rend)} frames) | {ratio} |")
+        if not a.no_m3 and shutil.which("qemu-system-arm") and (BUILD / "insn_count.so").exists():
+            e3, c3 = m3_counts(raw, n, fltool)
+            m3r = ""
+            bm = BUILD / "bench-m3.md"
+            if bm.exists():
+                m = re.search(r"freedoom2\.wad:MAP01[^|]*\|\s*([\d,]+)", bm.read_text())
+                if m:
+                    m3r = m.group(1)
+            r3 = f"{statistics.mean(e3) / int(m3r.replace(',', '')) * 100:.1f}% (of the MAP01 start view)" if m3r else "-"
+            out.append(f"| Cortex-M3 (QEMU, instructions) | **{fmt(statistics.mean(e3))}** (median "
+                       f"{fmt(statistics.median(e3))}, max {fmt(max(e3))}) | {fmt(statistics.mean(c3))} | "
+                       f"{m3r + ' (MAP01 start, build/bench-m3.md)' if m3r else '-'} | {r3} |")
+            out.append("\nThe Cortex-M3 image sent exactly the bytes the host encoder sends for the same frames.")
+    text = "\n".join(out) + "\n"
+    Path(a.out).write_text(text)
+    print(text)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
