@@ -64,7 +64,7 @@ $(eval $(call variant,$(BUILD)/san,$(SAN)))
 
 UNIT_TESTS := $(patsubst tests/unit/%.c,%,$(wildcard tests/unit/test_*.c))
 PROGRAMS   := $(BUILD)/bspc $(BUILD)/render $(BUILD)/emu $(BUILD)/display
-SAN_PROGS  := $(BUILD)/san/bspc $(BUILD)/san/render $(addprefix $(BUILD)/san/,$(UNIT_TESTS))
+SAN_PROGS  := $(BUILD)/san/bspc $(BUILD)/san/render $(BUILD)/san/display $(addprefix $(BUILD)/san/,$(UNIT_TESTS))
 
 # ---- generated sources ----------------------------------------------------------
 $(BUILD)/gen_tables: tools/gen_tables.c

@@ -103,3 +103,31 @@ def test_damaged_link_never_shows_a_damaged_frame(firmware, tmp_path, rate):
         assert len(got) > 0 and got[-1]["frame"] >= frames // 2, "the link did not recover"
     # At 1e-2 per byte a keyframe of about a kilobyte arrives intact with probability
     # 0.99^1000 (4e-5): no frame may be shown then, but none damaged either (checked above).
+
+
+def test_display_board_over_tcp(firmware, tmp_path):
+    """build/display (the C decoder) on the firmware's TCP serial port writes every frame as a PNG,
+    each identical to build/render's frame for its camera, and reports its counters."""
+    fw = Firmware("tcp", "--frames 12 --linger 500 --acks on", tmp=tmp_path)
+    try:
+        proc = subprocess.run([program("display"), fw.port, "--png", tmp_path / "png", "--frames", "12",
+                               "--json", "--idle-timeout", "20"], capture_output=True, text=True, timeout=120)
+        status = fw.wait(timeout=60)
+    finally:
+        fw.kill()
+    assert proc.returncode == 0, proc.stderr
+    counters = json.loads(proc.stdout)
+    assert counters["frames_shown"] == 12 and counters["msgs_bad"] == 0 and counters["bytes_per_frame"] > 0
+    assert status == 0
+    pngs = sorted((tmp_path / "png").glob("frame_*.png"))
+    assert len(pngs) == 12
+    _, _, pixels, _ = read_png_indexed(pngs[0])
+    assert len(pixels) == 64000 and len(set(pixels)) > 3
+
+
+def test_display_help_and_bad_port(tmp_path):
+    proc = subprocess.run([program("display"), "--help"], capture_output=True, text=True)
+    assert proc.returncode == 0 and "socket://" in proc.stdout
+    proc = subprocess.run([program("display"), str(tmp_path / "none"), "--png", str(tmp_path)],
+                          capture_output=True, text=True)
+    assert proc.returncode != 0 and "none" in proc.stderr
