@@ -92,7 +92,11 @@ help:
 	@echo "make            build build/bspc, build/render, build/emu (and check: no floating point)"
 	@echo "make run        walk the built-in scene in a window (headless: fly-through PNGs)"
 	@echo "make test       deps, build, unit tests and pytest, with ASan and UBSan"
-	@echo "make bench      instructions per frame (callgrind), overdraw, VRAM writes, bus cycles on 20 views"
+	@echo "make bench      instructions per frame (callgrind), overdraw, VRAM writes, bus cycles on 20 views;"
+	@echo "                Cortex-M3 instructions per frame (bench-m3); link faults (bench-faults)"
+	@echo "make bench-link the frame link's bytes per frame and encoder cost"
+	@echo "make firmware   build/arm/firmware.elf for QEMU mps2-an385 (SCENE=, CAMPATH=); make run-firmware"
+	@echo "make flash      IMAGE=x.dfu DEVICE=VID:PID (or LOOPBACK=1): USB DFU download"
 	@echo "make bench-bsp  bspc over all 68 Freedoom maps per strategy, beside zdbsp and glbsp"
 	@echo "make clean      remove build/"
 
