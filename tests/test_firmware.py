@@ -7,18 +7,16 @@ Builds go through make (mk/mps2.mk); variants go to their own ARM_OUT folders un
 """
 import json
 import os
-import re
 import select
 import shutil
-import socket
 import struct
 import subprocess
-import time
 import zlib
 
 import pytest
 
 from conftest import BUILD, ROOT
+from linkrig import Firmware
 
 QEMU = shutil.which("qemu-system-arm")
 TIMEOUT = 60
@@ -228,34 +226,13 @@ def test_instruction_counts_per_frame(firmware, tmp_path):
 
 def test_pty_started_paused_loses_nothing(raw_firmware, tmp_path):
     """On a pty QEMU drops what the guest writes while no reader has it open: started paused
-    (-S) and continued over QMP once the reader is there, every byte arrives."""
-    sock = tmp_path / "qmp.sock"
-    qemu_proc = subprocess.Popen([QEMU, "-M", "mps2-an385", "-nographic", "-monitor", "none", "-S",
-                                  "-qmp", f"unix:{sock},server=on,wait=off",
-                                  "-semihosting-config", "enable=on,target=native", "-kernel", str(raw_firmware),
-                                  "-serial", "pty", "-append", "--frames 3 --linger 1000"],
-                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    (-S) and continued over QMP once the reader is there (tests/linkrig.py), every byte arrives."""
+    fw = Firmware("pty", "--frames 3 --linger 1000", elf=raw_firmware, tmp=tmp_path)
     try:
-        pty, deadline = None, time.time() + 10
-        while pty is None and time.time() < deadline:  # "char device redirected to /dev/pts/N"
-            ready, _, _ = select.select([qemu_proc.stdout, qemu_proc.stderr], [], [], 1)
-            for f in ready:
-                m = re.search(rb"(/dev/pts/\d+)", f.readline())
-                pty = m.group(1).decode() if m else pty
-        assert pty, "QEMU did not name its pty"
-        fd = os.open(pty, os.O_RDWR | os.O_NOCTTY)
+        fd = os.open(fw.port, os.O_RDWR | os.O_NOCTTY)
         import tty
         tty.setraw(fd)
-        while not sock.exists() and time.time() < deadline:
-            time.sleep(0.05)
-        qmp = socket.socket(socket.AF_UNIX)
-        qmp.connect(str(sock))
-        f = qmp.makefile("rw")
-        f.readline()
-        for cmd in ("qmp_capabilities", "cont"):
-            f.write(json.dumps({"execute": cmd}) + "\n")
-            f.flush()
-            f.readline()
+        fw.start()
         data = b""
         while True:
             ready, _, _ = select.select([fd], [], [], 3)
@@ -268,11 +245,9 @@ def test_pty_started_paused_loses_nothing(raw_firmware, tmp_path):
             if not chunk:
                 break
             data += chunk
-        assert qemu_proc.wait(timeout=TIMEOUT) == 0
+        assert fw.wait(timeout=TIMEOUT) == 0
     finally:
-        if qemu_proc.poll() is None:
-            qemu_proc.kill()
-            qemu_proc.wait()
+        fw.kill()
     assert data.startswith(b"firmware: mps2-an385")
     frames, _ = raw_frames(data)
     assert len(frames) == 3 and all(zlib.crc32(p) == info["crc32"] for info, p in frames)
