@@ -47,3 +47,69 @@ def test_missing_lump_and_map(tmp_path):
     assert proc.returncode != 0 and "MAP99" in proc.stderr
     proc = run([program("bspc"), tmp_path / "none.wad:MAP01"], check=False)
     assert proc.returncode != 0 and "none.wad" in proc.stderr
+
+
+# ---- the ranges the renderer proves safe (docs/ranges.md): refused with the item named ----------
+
+ROOM = "sector {name} floor={floor} ceil={ceil}\n" \
+       "wall 0 0 0 {far} a\nwall 0 {far} {far} {far} a\nwall {far} {far} {far} 0 a\nwall {far} 0 0 0 a\n" \
+       "player 1 1 0\n"
+
+
+@pytest.mark.parametrize("values, line, message", [
+    (dict(far=32768, floor=0, ceil=64), 2, "= 32768 out of range (|coordinate| <= 32767)"),
+    (dict(far=256, floor=-16384, ceil=64), 1, "floor=-16384 out of range (|height| <= 16383)"),
+    (dict(far=256, floor=0, ceil=16384), 1, "ceil=16384 out of range (|height| <= 16383)"),
+    (dict(far=256, floor=64, ceil=0), 1, "ceil is below floor"),
+    (dict(far=0, floor=0, ceil=64), 2, "zero length"),
+])
+def test_text_scene_out_of_range(tmp_path, values, line, message):
+    path = tmp_path / "bad.scene"
+    path.write_text(ROOM.format(name="a", **values))
+    proc = run([program("bspc"), path, "-o", tmp_path / "bad.bsc"], check=False)
+    assert proc.returncode == 1, proc.stderr
+    assert f"bad.scene:{line}:" in proc.stderr and message in proc.stderr, proc.stderr
+    assert not (tmp_path / "bad.bsc").exists()
+
+
+def wad_room(path, x0, y0, x1, y1, floor, ceil):
+    """A PWAD whose MAP01 is one rectangular one-sided room."""
+    import struct
+    verts = [(x0, y0), (x0, y1), (x1, y1), (x1, y0)]
+    linedefs = b"".join(struct.pack("<HHHHHHH", i, (i + 1) % 4, 1, 0, 0, i, 0xFFFF) for i in range(4))
+    sides = b"".join(struct.pack("<hh8s8s8sH", 0, 0, b"-", b"-", b"STARTAN3", 0) for _ in range(4))
+    sectors = struct.pack("<hh8s8shhh", floor, ceil, b"FLOOR4_8", b"CEIL3_5", 160, 0, 0)
+    things = struct.pack("<hhhHH", (x0 + x1) // 2, (y0 + y1) // 2, 0, 1, 7)
+    vertexes = b"".join(struct.pack("<hh", x, y) for x, y in verts)
+    lumps = [(b"MAP01", b""), (b"THINGS", things), (b"LINEDEFS", linedefs), (b"SIDEDEFS", sides),
+             (b"VERTEXES", vertexes), (b"SECTORS", sectors)]
+    body, directory, pos = b"", b"", 12
+    for name, data in lumps:
+        directory += struct.pack("<II8s", pos, len(data), name)
+        body += data
+        pos += len(data)
+    path.write_bytes(b"PWAD" + struct.pack("<II", len(lumps), pos) + body + directory)
+
+
+@pytest.mark.parametrize("room, message", [
+    ((-32768, 0, 256, 256, 0, 128), "vertex 0: x = -32768 out of range (|coordinate| <= 32767)"),
+    ((0, 0, 256, 256, 0, 20000), "sector 0: floor 0 / ceiling 20000 out of range (|height| <= 16383)"),
+])
+def test_wad_out_of_range(tmp_path, room, message):
+    wad = tmp_path / "bad.wad"
+    wad_room(wad, *room)
+    proc = run([program("bspc"), f"{wad}:MAP01", "-o", tmp_path / "bad.bsc"], check=False)
+    assert proc.returncode == 1, proc.stderr
+    assert f"bad.wad:MAP01: {message}" in proc.stderr, proc.stderr
+
+
+def test_extremes_of_the_ranges_compile(tmp_path):
+    """The limits themselves are inside: a room from -32767 to 32767, heights +-16383."""
+    path = tmp_path / "edge.scene"
+    path.write_text("sector a floor=-16383 ceil=16383\n"
+                    "wall -32767 -32767 -32767 32767 a\nwall -32767 32767 32767 32767 a\n"
+                    "wall 32767 32767 32767 -32767 a\nwall 32767 -32767 -32767 -32767 a\nplayer 0 0 0\n")
+    run([program("bspc"), path, "-o", tmp_path / "edge.bsc"])
+    wad = tmp_path / "edge.wad"
+    wad_room(wad, -32767, -32767, 32767, 32767, -16383, 16383)
+    run([program("bspc"), f"{wad}:MAP01", "-o", tmp_path / "edge2.bsc"])

@@ -244,7 +244,7 @@ int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_sc
         l->v2 = v2;
         l->src_line = (int)i;
         l->sector[0] = l->sector[1] = SCN_NONE;
-        int dx = (s->vx[v2] - s->vx[v1]) / 65536, dy = (s->vy[v2] - s->vy[v1]) / 65536;
+        int64_t dx = ((int64_t)s->vx[v2] - s->vx[v1]) / 65536, dy = ((int64_t)s->vy[v2] - s->vy[v1]) / 65536;
         /* fake contrast as in Doom: walls running east-west a shade lighter,
          * north-south a shade darker */
         int contrast = (dy == 0) ? 1 : (dx == 0) ? -1 : 0;
