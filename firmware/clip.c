@@ -37,6 +37,7 @@ static view_pt intersect(view_pt a, int64_t da, view_pt b, int64_t db)
 static int clip_plane(clip_poly *p, const view_xform *v, unsigned plane)
 {
     view_pt out[CLIP_MAX_VERTS];
+    uint8_t on[CLIP_MAX_VERTS];
     int64_t d[CLIP_MAX_VERTS];
     int n = p->n, m = 0, inside = 0;
     for (int i = 0; i < n; i++) {
@@ -47,18 +48,39 @@ static int clip_plane(clip_poly *p, const view_xform *v, unsigned plane)
     if (inside == 0) return p->n = 0;
     for (int i = 0; i < n && m < CLIP_MAX_VERTS - 1; i++) {
         int j = (i + 1 == n) ? 0 : i + 1;
-        if (d[i] >= 0) out[m++] = p->v[i];
-        if ((d[i] >= 0) != (d[j] >= 0))
+        if (d[i] >= 0) {
+            on[m] = p->on[i];
+            out[m++] = p->v[i];
+        }
+        if ((d[i] >= 0) != (d[j] >= 0)) {
+            /* on this plane, and on any earlier plane both ends lie on */
+            on[m] = (uint8_t)(plane | (p->on[i] & p->on[j]));
             out[m++] = (d[i] >= 0) ? intersect(p->v[i], d[i], p->v[j], d[j]) : intersect(p->v[j], d[j], p->v[i], d[i]);
+        }
     }
-    for (int i = 0; i < m; i++) p->v[i] = out[i];
+    for (int i = 0; i < m; i++) {
+        p->v[i] = out[i];
+        p->on[i] = on[i];
+    }
     return p->n = m;
 }
 
 int clip_polygon(clip_poly *p, const view_xform *v, unsigned mask)
 {
-    if (p->n > CLIP_MAX_VERTS - 5) p->n = 0; /* caller broke the contract: draw nothing */
+    if (p->n > CLIP_MAX_VERTS - 5 || p->n < 0) p->n = 0; /* caller broke the contract: draw nothing */
+    for (int i = 0; i < p->n; i++) p->on[i] = 0;
     for (unsigned plane = 1; plane <= CLIP_BOTTOM && p->n >= 3; plane <<= 1)
         if (mask & plane) clip_plane(p, v, plane);
     return p->n >= 3 ? p->n : 0;
+}
+
+void clip_project(const view_xform *v, const clip_poly *p, screen_pt *out)
+{
+    for (int i = 0; i < p->n; i++) {
+        out[i] = view_project(v, p->v[i]);
+        if (p->on[i] & CLIP_LEFT) out[i].x = 0;
+        if (p->on[i] & CLIP_RIGHT) out[i].x = VIEW_W_FX;
+        if (p->on[i] & CLIP_TOP) out[i].y = 0;
+        if (p->on[i] & CLIP_BOTTOM) out[i].y = VIEW_H_FX;
+    }
 }

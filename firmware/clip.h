@@ -22,10 +22,19 @@ enum {
 typedef struct {
     int n;
     view_pt v[CLIP_MAX_VERTS];
+    uint8_t on[CLIP_MAX_VERTS]; /* CLIP_* planes the vertex lies on by construction */
 } clip_poly;
 
-/* Clip p in place against the planes in mask; returns the vertices left (0 if none). */
+/* Clip p in place against the planes in mask; returns the vertices left (0 if none).
+ * The caller fills n and v; on[] is set here. */
 int clip_polygon(clip_poly *p, const view_xform *v, unsigned mask);
+
+/* Project the clipped polygon to the screen. A vertex made by clipping against a
+ * side, top or bottom plane is put exactly on that screen edge: its view
+ * coordinates are rounded to 1/16384 unit, which near the eye (z of a few
+ * hundredths of a unit) would otherwise move it up to a pixel inside the screen
+ * and leave the border pixels uncovered. */
+void clip_project(const view_xform *v, const clip_poly *p, screen_pt *out);
 
 /* Signed distance of a view point from one plane (>= 0 inside), in 18.14 * 2^8 units. */
 int64_t clip_distance(const view_xform *v, view_pt p, unsigned plane);

@@ -15,7 +15,7 @@ static void emit(const view_xform *v, clip_poly *p, unsigned mask, const surf_si
         return;
     }
     screen_pt s[CLIP_MAX_VERTS];
-    for (int i = 0; i < p->n; i++) s[i] = view_project(v, p->v[i]);
+    clip_project(v, p, s);
     st->polygons++;
     sink->polygon(sink->ctx, s, p->n, colour, id);
 }

@@ -1,6 +1,6 @@
 """Zero overdraw and accuracy against the reference renderer (tools/refrender.py, which ray-casts the
 source map without the BSP tree), on every view of the bench list: mode spans writes each pixel once,
-and in both modes at least 99.5% of pixels carry the reference's surface id, with no pixel left empty
+and in both modes at least 99.9% of pixels carry the reference's surface id, with no pixel left empty
 (kind 0) inside these closed maps."""
 import json
 import struct
@@ -35,7 +35,7 @@ def test_bench_view_against_reference(view, tmp_path):
     assert spans_json["overdraw"] == 1.0 and spans_json["pixels_written"] == 64000
     for name, ids in (("spans", spans), ("painter", painter)):
         same = float((ids == ref).mean())
-        assert same >= 0.995, f"{name}: only {same:.4%} of pixels match the reference"
+        assert same >= 0.999, f"{name}: only {same:.4%} of pixels match the reference"
         assert int(((ids >> 24) == 0).sum()) == 0, f"{name}: empty pixels inside a closed map"
     # the two modes draw the same surfaces
     assert (spans == painter).mean() >= 0.999

@@ -18,7 +18,7 @@ Reading, numbered exactly as build/bspc numbers them (tools/bspc/scene_text.c, w
 
 Camera (DESIGN.md "Camera", as the C renderer): x east, y north, angle in degrees, 0 = east,
 counter-clockwise; forward f = (cos a, sin a), right r = (sin a, -cos a). Pixel (px, py):
-xv = (px + 0.5 - 160) / 160, yv = (100 + look - (py + 0.5)) / 160. The ray's map-plane direction
+xv = (px + 0.5 - 160) / 160, yv = (100 + look - (py + 0.5)) / 160 (plus the tie-break below, TIE_DX). The ray's map-plane direction
 is d = f + xv * r, so its point at forward depth t (distance along f) is eye + t * d, at height
 eye_z + yv * t. Hits at t < 1/1024 (the near plane) are ignored. The camera values are rounded to
 16.16 first, as build/render rounds them; the trigonometry is exact (double).
@@ -53,7 +53,8 @@ sectors starts in none (no floor, no ceiling) and rays pass through walls seen f
 they enter a sector. A wall whose end is exactly on the ray counts as crossed (the ends are
 inclusive). An eye exactly on a wall or vertex crosses it at depth 0, which the near plane
 ignores; each ray then starts in the near-side sector of the first wall it crosses (the sector it
-really goes into) rather than in the eye's sector.
+really goes into) rather than in the eye's sector, and a ray that crosses no wall (it leaves the
+map at once: the eye is on the map's outer edge, looking out) sees nothing.
 
 Eye sector (default eye height = its floor + 41, or 41 in none): even-odd ray crossing over each
 sector's lines (a line with the sector on both sides counts twice and cancels); if several
@@ -76,6 +77,12 @@ W, H = 320, 200
 FOCAL = 160.0
 EYE_HEIGHT = 41.0
 ZNEAR = 1.0 / 1024.0
+# The C renderer's top-left fill rule, as a sample point: a pixel centre exactly on an edge belongs
+# to the surface right of the edge, or below it when the edge is horizontal. Sampling a hair right
+# of the centre and a far smaller hair below it decides exact ties the same way and moves nothing
+# else (both are far below the C renderer's own 2^-16 pixel rounding).
+TIE_DX = 2.0 ** -20
+TIE_DY = 2.0 ** -40
 KIND_NONE, KIND_WALL, KIND_FLOOR, KIND_CEIL = 0, 1, 2, 3
 NONE = -1
 
@@ -344,8 +351,8 @@ def render_ids(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="
     a = np.radians(float(angle) % 360.0)
     fxd, fyd = np.cos(a), np.sin(a)
     rx, ry = fyd, -fxd
-    xv = (np.arange(W) + 0.5 - W / 2) / FOCAL                 # (320,)
-    yv = (H / 2 + look - (np.arange(H) + 0.5)) / FOCAL        # (200,)
+    xv = (np.arange(W) + 0.5 + TIE_DX - W / 2) / FOCAL        # (320,)
+    yv = (H / 2 + look - (np.arange(H) + 0.5 + TIE_DY)) / FOCAL  # (200,)
     dx, dy = fxd + xv * rx, fyd + xv * ry                      # ray directions per column
 
     # every column against every line: E + t d = A + u w
@@ -384,7 +391,10 @@ def render_ids(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="
         nsec, bsec = near[li], far[li]
         # the walk: sector of interval j (before crossing j; interval k is past the last)
         cur = np.empty(k + 1, np.int64)
-        cur[0] = nsec[0] if on_wall and k else start
+        if on_wall:   # a ray that crosses nothing leaves the map at once: it sees nothing
+            cur[0] = nsec[0] if k else NONE
+        else:
+            cur[0] = start
         cur[1:] = bsec        # after a crossing: the far side's sector (NONE past a one-sided
                               # wall the ray missed: only with the eye outside the map)
         t0 = np.concatenate(([ZNEAR], tk))                     # (k+1,)
