@@ -369,7 +369,12 @@ static void scan(span_state *S)
 }
 
 /* 1 if the eye stands inside its leaf's floor polygon (leaf regions also take in
- * void behind walls) and between its sector's floor and ceiling. */
+ * void behind walls) and between its sector's floor and ceiling, strictly: an eye
+ * on a wall's line sees into the sector beyond as well, where its height may be
+ * below that sector's floor and a solid wall there hides nothing. The shifted
+ * products are within |dx| + |dy| + |ex| + |ey| + 2 of the exact cross product
+ * (scaled by 1/16); a point nearer the edge than that counts as on it, which only
+ * costs the occlusion shortcut. */
 static int eye_in_world(const scene *sc, const view_xform *v)
 {
     const scn_leaf *f = &sc->leaves[scene_leaf_at(sc, (int32_t)v->cx, (int32_t)v->cy)];
@@ -383,7 +388,8 @@ static int eye_in_world(const scene *sc, const view_xform *v)
          * shifts keep both products below 2^61 (as in surfaces.c) */
         int64_t dx = fx_asr64((int64_t)b->x - a->x, 1), dy = fx_asr64((int64_t)b->y - a->y, 1);
         int64_t ex = fx_asr64(v->cx - a->x, 3), ey = fx_asr64(v->cy - a->y, 3);
-        if (dx * ey - dy * ex < 0) return 0;
+        int64_t slack = (dx < 0 ? -dx : dx) + (dy < 0 ? -dy : dy) + (ex < 0 ? -ex : ex) + (ey < 0 ? -ey : ey) + 2;
+        if (dx * ey - dy * ex <= slack) return 0;
     }
     return 1;
 }
