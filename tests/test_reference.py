@@ -314,6 +314,18 @@ def test_accuracy_shifted_edge():
     assert accuracy.walls_matched(a, b) == pytest.approx(1 - 100 / 32000)   # 100 of 100x320
 
 
+def test_accuracy_moved_horizontal_edge():
+    """An edge between rows that moved down by one row is a displacement of 1, as one that moved
+    sideways by one column is."""
+    a = two_walls(100)
+    b = a.copy()
+    b[150] = a[149]                       # the walls reach one row lower in B
+    assert accuracy.differ(a, b) == pytest.approx(320 / 64000)
+    assert accuracy.edge_displacement(a, b) == 1
+    b[150:153] = a[149]                   # three rows lower
+    assert accuracy.edge_displacement(a, b) == 3
+
+
 def test_accuracy_missing_edge_and_nothing():
     a = two_walls(100)
     b = a.copy()

@@ -6,15 +6,15 @@ usage: tools/accuracy.py A.bin B.bin [--json]
 Figures (A is usually the reference, tools/refrender.py; B the renderer under test):
 - differ: the share of the 64,000 pixels whose ids differ (0.0 .. 1.0).
 - none_a, none_b: the number of kind-0 ("nothing") pixels in each.
-- edge_displacement (pixels, 0 .. 320): the largest horizontal displacement of an edge.
-  An edge is a place in a row between two neighbouring pixels x-1 and x whose ids differ; it is
-  at position x (1..319) and is labelled by the ordered pair (id left, id right). For every edge
-  of A, its distance is |x - x'| to the nearest edge x' with the same label in the same row of
-  B, or 320 when that row of B has no such edge; likewise for every edge of B against A. The
-  figure is the maximum over all edges of both (0 when neither has an edge, or the buffers are
-  equal). A wall edge that moved by one pixel gives 1; an edge that exists in only one buffer
-  (a missing sliver of wall) gives 320. edge_displacement_p99 is the 99th percentile of the same
-  distances, which is robust to a few such slivers.
+- edge_displacement (pixels, 0 .. 320): the largest displacement of an edge between surfaces, in
+  any direction. For every pixel where the ids differ, d_a is the distance (Chebyshev: rows and
+  columns alike) to the nearest pixel of A that carries B's id there, and d_b the distance to the
+  nearest pixel of B that carries A's id; the pixel's displacement is the larger of the two, and
+  the figure is the maximum over all differing pixels (0 when the buffers are equal). An edge that
+  moved by one pixel, sideways or up and down, gives 1; a surface that exists in only one buffer
+  near there (a missing sliver of wall, a hole) gives 320, as does anything displaced by more than
+  SEARCH pixels. edge_displacement_p99 is the 99th percentile over the differing pixels, which is
+  robust to a few such slivers.
 - walls_b_matched: of the pixels where B shows a wall (kind 1), the share where A has the same
   id (walls_a_matched: the same the other way round). This compares a walls-only renderer mode
   against the reference without counting its empty floors and ceilings.
@@ -55,39 +55,40 @@ def none_count(a):
     return int(np.count_nonzero((as_ids(a) >> 24) == 0))
 
 
-def _edges(ids):
-    """Per row: dict (left id, right id) -> sorted array of edge positions x (1..319)."""
-    out = []
-    for row in ids:
-        xs = np.nonzero(row[1:] != row[:-1])[0] + 1
-        d = {}
-        for x in xs:
-            d.setdefault((int(row[x - 1]), int(row[x])), []).append(int(x))
-        out.append({k: np.array(v) for k, v in d.items()})
-    return out
+SEARCH = 32
 
 
-def _distances(ea, eb):
-    """Distances of every edge of ea to the nearest same-label edge in eb (same row), capped."""
-    dist = []
-    for ra, rb in zip(ea, eb):
-        for label, xs in ra.items():
-            other = rb.get(label)
-            if other is None:
-                dist.extend([CAP] * len(xs))
-                continue
-            j = np.clip(np.searchsorted(other, xs), 1, len(other)) - 1
-            d = np.abs(other[j] - xs)
-            j2 = np.clip(j + 1, 0, len(other) - 1)
-            d = np.minimum(d, np.abs(other[j2] - xs))
-            dist.extend(np.minimum(d, CAP).tolist())
+def _nearest(src, want, ys, xs):
+    """Per pixel (ys[i], xs[i]): the Chebyshev distance to the nearest pixel of src whose id is
+    want[i], or CAP when there is none within SEARCH. Rings are searched outwards, each only for
+    the pixels not yet matched."""
+    dist = np.full(ys.size, CAP, np.int64)
+    todo = np.nonzero(np.isin(want, src))[0]      # an id src lacks altogether is never found
+    for r in range(1, SEARCH + 1):
+        if todo.size == 0:
+            break
+        found = np.zeros(todo.size, bool)
+        ring = [(dy, dx) for dy in range(-r, r + 1) for dx in range(-r, r + 1) if max(abs(dy), abs(dx)) == r]
+        ty, tx, tw = ys[todo], xs[todo], want[todo]
+        for dy, dx in ring:
+            y, x = ty + dy, tx + dx
+            ok = (y >= 0) & (y < H) & (x >= 0) & (x < W)
+            found[ok] |= src[y[ok], x[ok]] == tw[ok]
+        dist[todo[found]] = r
+        todo = todo[~found]
     return dist
 
 
 def edge_distances(a, b):
-    """All edge distances, A against B and B against A (see the header)."""
-    ea, eb = _edges(as_ids(a)), _edges(as_ids(b))
-    return np.array(_distances(ea, eb) + _distances(eb, ea), dtype=np.int64)
+    """The displacement of every pixel whose ids differ (see the header)."""
+    a, b = as_ids(a), as_ids(b)
+    ys, xs = np.nonzero(a != b)
+    if ys.size == 0:
+        return np.zeros(0, np.int64)
+    d = _nearest(b, a[ys, xs], ys, xs)
+    rest = d < CAP                                 # the larger of the two is CAP already elsewhere
+    d[rest] = np.maximum(d[rest], _nearest(a, b[ys[rest], xs[rest]], ys[rest], xs[rest]))
+    return d
 
 
 def edge_displacement(a, b):
