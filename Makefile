@@ -98,6 +98,8 @@ help:
 	@echo "make firmware   build/arm/firmware.elf for QEMU mps2-an385 (SCENE=, CAMPATH=); make run-firmware"
 	@echo "make flash      IMAGE=x.dfu DEVICE=VID:PID (or LOOPBACK=1): USB DFU download"
 	@echo "make bench-bsp  bspc over all 68 Freedoom maps per strategy, beside zdbsp and glbsp"
+	@echo "make report     error against the reference vs instructions per frame, per render mode and"
+	@echo "                precision-knob configuration (mk/report.mk) -> build/report/report.md and plots"
 	@echo "make clean      remove build/"
 
 deps:

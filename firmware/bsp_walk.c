@@ -35,8 +35,9 @@ static int cull_box(const int32_t box[4], const view_xform *v, const walk_plane 
         if (far < 0) return -1;
         int64_t near = (p[i].nx >= 0 ? x0 : x1) * p[i].nx + (p[i].ny >= 0 ? y0 : y1) * p[i].ny;
         /* the near plane sits at z = VIEW_ZNEAR, not 0: only call a box inside it
-         * with a margin that covers that distance */
-        int64_t margin = (p[i].bit == CLIP_NEAR) ? ((int64_t)VIEW_ZNEAR << (30 + 2 - 3)) * 2 : 0;
+         * with a margin that covers that distance (view units to map 16.16 >> 3,
+         * times the 2.30 normal) */
+        int64_t margin = (p[i].bit == CLIP_NEAR) ? ((int64_t)VIEW_ZNEAR << (30 + (16 - VIEW_SHIFT) - 3)) * 2 : 0;
         if (near > margin) mask &= ~p[i].bit;
     }
     return (int)mask;

@@ -2,8 +2,9 @@
  * The sine table (fx_sin_quarter) is generated at build time by tools/gen_tables.c. */
 #include "fixed.h"
 
-/* 4097 entries: sin(i * pi/2 / 4096) in 2.30 for i = 0..4096 (build/gen/fx_tables.c). */
-extern const int32_t fx_sin_quarter[4097];
+/* sin(i * pi/2 / 2^FX_SIN_BITS) in 2.30 for i = 0..2^FX_SIN_BITS (build/gen/fx_tables.c). */
+#define SIN_N (1u << FX_SIN_BITS)
+extern const int32_t fx_sin_quarter[SIN_N + 1];
 
 fx_t fx_mul(fx_t a, fx_t b)
 {
@@ -32,15 +33,21 @@ fx_ang_t fx_ang_from_deg(fx_t deg)
     return (fx_ang_t)(uint64_t)q;
 }
 
-/* sin over the first quadrant for p in [0, 2^30] (a quarter turn), linearly
- * interpolated between table entries 2^18 angle units apart. */
+/* sin over the first quadrant for p in [0, 2^30] (a quarter turn); entries are
+ * 2^(30 - FX_SIN_BITS) angle units apart. */
+#define SIN_GAP (30 - FX_SIN_BITS)
 static int32_t sin_quadrant(uint32_t p)
 {
-    uint32_t i = p >> 18;
-    if (i >= 4096) return fx_sin_quarter[4096];
+#if FX_SIN_LERP
+    uint32_t i = p >> SIN_GAP;
+    if (i >= SIN_N) return fx_sin_quarter[SIN_N];
     int32_t a = fx_sin_quarter[i];
     int32_t d = fx_sin_quarter[i + 1] - a;
-    return a + (int32_t)fx_asr64((int64_t)d * (int64_t)(p & 0x3FFFFu), 18);
+    /* |d| < 2^30 * pi / 32 and the fraction < 2^26: the product is below 2^53 */
+    return a + (int32_t)fx_asr64((int64_t)d * (int64_t)(p & ((1u << SIN_GAP) - 1u)), SIN_GAP);
+#else
+    return fx_sin_quarter[(p + (1u << (SIN_GAP - 1))) >> SIN_GAP]; /* p <= 2^30: at most SIN_N */
+#endif
 }
 
 int32_t fx_sin(fx_ang_t a)

@@ -74,9 +74,31 @@ static inline int64_t fx_mul64(int64_t a, int32_t b, unsigned s)
 
 /* Angles. fx_ang_from_deg takes degrees in 16.16 (any value: it wraps). */
 fx_ang_t fx_ang_from_deg(fx_t deg);
-/* sin/cos as 2.30 fixed point (1.0 = 1 << 30), from a 4096-entry quarter-wave
- * table generated at build time (tools/gen_tables.c) with linear interpolation
- * between entries: max error 2^-24 or so; exact 0 and +-1 at the quadrant angles. */
+/* sin/cos as 2.30 fixed point (1.0 = 1 << 30), from a quarter-wave table of
+ * 2^FX_SIN_BITS intervals generated at build time (tools/gen_tables.c); exact 0
+ * and +-1 at the quadrant angles.
+ *
+ * Precision knobs: they trade the table's memory (4 * (2^FX_SIN_BITS + 1)
+ * bytes) and, for FX_SIN_LERP, a multiply per call against the accuracy of the
+ * view's rotation; sin and cos are taken once per frame, so run time hardly
+ * moves. An angle error of e radians turns the whole view by e: up to 160 * e
+ * pixels at the screen's sides.
+ *   FX_SIN_BITS  4..12 (default 12: 4097 entries).
+ *   FX_SIN_LERP  1 (default): interpolate linearly between entries, max error
+ *                about (pi / 2^(FX_SIN_BITS + 1))^2 / 8 (2^-24 or so at 12 bits);
+ *                0: take the nearest entry, max error pi / 2^(FX_SIN_BITS + 2). */
+#ifndef FX_SIN_BITS
+#define FX_SIN_BITS 12
+#endif
+#ifndef FX_SIN_LERP
+#define FX_SIN_LERP 1
+#endif
+#if FX_SIN_BITS < 4 || FX_SIN_BITS > 12
+#error "FX_SIN_BITS: 4..12"
+#endif
+#if FX_SIN_LERP != 0 && FX_SIN_LERP != 1
+#error "FX_SIN_LERP: 0 or 1"
+#endif
 #define FX_TRIG_SHIFT 30
 int32_t fx_sin(fx_ang_t a);
 int32_t fx_cos(fx_ang_t a);

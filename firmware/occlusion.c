@@ -53,11 +53,13 @@ void occ_close(occ_columns *o, int x0, int x1)
     o->r[i][1] = (int16_t)x1;
 }
 
-/* Screen x (16.16) of view point (x, z), z >= VIEW_ZNEAR, |x| <= z. */
+/* Screen x (16.16) of view point (x, z), z >= VIEW_ZNEAR, |x| <= z, projected
+ * as view_project projects a vertex (the same precision knobs apply), so the
+ * columns a wall closes stay within the columns it is drawn in. */
 static int32_t screen_x(int64_t x, int64_t z)
 {
-    int64_t sx = ((int64_t)VIEW_CX << 16) + x * ((int64_t)VIEW_FOCAL << 16) / z;
-    return sx < 0 ? 0 : (sx > VIEW_W_FX ? VIEW_W_FX : (int32_t)sx);
+    int64_t sx = ((int64_t)VIEW_CX << 16) + view_persp((int32_t)x, (int32_t)z);
+    return view_subpixel(sx < 0 ? 0 : (sx > VIEW_W_FX ? VIEW_W_FX : (int32_t)sx));
 }
 
 static int column(int32_t sx)

@@ -1,9 +1,8 @@
-/* raster.c - convex polygon scan conversion with exact edge stepping.
- * Each edge is walked top to bottom with an integer DDA (whole step plus a
- * remainder against the edge's height), so x at every scan line is exactly
- * floor(true x) in 16.16: no error accumulates however long the edge is, and
- * two polygons sharing an edge compute the same x on every line, whichever
- * renderer walks it. */
+/* raster.c - convex polygon scan conversion.
+ * Each edge is walked top to bottom with an integer DDA (RAST_STEP_BITS in
+ * raster.h: by default the exact whole step plus a remainder against the
+ * edge's height, or a step rounded to fewer bits), and two polygons sharing an edge
+ * compute the same x on every line, whichever renderer walks it. */
 #include "raster.h"
 
 void rast_span(const rast_target *t, int y, int x0, int x1, uint8_t colour, uint32_t id)
@@ -31,6 +30,7 @@ int rast_edge_setup(rast_edge *e, int32_t xa, int32_t ya, int32_t xb, int32_t yb
     /* |dx| < 2^25 and the first sample is under one row below ya: the products
      * stay below 2^42 */
     int64_t dx = (int64_t)xb - xa, dy = (int64_t)yb - ya;
+#if RAST_STEP_BITS == 0
     int64_t num = (((int64_t)row << 16) + 32768 - ya) * dx;
     int64_t x = floor_div(num, dy);
     int64_t step = floor_div(dx * 65536, dy);
@@ -38,6 +38,14 @@ int rast_edge_setup(rast_edge *e, int32_t xa, int32_t ya, int32_t xb, int32_t yb
     e->rem = (int32_t)(num - x * dy); /* in [0, dy) */
     e->step = (int32_t)step;
     e->srem = (int32_t)(dx * 65536 - step * dy);
+#else
+    /* dx / dy rounded to RAST_STEP_BITS fraction bits, in 16.16; x from the top
+     * vertex with that step */
+    int64_t step = floor_div(dx * (2 << RAST_STEP_BITS) + dy, 2 * dy) * (1 << (16 - RAST_STEP_BITS));
+    e->x = (int32_t)(xa + fx_asr64((((int64_t)row << 16) + 32768 - ya) * step, 16));
+    e->rem = e->srem = 0;
+    e->step = (int32_t)step;
+#endif
     e->dy = (int32_t)dy;
     e->row = (int16_t)row;
     e->end_row = (int16_t)end;

@@ -22,11 +22,9 @@ static int32_t clamp32(int64_t v, int32_t hi)
 
 screen_pt view_project(const view_xform *v, view_pt p)
 {
-    /* |x|,|y| < 2^31 and focal * 2^16 < 2^24: products < 2^55. */
-    const int64_t f = (int64_t)VIEW_FOCAL << 16;
     int32_t z = p.z < VIEW_ZNEAR ? VIEW_ZNEAR : p.z;
     screen_pt s;
-    s.x = clamp32(((int64_t)VIEW_CX << 16) + (int64_t)p.x * f / z, VIEW_W_FX);
-    s.y = clamp32(((int64_t)(VIEW_CY + v->look) << 16) - (int64_t)p.y * f / z, VIEW_H_FX);
+    s.x = view_subpixel(clamp32(((int64_t)VIEW_CX << 16) + view_persp(p.x, z), VIEW_W_FX));
+    s.y = view_subpixel(clamp32(((int64_t)(VIEW_CY + v->look) << 16) - view_persp(p.y, z), VIEW_H_FX));
     return s;
 }

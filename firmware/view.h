@@ -1,12 +1,39 @@
 /* view.h - the camera and the world-to-view transform (prefix view_).
  *
- * View space: x right, y up, z forward, in "view units": 18.14 fixed point in an
- * int32_t (VIEW_SHIFT). World coordinates lie inside +-32767 and heights inside
- * +-16383 (scene_format.h) and view_setup clamps the eye into that box, so a view
- * coordinate is at most 65534 * sqrt(2) < 2^16.5 units = 2^30.5 raw: it fits.
+ * View space: x right, y up, z forward, in "view units": fixed point with
+ * VIEW_SHIFT fraction bits in an int32_t (18.14 by default). World coordinates
+ * lie inside +-32767 and heights inside +-16383 (scene_format.h) and view_setup
+ * clamps the eye into that box, so a view coordinate is at most 65534 * sqrt(2)
+ * < 2^16.5 units = 2^(16.5 + VIEW_SHIFT) raw: it fits for VIEW_SHIFT <= 14.
  * Screen: 320x200, focal length 160 px on both axes, centre (160, 100 + look),
  * pixel (px, py) sampled at its centre (px + 0.5, py + 0.5); screen coordinates
  * are 16.16.
+ *
+ * Precision knobs (compile-time; make report measures each against the
+ * reference renderer). The defaults are the exact arithmetic the golden frames
+ * were recorded with; every other allowed value draws a slightly different,
+ * still gap-free frame, because a shared vertex still maps to one screen point.
+ *
+ *   VIEW_SHIFT          fraction bits of view space, 4..14 (default 14). Fewer
+ *                       bits quantise vertices to 2^-VIEW_SHIFT map units before
+ *                       projection, which moves edges near the eye most (an
+ *                       error of 2^-VIEW_SHIFT units at depth z is 160 / z
+ *                       times that in pixels). It changes no instruction on a
+ *                       64-bit host; a narrower target could keep the transform
+ *                       in fewer bits.
+ *   VIEW_SUBPIXEL_BITS  fraction bits kept of each projected screen coordinate,
+ *                       0..16 (default 16: all of 16.16). Below 16 x and y are
+ *                       rounded to the nearest 1/2^k pixel, as a renderer with
+ *                       k-bit subpixel vertices would see them: edges move by up
+ *                       to half of 1/2^k pixel at their ends.
+ *   VIEW_RECIP_BITS     0 (default): the perspective divide is an exact 64-bit
+ *                       division. 4..12: 1/z comes from a table of
+ *                       2^VIEW_RECIP_BITS reciprocals indexed by the bits of z
+ *                       below its leading one, then a multiply - what a core
+ *                       without a 64-bit divide (the Cortex-M3) wants. The
+ *                       relative error of 1/z is below 2^-(VIEW_RECIP_BITS + 1),
+ *                       i.e. up to 160 / 2^(VIEW_RECIP_BITS + 1) pixels at the
+ *                       screen's sides.
  */
 #ifndef VIEW_VIEW_H
 #define VIEW_VIEW_H
@@ -14,9 +41,29 @@
 #include <stdint.h>
 #include "fixed.h"
 
+#ifndef VIEW_SHIFT
 #define VIEW_SHIFT 14
+#endif
+#ifndef VIEW_SUBPIXEL_BITS
+#define VIEW_SUBPIXEL_BITS 16
+#endif
+#ifndef VIEW_RECIP_BITS
+#define VIEW_RECIP_BITS 0
+#endif
+#if VIEW_SHIFT < 4 || VIEW_SHIFT > 14
+#error "VIEW_SHIFT: 4..14 (view coordinates must fit an int32_t)"
+#endif
+#if VIEW_SUBPIXEL_BITS < 0 || VIEW_SUBPIXEL_BITS > 16
+#error "VIEW_SUBPIXEL_BITS: 0..16"
+#endif
+#if VIEW_RECIP_BITS != 0 && (VIEW_RECIP_BITS < 4 || VIEW_RECIP_BITS > 12)
+#error "VIEW_RECIP_BITS: 0 (exact divide) or 4..12"
+#endif
+
 #define VIEW_ONE (1 << VIEW_SHIFT)
-#define VIEW_ZNEAR 16            /* near plane: 16 / 2^14 = 1/1024 unit */
+/* The near plane at 1/1024 unit (16 raw by default); with fewer than 10 view
+ * bits, at one raw unit, the nearest plane they can express. */
+#define VIEW_ZNEAR (VIEW_SHIFT >= 10 ? 1 << (VIEW_SHIFT - 10) : 1)
 #define VIEW_FOCAL 160           /* pixels */
 #define VIEW_CX 160
 #define VIEW_CY 100
@@ -39,7 +86,7 @@ typedef struct {
 } view_xform;
 
 typedef struct {
-    int32_t x, y, z;     /* view space, 18.14 */
+    int32_t x, y, z;     /* view space, VIEW_SHIFT fraction bits */
 } view_pt;
 
 typedef struct {
@@ -56,11 +103,48 @@ static inline view_pt view_point(const view_xform *v, int32_t wx, int32_t wy, in
     view_pt p;
     /* |dx|,|dy| < 2^32 raw and |sin|,|cos| <= 2^30: each product < 2^62 and the
      * rotated sum is bounded by the vector length (< 2^62.5): no overflow.
-     * 16.16 * 2.30 has 46 fraction bits; >> 32 leaves 14. */
-    p.z = (int32_t)fx_asr64(dx * v->cos + dy * v->sin, 32);
-    p.x = (int32_t)fx_asr64(dx * v->sin - dy * v->cos, 32);
-    p.y = (int32_t)fx_asr64((int64_t)h - v->cz, 2);
+     * 16.16 * 2.30 has 46 fraction bits; VIEW_SHIFT of them are kept. */
+    p.z = (int32_t)fx_asr64(dx * v->cos + dy * v->sin, 46 - VIEW_SHIFT);
+    p.x = (int32_t)fx_asr64(dx * v->sin - dy * v->cos, 46 - VIEW_SHIFT);
+    p.y = (int32_t)fx_asr64((int64_t)h - v->cz, 16 - VIEW_SHIFT);
     return p;
+}
+
+#if VIEW_RECIP_BITS
+/* view_recip[j] = 2^(k + 32) / (2m + 1) rounded, m = 2^k + j, k = VIEW_RECIP_BITS:
+ * 2^(k + 31) / m at the middle of the bucket of z values that share those top
+ * k + 1 bits, in (2^30, 2^31). Generated by tools/gen_tables.c. */
+extern const uint32_t view_recip[1 << VIEW_RECIP_BITS];
+#endif
+
+/* a * VIEW_FOCAL / z in 16.16 pixels, for 1 <= z < 2^31: the perspective divide
+ * every projection goes through, so that the polygons and the column estimates
+ * of occlusion.c see the same screen positions. */
+static inline int64_t view_persp(int32_t a, int32_t z)
+{
+#if VIEW_RECIP_BITS
+    /* z = m * 2^(b - k) with m's leading one at bit k; 1/z ~ r / 2^(31 + b).
+     * |a| * r < 2^62; a quarter of that times 160 < 2^62. */
+    int b = 31 - __builtin_clz((uint32_t)z);
+    uint32_t m = b >= VIEW_RECIP_BITS ? (uint32_t)z >> (b - VIEW_RECIP_BITS) : (uint32_t)z << (VIEW_RECIP_BITS - b);
+    int64_t r = view_recip[m - (1u << VIEW_RECIP_BITS)];
+    return fx_asr64(fx_asr64((int64_t)a * r, 8) * VIEW_FOCAL, (unsigned)(7 + b));
+#else
+    /* |a| < 2^31 and focal * 2^16 < 2^24: the product is below 2^55. */
+    return (int64_t)a * ((int64_t)VIEW_FOCAL << 16) / z;
+#endif
+}
+
+/* A projected 16.16 coordinate in [0, 320 << 16] rounded to VIEW_SUBPIXEL_BITS
+ * fraction bits; the bounds are whole pixels, so it stays inside them. */
+static inline int32_t view_subpixel(int32_t s)
+{
+#if VIEW_SUBPIXEL_BITS < 16
+    const int32_t unit = (int32_t)1 << (16 - VIEW_SUBPIXEL_BITS);
+    return (s + unit / 2) & ~(unit - 1);
+#else
+    return s;
+#endif
 }
 
 /* Project a view point with z >= VIEW_ZNEAR that lies inside the frustum; the

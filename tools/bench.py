@@ -32,16 +32,17 @@ def compiled(scene, out_dir):
     return out
 
 
-def render_json(scene, view, *extra):
-    out = subprocess.run([str(RENDER), str(scene), "--at", view["at"], "--angle", view["angle"], *extra],
+def render_json(scene, view, *extra, render=RENDER):
+    out = subprocess.run([str(render), str(scene), "--at", view["at"], "--angle", view["angle"], *extra],
                          check=True, capture_output=True, text=True).stdout
     return json.loads(out)
 
 
-def instructions(scene, view, mode, repeat):
+def instructions(scene, view, mode, repeat, render=RENDER):
+    """Instructions callgrind counts for one run of `render` (a build/render binary)."""
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "cg.out"
-        subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", str(RENDER), str(scene),
+        subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", str(render), str(scene),
                         "--at", view["at"], "--angle", view["angle"], "--mode", mode, "--repeat", str(repeat)],
                        check=True, capture_output=True, text=True)
         for line in out.read_text().splitlines():

@@ -1,0 +1,129 @@
+"""The precision knobs and make report (mk/report.mk, tools/report.py), cheaply: every knob
+configuration compiles warning-free and an out-of-range value is refused; configuration "default"
+draws exactly what build/render draws while a coarse one draws something else and further from
+the reference; and the report's tables and figure come out of a tiny run without callgrind and
+out of fake points with instruction counts."""
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from conftest import BUILD, ROOT, SAN_ENV, render, run
+
+sys.path.insert(0, str(ROOT / "tools"))
+import accuracy  # noqa: E402
+import refrender  # noqa: E402
+import report  # noqa: E402
+
+KNOB = BUILD / "knob"
+VIEW = {"scene": "freedoom1.wad:E1M4", "at": "896,-1760", "angle": "135"}
+CFLAGS = ["-std=c11", "-Wall", "-Wextra", "-Wshadow", "-Wstrict-prototypes", "-Wno-missing-field-initializers",
+          "-Werror", "-ffreestanding", "-mgeneral-regs-only", "-Ifirmware", "-Ihal", "-fsyntax-only"]
+
+
+def configs():
+    out = subprocess.run(["make", "-s", "--no-print-directory", "report-configs"], cwd=ROOT, check=True,
+                         capture_output=True, text=True).stdout
+    table = dict(line.split(":", 1) for line in out.splitlines() if ":" in line)
+    return {name.strip(): flags.split() for name, flags in table.items()}
+
+
+def knob_render(config, sanitized=True):
+    path = KNOB / config / ("san/render" if sanitized else "render")
+    if not path.exists():
+        pytest.fail(f"{path} is missing: make {path.relative_to(ROOT)}")
+    return path
+
+
+def firmware_sources():
+    tables = BUILD / "gen" / "fx_tables.c"
+    if not tables.exists():
+        pytest.fail(f"{tables} is missing: run make first")
+    return sorted(str(p) for p in (ROOT / "firmware").glob("*.c")) + [str(tables)]
+
+
+def test_every_configuration_compiles():
+    table = configs()
+    assert "default" in table and not table["default"] and len(table) >= 5
+    knobs = {f.split("=")[0] for flags in table.values() for f in flags}
+    assert len(knobs) >= 4, knobs
+    srcs = firmware_sources()
+    procs = {name: subprocess.Popen(["cc", *CFLAGS, *flags, *srcs], cwd=ROOT, stderr=subprocess.PIPE, text=True)
+             for name, flags in table.items()}
+    errors = {name: p.communicate()[1] for name, p in procs.items()}
+    bad = {name: err for name, err in errors.items() if procs[name].returncode != 0 or err.strip()}
+    assert not bad, "\n".join(f"{n}:\n{e}" for n, e in bad.items())
+
+
+@pytest.mark.parametrize("flag", ["-DVIEW_SUBPIXEL_BITS=17", "-DRAST_STEP_BITS=3", "-DVIEW_RECIP_BITS=13",
+                                  "-DVIEW_SHIFT=15", "-DFX_SIN_BITS=13", "-DFX_SIN_LERP=2"])
+def test_out_of_range_knob_is_refused(flag):
+    proc = subprocess.run(["cc", *CFLAGS, flag, "firmware/view.c", "firmware/raster.c", "firmware/fixed.c"],
+                          cwd=ROOT, capture_output=True, text=True)
+    assert proc.returncode != 0 and "#error" in proc.stderr, proc.stderr
+
+
+def ids_of(binary, tmp_path, mode):
+    out = tmp_path / f"{binary.parent.name}-{mode}.ids"
+    proc = run([binary, VIEW["scene"], "--at", VIEW["at"], "--angle", VIEW["angle"], "--mode", mode, "--ids", out],
+               env=SAN_ENV)
+    return json.loads(proc.stdout), accuracy.read_ids(out)
+
+
+@pytest.mark.parametrize("mode", ["spans", "painter"])
+def test_default_is_exact_and_a_coarse_knob_is_not(mode, tmp_path):
+    plain = render(VIEW["scene"], "--mode", mode, at=VIEW["at"], angle=VIEW["angle"], sanitized=False)
+    default_json, default_ids = ids_of(knob_render("default", sanitized=False), tmp_path, mode)
+    coarse_json, coarse_ids = ids_of(knob_render("subpix0"), tmp_path, mode)
+    assert default_json["crc32"] == plain["crc32"]
+    assert coarse_json["crc32"] != plain["crc32"]
+    x, y = (float(c) for c in VIEW["at"].split(","))
+    ref = refrender.render_ids(VIEW["scene"], x, y, float(plain["camera"]["z"]), float(VIEW["angle"]))
+    assert accuracy.differ(ref, coarse_ids) > accuracy.differ(ref, default_ids)
+    assert accuracy.edge_displacement(ref, coarse_ids) > accuracy.edge_displacement(ref, default_ids)
+    # whole-pixel vertices still leave no gap and no pixel drawn twice
+    assert int(np.count_nonzero((coarse_ids >> 24) == 0)) == 0
+    if mode == "spans":
+        assert coarse_json["overdraw"] == 1.0 and coarse_json["pixels_written"] == 64000
+
+
+def test_report_runs_on_one_view_without_callgrind(tmp_path):
+    knob_render("default", sanitized=False), knob_render("subpix0", sanitized=False)
+    proc = subprocess.run([sys.executable, str(ROOT / "tools/report.py"), "--configs", "default", "subpix0",
+                           "--views", "1", "--no-ir", "--jobs", "1", "--out", str(tmp_path)],
+                          cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert "report:" in proc.stderr
+    md = (tmp_path / "report.md").read_text()
+    for row in ("| **default** | — | spans |", "| **default** | — | painter |",
+                "| subpix0 | -DVIEW_SUBPIXEL_BITS=0 | spans |", "| subpix0 | -DVIEW_SUBPIXEL_BITS=0 | painter |"):
+        assert row in md, md
+    assert (tmp_path / "error_vs_ir.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    points = {(p["config"], p["mode"]): p for p in json.loads((tmp_path / "points.json").read_text())["points"]}
+    assert points[("default", "spans")]["views"] == 1
+    assert points[("subpix0", "spans")]["mean_differ"] > points[("default", "spans")]["mean_differ"]
+    assert any((tmp_path / "ref").glob("*.bin"))
+
+
+def test_report_writes_tables_and_figure_from_fake_points(tmp_path):
+    views = [{"set": "bench", "group": "bench", "name": "a"}, {"set": "extreme", "group": "s1", "name": "s1/v"}]
+    errors = [{"differ": 0.01, "edge": 2, "hist": [[2, 99]]},
+              {"differ": 0.03, "edge": report.CAP, "hist": [[1, 50], [report.CAP, 1]], "failed": 1}]
+    points = [report.summarise("default", "", "spans", views, errors, [1000, 3000]),
+              report.summarise("cheap", "-DRAST_STEP_BITS=8 -DVIEW_RECIP_BITS=8", "painter", views, errors[:1], [500])]
+    assert points[0]["ir"] == 2000 and points[0]["worst_differ"] == 0.03 and points[0]["worst_view"] == "s1/v"
+    assert points[0]["mean_differ_bench"] == 0.01 and points[0]["p99_edge"] == 2 and points[0]["failed"] == ["s1/v"]
+    per_scene = {"s1": {"views": 1, "spans": {"differ": 0.03, "edge": 320}, "painter": {"differ": 0.0, "edge": 0}}}
+    report.plot(tmp_path / "p.png", points, no_ir=False)
+    report.write_markdown(tmp_path / "r.md", points, per_scene, views,
+                          {"default": "", "cheap": points[1]["flags"]}, "p.png", no_ir=False)
+    md = (tmp_path / "r.md").read_text()
+    assert "| **default** | — | spans | 2,000 | +0.0% | 2.000% |" in md, md
+    assert "| s1 | 1 | 3.00% | 320 | 0.00% | 0 |" in md, md
+    assert "Failed renders" in md
+    assert (tmp_path / "p.png").stat().st_size > 10000
+    assert report.hist_percentile([0, 0, 5], 99) == 2 and report.hist_percentile([0] * 4, 99) == 0
+    assert points[0]["worst_moved_edge"] == 2 and points[0]["worst_edge"] == report.CAP
+    assert report.sparse_hist(np.array([3, 3, 400])) == [[3, 2], [report.CAP, 1]]

@@ -1,0 +1,526 @@
+#!/usr/bin/env python3
+"""make report: error against run time, per render mode and precision-knob configuration.
+
+Each configuration is a build/knob/NAME/render built by mk/report.mk with the knob flags in
+build/knob/NAME/flags ("default" has none). For each configuration and render mode (spans,
+painter):
+
+- error, over the views of tests/bench_views.json and every view of the extreme scenes'
+  manifests (tests/scenes/extreme/*.json): the surface-id buffer against the reference renderer's
+  (tools/refrender.py), with tools/accuracy.py's figures: the share of differing pixels, and the
+  displacement of each differing pixel from its surface in the other buffer (320 when that surface
+  is not within accuracy.SEARCH pixels: a sliver one buffer lacks, or a larger shift);
+- run time, over the bench views only: instructions per frame with callgrind, as tools/bench.py
+  counts them ((Ir of --repeat 3 - Ir of --repeat 1) / 2).
+
+Writes OUT/report.md (default build/report/) with a table of every point, OUT/error_vs_ir.png
+(mean differing share and worst edge displacement against median instructions per frame, the
+default configuration marked), and a per-scene table of the extreme scenes for the default
+configuration. Reference id buffers are kept in OUT/ref/, and every measured figure in
+OUT/cache.json keyed by the binary's and the scene's contents, so a re-run only measures what
+changed. Progress goes to stderr. A report, not a test: it asserts nothing about the figures.
+
+usage: tools/report.py [--configs NAME ...] [--views N] [--no-ir] [--jobs N] [--out DIR]
+"""
+import argparse
+import concurrent.futures as cf
+import hashlib
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import accuracy  # noqa: E402
+import bench  # noqa: E402
+import refrender  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
+BUILD = ROOT / "build"
+KNOB = BUILD / "knob"
+EXTREME = ROOT / "tests" / "scenes" / "extreme"
+MODES = bench.MODES
+DEFAULT = "default"
+CAP = accuracy.CAP
+CACHE_VERSION = 1
+
+
+def log(msg):
+    print(f"report: {msg}", file=sys.stderr, flush=True)
+
+
+def digest(data):
+    return hashlib.sha1(data).hexdigest()
+
+
+def file_digest(path):
+    return digest(Path(path).read_bytes())
+
+
+# ---- views -----------------------------------------------------------------------------------
+
+def load_views():
+    """The bench views, then every view of every extreme manifest that parses (a manifest that
+    does not is reported and left out: they are written alongside)."""
+    views = []
+    for v in json.loads((ROOT / "tests/bench_views.json").read_text())["views"]:
+        views.append({"set": "bench", "group": "bench", "scene": v["scene"], "source": None,
+                      "name": f"{v['scene']} @ {v['at']} {v['angle']}°",
+                      "at": v["at"], "angle": v["angle"], "look": 0})
+    for path in sorted(EXTREME.glob("*.json")):
+        try:
+            m = json.loads(path.read_text())
+            scene = path.parent / m["scene"]
+            if not scene.is_file():
+                raise ValueError(f"no scene {scene}")
+            for v in m["views"]:
+                views.append({"set": "extreme", "group": path.stem, "scene": str(scene), "source": scene,
+                              "name": f"{path.stem}/{v['name']}", "at": str(v["at"]), "angle": str(v["angle"]),
+                              "look": int(v.get("look") or 0)})
+        except (ValueError, KeyError, TypeError) as e:
+            log(f"{path.name}: left out ({e})")
+    return views
+
+
+def compiled(view, out_dir):
+    """The view's scene compiled by build/bspc once (a text scene again when it changes)."""
+    src = view["source"]
+    if src is None:
+        return bench.compiled(view["scene"], out_dir)
+    out = out_dir / (Path(src).stem + ".bsc")
+    if not out.exists() or out.stat().st_mtime < Path(src).stat().st_mtime:
+        subprocess.run([str(BUILD / "bspc"), str(src), "-o", str(out)], check=True, capture_output=True)
+    return out
+
+
+def scene_key(view):
+    """What the view's picture depends on besides the camera: the map's contents."""
+    return view["scene"] if view["source"] is None else file_digest(view["source"])
+
+
+def camera_args(view):
+    return ["--at", view["at"], "--angle", view["angle"]] + (["--look", str(view["look"])] if view["look"] else [])
+
+
+# ---- the reference ---------------------------------------------------------------------------
+
+def reference(view, z, ref_dir):
+    """The reference id buffer of a view (eye height z as the C renderer used it), cached."""
+    key = digest(json.dumps([scene_key(view), view["at"], view["angle"], view["look"], z,
+                             file_digest(refrender.__file__)]).encode())[:16]
+    safe = "".join(c if c.isalnum() or c in "-_." else "_" for c in view["name"])[:80]
+    path = ref_dir / f"{safe}.{key}.bin"
+    if not path.exists():
+        x, y = (float(c) for c in view["at"].split(",")[:2])
+        ids = refrender.render_ids(view["scene"], x, y, z, float(view["angle"]), view["look"])
+        tmp = path.with_suffix(".tmp")
+        refrender.write_ids(tmp, ids)
+        tmp.replace(path)
+    return path
+
+
+def _reference_task(args):
+    view, z, ref_dir = args
+    return str(reference(view, z, ref_dir))
+
+
+# ---- measuring one point -----------------------------------------------------------------------
+
+def _error_task(args):
+    """Render one view with one binary and mode; compare with the reference. Runs in a worker."""
+    render, bsc, view, mode, ref_path = args
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "ids.bin"
+        proc = subprocess.run([str(render), str(bsc), *camera_args(view), "--mode", mode, "--ids", str(out)],
+                              capture_output=True, text=True)
+        if proc.returncode != 0:
+            # a render that fails shows nothing: counted as every pixel wrong, and reported
+            return {"differ": 1.0, "edge": CAP, "hist": [], "failed": proc.returncode}
+        ids = accuracy.read_ids(out)
+    ref = accuracy.read_ids(ref_path)
+    d = accuracy.edge_distances(ref, ids)
+    return {
+        "differ": accuracy.differ(ref, ids),
+        "edge": int(d.max()) if d.size else 0,
+        "hist": sparse_hist(d),
+    }
+
+
+def sparse_hist(distances):
+    """[[distance, count], ...] for the distances that occur (most views have few differing pixels)."""
+    counts = np.bincount(np.minimum(distances, CAP), minlength=CAP + 1) if distances.size else np.zeros(0, int)
+    return [[int(v), int(n)] for v, n in enumerate(counts) if n]
+
+
+def dense_hist(pairs):
+    hist = np.zeros(CAP + 1, dtype=np.int64)
+    for v, n in pairs:
+        hist[v] += n
+    return hist
+
+
+def _ir_task(args):
+    render, bsc, view, mode = args
+    cg_view = {"at": view["at"], "angle": view["angle"]}
+    return (bench.instructions(bsc, cg_view, mode, 3, render=render)
+            - bench.instructions(bsc, cg_view, mode, 1, render=render)) // 2
+
+
+class Cache:
+    """Measured figures by key, in one JSON file; written after every batch. Only the entries this
+    run used are written back, so figures of binaries since rebuilt do not pile up."""
+
+    def __init__(self, path):
+        self.path = path
+        self.data = {}
+        self.used = {}
+        try:
+            d = json.loads(path.read_text())
+            if d.get("version") == CACHE_VERSION:
+                self.data = d["entries"]
+        except (OSError, ValueError, KeyError):
+            pass
+
+    def get(self, key):
+        value = self.data.get(key)
+        if value is not None:
+            self.used[key] = value
+        return value
+
+    def put(self, key, value):
+        self.data[key] = self.used[key] = value
+
+    def save(self):
+        tmp = self.path.with_suffix(".tmp")
+        tmp.write_text(json.dumps({"version": CACHE_VERSION, "entries": self.used}))
+        tmp.replace(self.path)
+
+
+def run_tasks(pool, fn, tasks, what, every=25):
+    """Map fn over tasks in the pool, in order, logging progress."""
+    out, t0 = [], time.time()
+    for i, r in enumerate(pool.map(fn, tasks), 1):
+        out.append(r)
+        if i % every == 0 or i == len(tasks):
+            log(f"{what}: {i}/{len(tasks)} ({time.time() - t0:.0f} s)")
+    return out
+
+
+# ---- summaries -------------------------------------------------------------------------------
+
+def hist_percentile(hist, q):
+    """The q-th percentile (nearest rank) of the values counted in hist (index = value)."""
+    total = sum(hist)
+    if total == 0:
+        return 0
+    rank = max(1, int(np.ceil(q / 100.0 * total)))
+    acc = 0
+    for v, n in enumerate(hist):
+        acc += n
+        if acc >= rank:
+            return v
+    return len(hist) - 1
+
+
+def summarise(config, flags, mode, views, errors, irs):
+    """One point: the figures of a configuration and mode over the views."""
+    differ = [e["differ"] for e in errors]
+    bench_differ = [e["differ"] for e, v in zip(errors, views) if v["set"] == "bench"]
+    ext_differ = [e["differ"] for e, v in zip(errors, views) if v["set"] == "extreme"]
+    hist = dense_hist([pair for e in errors for pair in e["hist"]]).tolist()
+    worst = max(range(len(errors)), key=lambda i: (errors[i]["differ"], errors[i]["edge"])) if errors else None
+    return {
+        "config": config, "flags": flags, "mode": mode,
+        "ir": int(statistics.median(irs)) if irs else None,
+        "views": len(errors),
+        "mean_differ": float(np.mean(differ)) if differ else 0.0,
+        "mean_differ_bench": float(np.mean(bench_differ)) if bench_differ else None,
+        "mean_differ_extreme": float(np.mean(ext_differ)) if ext_differ else None,
+        "worst_differ": max(differ) if differ else 0.0,
+        "worst_view": views[worst]["name"] if worst is not None else "",
+        "worst_edge": max((e["edge"] for e in errors), default=0),
+        "worst_moved_edge": max((v for v, n in enumerate(hist[:CAP]) if n), default=0),
+        "p99_edge": hist_percentile(hist, 99),
+        "views_at_cap": sum(1 for e in errors if e["edge"] >= CAP),
+        "failed": [views[i]["name"] for i, e in enumerate(errors) if e.get("failed") is not None],
+    }
+
+
+def pct(x, digits=3):
+    return "—" if x is None else f"{100 * x:.{digits}f}%"
+
+
+def write_markdown(path, points, per_scene, views, configs, png_name, no_ir):
+    """The report: how it was measured, every point, the default's extreme scenes."""
+    n_bench = sum(1 for v in views if v["set"] == "bench")
+    groups = sorted({v["group"] for v in views if v["set"] == "extreme"})
+    n_ext = len(views) - n_bench
+    default_ir = {p["mode"]: p["ir"] for p in points if p["config"] == DEFAULT}
+    lines = [
+        "# Error against run time",
+        "",
+        f"Views: {n_bench} bench views (tests/bench_views.json) and {n_ext} views of {len(groups)} extreme "
+        f"scenes (tests/scenes/extreme/). Error: each view's surface ids against tools/refrender.py "
+        f"(tools/accuracy.py): the share of differing pixels, and the displacement of edges: for each "
+        f"differing pixel, the distance in pixels (rows or columns) to its surface in the other buffer, 320 "
+        f"when that is not within {accuracy.SEARCH} pixels. Run time: "
+        + ("not measured (--no-ir)." if no_ir else
+           "instructions per frame on x86-64 (callgrind, (Ir of --repeat 3 - Ir of --repeat 1) / 2), "
+           "the median over the bench views."),
+        "",
+        "Columns: *mean differ* over all views (and over the bench and extreme views apart), *worst differ* "
+        "and the view it is on, *worst edge* the largest displacement on any view (320: a surface one "
+        "buffer lacks there, such as a sliver of wall, or a shift of more than "
+        f"{accuracy.SEARCH} pixels), *worst moved edge* the largest displacement below that (an edge both "
+        "buffers have, moved), *p99 edge* the 99th percentile of the displacements of all differing pixels "
+        "pooled over the views, *views at 320* the views with a displacement of 320.",
+        "",
+        f"![error against instructions per frame]({png_name})",
+        "",
+        "| config | flags | mode | median Ir/frame | vs default | mean differ | bench | extreme | worst differ "
+        "| worst view | worst edge px | worst moved edge px | p99 edge px | views at 320 |",
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|",
+    ]
+    for p in points:
+        base = default_ir.get(p["mode"])
+        rel = "—" if p["ir"] is None or not base else f"{100.0 * (p['ir'] - base) / base:+.1f}%"
+        name = f"**{p['config']}**" if p["config"] == DEFAULT else p["config"]
+        lines.append(
+            f"| {name} | {p['flags'] or '—'} | {p['mode']} | {'—' if p['ir'] is None else format(p['ir'], ',')} "
+            f"| {rel} | {pct(p['mean_differ'])} | {pct(p['mean_differ_bench'])} | {pct(p['mean_differ_extreme'])} "
+            f"| {pct(p['worst_differ'], 2)} | {p['worst_view']} | {p['worst_edge']} | {p['worst_moved_edge']} "
+            f"| {p['p99_edge']} "
+            f"| {p['views_at_cap']} |")
+    failed = [(p["config"], p["mode"], n) for p in points for n in p["failed"]]
+    if failed:
+        lines += ["", f"Failed renders (counted as every pixel differing, displacement 320): {len(failed)}: "
+                  + "; ".join(f"{c}/{m} {n}" for c, m, n in failed[:20]) + ("; ..." if len(failed) > 20 else "")]
+    if per_scene:
+        lines += [
+            "",
+            f"## Extreme scenes, configuration {DEFAULT}",
+            "",
+            "Worst share of differing pixels and worst edge displacement over each scene's views.",
+            "",
+            "| scene | views | " + " | ".join(f"{m} worst differ | {m} worst edge px" for m in MODES) + " |",
+            "|---|---:|" + "---:|---:|" * len(MODES),
+        ]
+        for scene, row in per_scene.items():
+            cells = " | ".join(f"{pct(row[m]['differ'], 2)} | {row[m]['edge']}" for m in MODES)
+            lines.append(f"| {scene} | {row['views']} | {cells} |")
+    lines += ["", "Configurations (mk/report.mk): " +
+              "; ".join(f"{c} = {configs[c] or '(no flags)'}" for c in configs) + "."]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def family(config, flags):
+    """The knob a configuration turns, for the plot's colours."""
+    if config == DEFAULT:
+        return "default"
+    knobs = {f.split("=")[0].lstrip("-D") for f in flags.split()}
+    if len(knobs) > 1 and "FX_SIN_LERP" not in knobs:
+        return "combined"
+    return {"VIEW_SUBPIXEL_BITS": "subpixel bits", "RAST_STEP_BITS": "edge step bits",
+            "VIEW_RECIP_BITS": "reciprocal table", "VIEW_SHIFT": "view-space bits",
+            "FX_SIN_BITS": "sine table", "FX_SIN_LERP": "sine table"}.get(sorted(knobs)[0], "other")
+
+
+def _place_labels(ax, items, fontsize=7):
+    """Write each point's label beside it, moved up or down in steps of a line until it no longer
+    overlaps a label already written (the points of nearly equal configurations coincide)."""
+    fig = ax.figure
+    fig.canvas.draw()
+    px_per_pt = fig.dpi / 72.0
+    line = fontsize * 1.3  # points
+    placed = []
+    for x, y, text, colour in sorted(items, key=lambda t: (t[0], t[1])):
+        px, py = ax.transData.transform((x, y)) / px_per_pt  # in points
+        w = len(text) * fontsize * 0.6
+        for k in [0, 1, -1, 2, -2, 3, -3, 4, -4, 5, -5, 6, -6, 7, -7, 8, -8, 9, -9, 10, -10]:
+            box = (px + 5, py - 3 + k * line, px + 5 + w, py - 3 + (k + 1) * line)
+            if not any(box[0] < b[2] and b[0] < box[2] and box[1] < b[3] and b[1] < box[3] for b in placed):
+                break
+        placed.append(box)
+        ax.annotate(text, (x, y), xytext=(5, -3 + k * line), textcoords="offset points", fontsize=fontsize,
+                    color=colour, arrowprops=dict(arrowstyle="-", color=colour, lw=0.4, alpha=0.6) if k else None)
+
+
+def plot(path, points, no_ir):
+    """Per render mode (a column each), against median instructions per frame: the mean share of
+    differing pixels (top) and the largest displacement of an edge both buffers have (bottom)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fams = sorted({family(p["config"], p["flags"]) for p in points} - {"default"})
+    colours = {f: plt.get_cmap("tab10")(i % 10) for i, f in enumerate(fams)}
+    colours["default"] = "black"
+    modes = [m for m in MODES if any(p["mode"] == m for p in points)]
+    order = {c: i for i, c in enumerate(dict.fromkeys(p["config"] for p in points))}
+    rows = [("mean_differ", "mean share of pixels differing\nfrom the reference (%)", 100.0, 0.001),
+            ("worst_moved_edge", f"worst edge displacement (px),\nbelow 320 (found within {accuracy.SEARCH} px)", 1.0, 1.0)]
+    fig, axes = plt.subplots(len(rows), len(modes), figsize=(7.5 * len(modes), 10), squeeze=False, sharey="row")
+    labels = []
+    for col, mode in enumerate(modes):
+        pts = [p for p in points if p["mode"] == mode]
+        for row, (key, ylabel, scale, linthresh) in enumerate(rows):
+            ax = axes[row][col]
+            items = []
+            for p in pts:
+                x = order[p["config"]] if no_ir or p["ir"] is None else p["ir"]
+                y = p[key] * scale
+                fam = family(p["config"], p["flags"])
+                if p["config"] == DEFAULT:
+                    ax.scatter([x], [y], marker="*", s=420, c="gold", edgecolors="black", linewidths=1.5, zorder=5)
+                else:
+                    ax.scatter([x], [y], marker="o", s=46, color=colours[fam], edgecolors="black", linewidths=0.4,
+                               zorder=3)
+                items.append((x, y, p["config"], colours[fam]))
+            ax.set_yscale("symlog", linthresh=linthresh)
+            ax.margins(x=0.2, y=0.15)
+            ax.grid(True, which="both", alpha=0.3)
+            if col == 0:
+                ax.set_ylabel(ylabel)
+            if row == 0:
+                ax.set_title(f"mode {mode}")
+            if row == len(rows) - 1:
+                ax.set_xlabel("configuration (instructions not measured: --no-ir)" if no_ir else
+                              "median instructions per frame, bench views (x86-64, callgrind)")
+            labels.append((ax, items))
+    handles = [plt.Line2D([], [], marker="*", color="gold", markeredgecolor="black", markersize=15, linestyle="",
+                          label="default")]
+    handles += [plt.Line2D([], [], marker="o", color=colours[f], linestyle="", label=f) for f in fams]
+    axes[0][0].legend(handles=handles, fontsize=8, loc="lower right")
+    fig.suptitle("Precision knobs: error against the reference renderer vs. instructions per frame")
+    fig.tight_layout()
+    for ax, items in labels:  # placed in figure pixels, so after the layout is final
+        _place_labels(ax, items)
+    fig.savefig(path, dpi=fig.dpi)
+    plt.close(fig)
+
+
+# ---- main ------------------------------------------------------------------------------------
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(prog="report.py", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--configs", nargs="+", default=[DEFAULT],
+                    help="configuration names (build/knob/NAME/render); the first named 'default' is marked")
+    ap.add_argument("--views", type=int, default=0, help="only the first N views (bench views first)")
+    ap.add_argument("--no-ir", action="store_true", help="no instruction counts (no callgrind)")
+    ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="parallel workers")
+    ap.add_argument("--knob-dir", type=Path, default=KNOB, help="where the configurations' binaries are")
+    ap.add_argument("--out", type=Path, default=BUILD / "report", help="output folder")
+    args = ap.parse_args(argv)
+
+    t_start = time.time()
+    configs = {}
+    for c in args.configs:
+        render = args.knob_dir / c / "render"
+        if not render.exists():
+            log(f"{render} is missing: make {render.relative_to(ROOT) if render.is_relative_to(ROOT) else render}")
+            return 2
+        flags_file = args.knob_dir / c / "flags"
+        configs[c] = flags_file.read_text().strip() if flags_file.exists() else ""
+    views = load_views()
+    if args.views:
+        views = views[:args.views]
+    out = args.out
+    (out / "ref").mkdir(parents=True, exist_ok=True)
+    bsc_dir = BUILD / "report" / "bsc"
+    bsc_dir.mkdir(parents=True, exist_ok=True)
+    cache = Cache(out / "cache.json")
+    log(f"{len(configs)} configurations x {len(MODES)} modes, {len(views)} views "
+        f"({sum(v['set'] == 'bench' for v in views)} bench), {args.jobs} workers")
+
+    bscs = [compiled(v, bsc_dir) for v in views]
+    default_render = args.knob_dir / (DEFAULT if DEFAULT in configs else args.configs[0]) / "render"
+    # the eye height the C renderer uses (the floor under the eye + 41 unless given) is the one
+    # the reference is asked for, as tests/test_accuracy.py does
+    zs = []
+    for v, bsc in zip(views, bscs):
+        j = json.loads(subprocess.run([str(default_render), str(bsc), *camera_args(v)], check=True,
+                                      capture_output=True, text=True).stdout)
+        zs.append(float(j["camera"]["z"]))
+    with cf.ProcessPoolExecutor(max_workers=args.jobs) as pool:
+        refs = run_tasks(pool, _reference_task, [(v, z, out / "ref") for v, z in zip(views, zs)],
+                         "reference id buffers")
+        bin_digest = {c: file_digest(args.knob_dir / c / "render") for c in configs}
+        view_keys = [digest(json.dumps([scene_key(v), v["at"], v["angle"], v["look"]]).encode()) for v in views]
+        ref_keys = {r: file_digest(r) for r in refs}
+        accuracy_digest = file_digest(accuracy.__file__)[:12]
+
+        # error: every configuration, mode and view
+        errors = {}
+        todo, todo_keys = [], []
+        for c in configs:
+            for m in MODES:
+                for i, v in enumerate(views):
+                    key = f"error:{bin_digest[c]}:{m}:{view_keys[i]}:{ref_keys[refs[i]]}:{accuracy_digest}"
+                    hit = cache.get(key)
+                    if hit is None:
+                        todo.append((args.knob_dir / c / "render", bscs[i], v, m, refs[i]))
+                        todo_keys.append((c, m, i, key))
+                    errors[(c, m, i)] = hit
+        log(f"error: {len(todo)} renders to compare ({len(errors) - len(todo)} cached)")
+        for (c, m, i, key), r in zip(todo_keys, run_tasks(pool, _error_task, todo, "error", every=100)):
+            errors[(c, m, i)] = r
+            cache.put(key, r)
+        cache.save()
+
+    # run time: every configuration and mode on the bench views
+    irs = {}
+    if not args.no_ir:
+        todo, todo_keys = [], []
+        for c in configs:
+            for m in MODES:
+                for i, v in enumerate(views):
+                    if v["set"] != "bench":
+                        continue
+                    key = f"ir:{bin_digest[c]}:{m}:{view_keys[i]}"
+                    hit = cache.get(key)
+                    if hit is None:
+                        todo.append((args.knob_dir / c / "render", bscs[i], v, m))
+                        todo_keys.append((c, m, i, key))
+                    irs[(c, m, i)] = hit
+        log(f"instructions per frame: {len(todo)} callgrind pairs ({len(irs) - len(todo)} cached)")
+        with cf.ThreadPoolExecutor(max_workers=args.jobs) as pool:
+            for (c, m, i, key), r in zip(todo_keys, run_tasks(pool, _ir_task, todo, "callgrind", every=20)):
+                irs[(c, m, i)] = r
+                cache.put(key, r)
+        cache.save()
+
+    points = []
+    for c in configs:
+        for m in MODES:
+            errs = [errors[(c, m, i)] for i in range(len(views))]
+            ir = [irs[(c, m, i)] for i, v in enumerate(views) if (c, m, i) in irs]
+            points.append(summarise(c, configs[c], m, views, errs, ir))
+    per_scene = {}
+    if DEFAULT in configs:
+        for i, v in enumerate(views):
+            if v["set"] != "extreme":
+                continue
+            row = per_scene.setdefault(v["group"], {"views": 0, **{m: {"differ": 0.0, "edge": 0} for m in MODES}})
+            row["views"] += 1
+            for m in MODES:
+                e = errors[(DEFAULT, m, i)]
+                row[m]["differ"] = max(row[m]["differ"], e["differ"])
+                row[m]["edge"] = max(row[m]["edge"], e["edge"])
+
+    png = out / "error_vs_ir.png"
+    plot(png, points, args.no_ir)
+    write_markdown(out / "report.md", points, per_scene, views, configs, png.name, args.no_ir)
+    (out / "points.json").write_text(json.dumps({"points": points, "per_scene": per_scene}, indent=1))
+    log(f"wrote {out / 'report.md'} and {png} in {time.time() - t_start:.0f} s")
+    print((out / "report.md").read_text())
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
