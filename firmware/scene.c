@@ -8,6 +8,7 @@
 static const uint32_t record_bytes[SCN_SEC_COUNT] = {
     sizeof(scn_vertex), sizeof(scn_sector), sizeof(scn_line), sizeof(scn_seg),
     sizeof(scn_node), sizeof(scn_leaf), sizeof(scn_vertex), 3,
+    sizeof(scn_model), sizeof(scn_mvert), sizeof(scn_face), sizeof(uint32_t), sizeof(scn_object),
 };
 
 const char *scene_status_text(scene_status st)
@@ -24,6 +25,7 @@ const char *scene_section_name(int section)
 {
     static const char *const names[SCN_SEC_COUNT] = {
         "vertices", "sectors", "lines", "segs", "nodes", "leaves", "leaf polygon vertices", "palette",
+        "models", "model vertices", "faces", "face indices", "objects",
     };
     return (section >= 0 && section < SCN_SEC_COUNT) ? names[section] : "header";
 }
@@ -68,6 +70,16 @@ static scene_status check_sections(scene *s, const uint8_t *base, const scn_head
     s->nnodes = h->sec[SCN_SEC_NODES].count;
     s->nleaves = h->sec[SCN_SEC_LEAVES].count;
     s->npverts = h->sec[SCN_SEC_PVERTS].count;
+    s->models = (const scn_model *)(base + h->sec[SCN_SEC_MODELS].offset);
+    s->mverts = (const scn_mvert *)(base + h->sec[SCN_SEC_MVERTS].offset);
+    s->faces = (const scn_face *)(base + h->sec[SCN_SEC_FACES].offset);
+    s->findex = (const uint32_t *)(base + h->sec[SCN_SEC_FINDEX].offset);
+    s->objects = (const scn_object *)(base + h->sec[SCN_SEC_OBJECTS].offset);
+    s->nmodels = h->sec[SCN_SEC_MODELS].count;
+    s->nmverts = h->sec[SCN_SEC_MVERTS].count;
+    s->nfaces = h->sec[SCN_SEC_FACES].count;
+    s->nfindex = h->sec[SCN_SEC_FINDEX].count;
+    s->nobjects = h->sec[SCN_SEC_OBJECTS].count;
     return SCENE_OK;
 }
 

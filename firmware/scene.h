@@ -17,7 +17,13 @@ typedef struct {
     const scn_leaf *leaves;
     const scn_vertex *pverts;
     const uint8_t *palette; /* 768 bytes */
+    const scn_model *models;
+    const scn_mvert *mverts;
+    const scn_face *faces;
+    const uint32_t *findex;
+    const scn_object *objects;
     uint32_t nverts, nsectors, nlines, nsegs, nnodes, nleaves, npverts;
+    uint32_t nmodels, nmverts, nfaces, nfindex, nobjects;
     uint32_t root;
 } scene;
 

@@ -16,7 +16,7 @@
 #include <stdint.h>
 
 #define SCN_MAGIC 0x4E435342u /* bytes "BSCN" */
-#define SCN_VERSION 1u
+#define SCN_VERSION 2u
 #define SCN_NONE 0xFFFFFFFFu     /* "no sector" / "no index" */
 #define SCN_LEAF_BIT 0x80000000u /* child index refers to a leaf */
 
@@ -25,6 +25,12 @@
 #define SCN_HEIGHT_MAX 16383 /* |floor|, |ceiling| heights, whole units */
 #define SCN_MAX_DEPTH 255    /* deepest node path the walk stack supports */
 #define SCN_MAX_LEAF_VERTS 64 /* most vertices of a leaf floor polygon (clip.h has room for 5 more) */
+/* Objects (docs/objects.md) */
+#define SCN_MODEL_MAX 1024       /* |x|, |y|, |z| of a model vertex, whole units */
+#define SCN_MAX_MODEL_VERTS 64   /* vertices of one model */
+#define SCN_MAX_MODEL_FACES 64   /* faces of one model */
+#define SCN_MAX_FACE_VERTS 16    /* vertices of one face (clip.h has room for 5 more) */
+#define SCN_MAX_OBJECTS 4096     /* objects of one scene */
 
 enum scn_section_id {
     SCN_SEC_VERTICES, /* scn_vertex[]: original vertices first, then split points */
@@ -35,6 +41,11 @@ enum scn_section_id {
     SCN_SEC_LEAVES,   /* scn_leaf[] */
     SCN_SEC_PVERTS,   /* scn_vertex[]: leaf floor polygons, convex, counter-clockwise */
     SCN_SEC_PALETTE,  /* 768 bytes: 256 x (r, g, b), 8 bits per gun; count = 256 */
+    SCN_SEC_MODELS,   /* scn_model[] (docs/objects.md) */
+    SCN_SEC_MVERTS,   /* scn_mvert[]: model vertices, model by model */
+    SCN_SEC_FACES,    /* scn_face[]: model faces, model by model */
+    SCN_SEC_FINDEX,   /* uint32_t[]: face vertex numbers, relative to the model's first vertex */
+    SCN_SEC_OBJECTS,  /* scn_object[]: placed objects */
     SCN_SEC_COUNT
 };
 
@@ -62,11 +73,13 @@ typedef struct {
     int32_t x, y; /* 16.16 */
 } scn_vertex;
 
-#define SCN_SECTOR_SKY 1u /* ceiling is sky */
+#define SCN_SECTOR_SKY 1u  /* ceiling is sky */
+#define SCN_SECTOR_DOOR 2u /* a door: the ceiling moves between ceil_h (closed) and open_h */
 
 typedef struct {
-    int32_t floor_h, ceil_h; /* 16.16 */
+    int32_t floor_h, ceil_h; /* 16.16; ceil_h is a door's closed ceiling */
     uint8_t floor_color, ceil_color, light, flags;
+    int32_t open_h;          /* 16.16: a door's open ceiling (>= ceil_h); ceil_h for other sectors */
 } scn_sector;
 
 enum { SCN_PART_UPPER, SCN_PART_MIDDLE, SCN_PART_LOWER };
@@ -95,5 +108,37 @@ typedef struct {
     uint32_t sector;              /* the leaf's sector (SCN_NONE if it has none) */
     uint32_t first_pvert, num_pverts; /* floor polygon in pverts[] (0 pverts if degenerate) */
 } scn_leaf;
+
+/* A model: convex parts made of faces over its vertices (model space: x forward,
+ * y left, z up, 16.16, |v| <= SCN_MODEL_MAX units). */
+typedef struct {
+    uint32_t first_vert, num_verts; /* mverts[first_vert ..), at most SCN_MAX_MODEL_VERTS */
+    uint32_t first_face, num_faces; /* faces[first_face ..), at most SCN_MAX_MODEL_FACES */
+    int32_t radius;                 /* 16.16: largest horizontal distance of a vertex from the origin */
+    int32_t zmin, zmax;             /* 16.16: lowest and highest vertex */
+} scn_model;
+
+typedef struct {
+    int32_t x, y, z; /* 16.16 model space */
+} scn_mvert;
+
+typedef struct {
+    uint32_t first_index; /* findex[first_index .. + num_index): vertex numbers within the model */
+    uint16_t num_index;   /* 3 .. SCN_MAX_FACE_VERTS, counter-clockwise seen from outside */
+    uint8_t colour;
+    uint8_t part;         /* convex part of the model it belongs to */
+} scn_face;
+
+enum { SCN_PATH_NONE, SCN_PATH_CIRCLE, SCN_PATH_LINE };
+
+typedef struct {
+    uint32_t model;
+    int32_t x, y, z;    /* 16.16: the origin at time 0 (circle: the circle's centre) */
+    int32_t yaw;        /* degrees, 16.16 */
+    uint32_t path;      /* SCN_PATH_* */
+    int32_t pa, pb;     /* 16.16: circle radius, 0; line DX, DY */
+    uint32_t period_ms; /* one turn or one round trip; > 0 when path != SCN_PATH_NONE */
+    int32_t spin;       /* degrees per second, 16.16 */
+} scn_object;
 
 #endif

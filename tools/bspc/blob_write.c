@@ -10,7 +10,11 @@
 
 _Static_assert(sizeof(scn_header) == 44 + 8 * SCN_SEC_COUNT, "scn_header layout");
 _Static_assert(sizeof(scn_vertex) == 8, "scn_vertex layout");
-_Static_assert(sizeof(scn_sector) == 12, "scn_sector layout");
+_Static_assert(sizeof(scn_sector) == 16, "scn_sector layout");
+_Static_assert(sizeof(scn_model) == 28, "scn_model layout");
+_Static_assert(sizeof(scn_mvert) == 12, "scn_mvert layout");
+_Static_assert(sizeof(scn_face) == 8, "scn_face layout");
+_Static_assert(sizeof(scn_object) == 40, "scn_object layout");
 _Static_assert(sizeof(scn_line) == 24, "scn_line layout");
 _Static_assert(sizeof(scn_seg) == 16, "scn_seg layout");
 _Static_assert(sizeof(scn_node) == 56, "scn_node layout");
@@ -94,8 +98,9 @@ int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *l
     uint32_t npv = 0;
     for (uint32_t i = 0; i < t->nleaves; i++) npv += t->leaves[i].poly.n;
     uint32_t counts[SCN_SEC_COUNT] = {t->nverts, s->nsectors, s->nlines, t->nsegs,
-                                      t->nnodes, t->nleaves,  npv,       256};
-    static const uint32_t recsz[SCN_SEC_COUNT] = {8, 12, 24, 16, 56, 20, 8, 3};
+                                      t->nnodes, t->nleaves,  npv,       256,
+                                      0,         0,           0,         0,     0};
+    static const uint32_t recsz[SCN_SEC_COUNT] = {8, 12 + 4, 24, 16, 56, 20, 8, 3, 28, 12, 8, 4, 40};
     uint32_t off[SCN_SEC_COUNT];
     uint64_t at = sizeof(scn_header);
     for (int k = 0; k < SCN_SEC_COUNT; k++) {
@@ -149,6 +154,7 @@ int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *l
         w8(&w, c->ceil_color);
         w8(&w, c->light);
         w8(&w, c->flags);
+        wi32(&w, c->ceil_h); /* open_h: no doors yet */
     }
     w.at = off[SCN_SEC_LINES];
     for (uint32_t i = 0; i < s->nlines; i++) {
