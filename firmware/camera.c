@@ -38,7 +38,7 @@ void cam_start(cam_state *c, const scene *s)
     c->eye_floor = 0;
     c->noclip = 0;
     c->feet = 0;
-    col_move(s, 0, &c->view.x, &c->view.y, &c->feet, 0, 0); /* the floor stood on; no move */
+    col_move(s, 0, 0, &c->view.x, &c->view.y, &c->feet, 0, 0); /* the floor stood on; no move */
     cam_follow_floor(c, s);
 }
 
@@ -46,11 +46,11 @@ void cam_start(cam_state *c, const scene *s)
  * dt / (dt + CAM_EASE_MS) each step (exponential, time constant 60 ms), the eye
  * never lags more than a step (COL_STEP) below the floor, so it is at least 17
  * units above it, and never rises to within CEIL_GAP + 41 of the ceiling. */
-static void ease_floor(cam_state *c, const scene *s, uint32_t dt_ms)
+static void ease_floor(cam_state *c, const scene *s, const world_state *w, uint32_t dt_ms)
 {
     uint32_t sec = scene_sector_at(s, c->view.x, c->view.y);
     if (sec == SCN_NONE) return;
-    int64_t target = s->sectors[sec].floor_h, ceil = s->sectors[sec].ceil_h;
+    int64_t target = s->sectors[sec].floor_h, ceil = obj_ceil(w, s, sec);
     int64_t e = c->eye_floor, diff = target - e; /* |diff| < 2^32 */
     int64_t dt = dt_ms > EASE_DT_MAX ? EASE_DT_MAX : dt_ms;
     if (diff > -EASE_SNAP && diff < EASE_SNAP)
@@ -84,7 +84,7 @@ static fx_t clamp_coord(int64_t v)
     return (fx_t)(v < -lim ? -lim : (v > lim ? lim : v));
 }
 
-void cam_move(cam_state *c, const scene *s, uint32_t input, uint32_t dt_ms)
+void cam_move(cam_state *c, const scene *s, const world_state *w, uint32_t input, uint32_t dt_ms)
 {
     int32_t boost = (input & HAL_KEY_RUN) ? 2 : 1;
     int64_t step = per_frame(WALK_SPEED * boost, dt_ms);
@@ -112,9 +112,9 @@ void cam_move(cam_state *c, const scene *s, uint32_t input, uint32_t dt_ms)
     if (c->noclip) {
         c->view.x = clamp_coord(c->view.x + mx);
         c->view.y = clamp_coord(c->view.y + my);
-        col_move(s, 0, &c->view.x, &c->view.y, &c->feet, 0, 0);
+        col_move(s, w, 0, &c->view.x, &c->view.y, &c->feet, 0, 0);
     } else {
-        col_move(s, 0, &c->view.x, &c->view.y, &c->feet, mx, my);
+        col_move(s, w, 0, &c->view.x, &c->view.y, &c->feet, mx, my);
     }
     if (input & HAL_KEY_FLY_UP) c->fly = fx_sat32((int64_t)c->fly + per_frame(FLY_SPEED, dt_ms));
     if (input & HAL_KEY_FLY_DOWN) c->fly = fx_sat32((int64_t)c->fly - per_frame(FLY_SPEED, dt_ms));
@@ -126,6 +126,6 @@ void cam_move(cam_state *c, const scene *s, uint32_t input, uint32_t dt_ms)
     if (input & HAL_KEY_LOOK_DOWN) c->view.look -= look_step;
     if (c->view.look > VIEW_LOOK_MAX) c->view.look = VIEW_LOOK_MAX;
     if (c->view.look < -VIEW_LOOK_MAX) c->view.look = -VIEW_LOOK_MAX;
-    ease_floor(c, s, dt_ms);
+    ease_floor(c, s, w, dt_ms);
     set_eye(c);
 }

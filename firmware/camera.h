@@ -5,6 +5,7 @@
 #define CAMERA_H
 
 #include <stdint.h>
+#include "objects.h"
 #include "scene.h"
 #include "view.h"
 
@@ -29,7 +30,8 @@ void cam_follow_floor(cam_state *c, const scene *s);
 
 /* Apply one step of input (HAL_KEY_* bits) over dt milliseconds: turn, look, walk
  * (colliding and sliding unless noclip), fly (raises the eye above the floor;
- * walking still collides), and ease the eye toward the floor under it + 41. */
-void cam_move(cam_state *c, const scene *s, uint32_t input, uint32_t dt_ms);
+ * walking still collides), and ease the eye toward the floor under it + 41.
+ * w: the ceilings now (doors block when closed; NULL: as compiled). */
+void cam_move(cam_state *c, const scene *s, const world_state *w, uint32_t input, uint32_t dt_ms);
 
 #endif

@@ -275,6 +275,7 @@ static int walk_leaves(const scene *s, const rbox *b, const gpt *line, leaf_fn f
 
 typedef struct {
     const scene *s;
+    const world_state *w; /* the ceilings now (doors) */
     int64_t r, r2;       /* radius on the grid (2^12 .. 2^22) and its square */
     int64_t rraw;        /* radius, 16.16 */
     int64_t height, step;
@@ -365,7 +366,8 @@ static int wall_blocks(const mover *m, const scn_line *ln, int64_t z)
 {
     if (ln->sector[1] == SCN_NONE) return 1;
     const scn_sector *f = &m->s->sectors[ln->sector[0]], *b = &m->s->sectors[ln->sector[1]];
-    int64_t fl = max64(f->floor_h, b->floor_h), ce = min64(f->ceil_h, b->ceil_h);
+    int64_t fl = max64(f->floor_h, b->floor_h);
+    int64_t ce = min64(obj_ceil(m->w, m->s, ln->sector[0]), obj_ceil(m->w, m->s, ln->sector[1]));
     return ce - fl < m->height || fl - z > m->step || ce - z < m->height;
 }
 
@@ -383,8 +385,9 @@ static void touch_sector(path_ck *c, uint32_t sec)
 {
     if (sec == SCN_NONE) return;
     const scn_sector *t = &c->m->s->sectors[sec];
+    int64_t ceil = obj_ceil(c->m->w, c->m->s, sec);
     if (!c->touched || t->floor_h > c->fmax) c->fmax = t->floor_h;
-    if (!c->touched || t->ceil_h < c->cmin) c->cmin = t->ceil_h;
+    if (!c->touched || ceil < c->cmin) c->cmin = ceil;
     c->touched = 1;
 }
 
@@ -506,10 +509,11 @@ col_body col_player(void)
     return b;
 }
 
-static void mover_init(mover *m, const scene *s, const col_body *body)
+static void mover_init(mover *m, const scene *s, const world_state *w, const col_body *body)
 {
     col_body b = body ? *body : col_player();
     m->s = s;
+    m->w = w;
     m->rraw = clamp64(b.radius, COL_RADIUS_MIN, COL_RADIUS_MAX);
     m->r = m->rraw >> G_SHIFT;
     m->r2 = m->r * m->r;
@@ -519,11 +523,11 @@ static void mover_init(mover *m, const scene *s, const col_body *body)
     m->overflow = 0;
 }
 
-uint32_t col_move(const scene *s, const col_body *body, fx_t *x, fx_t *y, fx_t *floor_z, int64_t dx,
-                  int64_t dy)
+uint32_t col_move(const scene *s, const world_state *w, const col_body *body, fx_t *x, fx_t *y, fx_t *floor_z,
+                  int64_t dx, int64_t dy)
 {
     mover m;
-    mover_init(&m, s, body);
+    mover_init(&m, s, w, body);
     uint32_t flags = 0;
     int64_t px = clampw(*x), py = clampw(*y);
     dx = clamp64(dx, -MOVE_MAX, MOVE_MAX);
@@ -616,6 +620,7 @@ int col_floor_at(const scene *s, fx_t x, fx_t y, fx_t *floor)
 
 typedef struct {
     const scene *s;
+    const world_state *w;
     gpt p, q;
     int64_t gx0, gy0, gx1, gy1; /* box of pq on the grid */
     int64_t z1, z2;
@@ -645,7 +650,8 @@ static int sight_leaf(void *vctx, uint32_t leaf)
         const scn_line *ln = &s->lines[g->line];
         if (ln->sector[1] == SCN_NONE) return 1;
         const scn_sector *f = &s->sectors[ln->sector[0]], *k = &s->sectors[ln->sector[1]];
-        int64_t lo = max64(f->floor_h, k->floor_h), hi = min64(f->ceil_h, k->ceil_h);
+        int64_t lo = max64(f->floor_h, k->floor_h);
+        int64_t hi = min64(obj_ceil(c->w, s, ln->sector[0]), obj_ceil(c->w, s, ln->sector[1]));
         if (hi <= lo) return 1; /* closed (a shut door): nothing passes, not even on the edge */
         int64_t o1 = orient(a, b, c->p), o2 = orient(a, b, c->q);
         if (o1 != o2) { /* crosses at t = o1 / (o1 - o2), in [0, 1] */
@@ -671,11 +677,12 @@ static int sight_leaf(void *vctx, uint32_t leaf)
     return 0;
 }
 
-int col_line_of_sight(const scene *s, fx_t x1, fx_t y1, fx_t z1, fx_t x2, fx_t y2, fx_t z2)
+int col_line_of_sight(const scene *s, const world_state *w, fx_t x1, fx_t y1, fx_t z1, fx_t x2, fx_t y2, fx_t z2)
 {
     int64_t ax = clampw(x1), ay = clampw(y1), bx = clampw(x2), by = clampw(y2);
     sight_ck c;
     c.s = s;
+    c.w = w;
     c.p = to_grid(ax, ay);
     c.q = to_grid(bx, by);
     c.gx0 = min64(c.p.x, c.q.x);

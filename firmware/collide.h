@@ -8,6 +8,10 @@
  * candidates are found by walking the BSP tree and visiting only the leaves whose
  * node bounding box overlaps the box of the move (or of the sight line).
  *
+ * Ceilings are those of w (objects.h: doors move them; w NULL: as compiled), so
+ * a closed door blocks like a wall with no opening and an open one lets the
+ * player through. Objects do not collide.
+ *
  * Geometry is exact integer arithmetic on a grid of 1/4096 map unit (16.16
  * coordinates shifted right by 4): every orientation and distance comparison is
  * decided exactly on that grid (64-bit products, 128-bit where a product of
@@ -18,6 +22,7 @@
 
 #include <stdint.h>
 #include "fixed.h"
+#include "objects.h"
 #include "scene.h"
 
 /* Doom's player. */
@@ -76,8 +81,8 @@ col_body col_player(void);
  * sub-step, about 15 passes when a sub-step is blocked (the cut to 1/4096 and
  * the slide). Stack: under 3 KB on a Cortex-M3 (gcc -fstack-usage: 128
  * candidate seg indices, a tree-walk stack of SCN_MAX_DEPTH + 2 entries). */
-uint32_t col_move(const scene *s, const col_body *body, fx_t *x, fx_t *y, fx_t *floor_z, int64_t dx,
-                  int64_t dy);
+uint32_t col_move(const scene *s, const world_state *w, const col_body *body, fx_t *x, fx_t *y, fx_t *floor_z,
+                  int64_t dx, int64_t dy);
 
 /* The floor of the sector of the leaf under (x, y) (scene_sector_at). Returns 1
  * and writes *floor, or returns 0 (no sector) and leaves *floor alone. */
@@ -90,6 +95,6 @@ int col_floor_at(const scene *s, fx_t x, fx_t y, fx_t *floor);
  * (a height exactly on the edge of the opening passes; a closed opening,
  * ceiling <= floor, blocks at every height). Exact on the 1/4096 grid; x, y any
  * fx_t (clamped to the world), z any fx_t. */
-int col_line_of_sight(const scene *s, fx_t x1, fx_t y1, fx_t z1, fx_t x2, fx_t y2, fx_t z2);
+int col_line_of_sight(const scene *s, const world_state *w, fx_t x1, fx_t y1, fx_t z1, fx_t x2, fx_t y2, fx_t z2);
 
 #endif

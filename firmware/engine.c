@@ -1,4 +1,5 @@
-/* engine.c - one frame of the target's loop: input, camera, render, present. */
+/* engine.c - one frame of the target's loop: input, camera, objects and doors,
+ * render, present. */
 #include "engine.h"
 
 scene_status eng_init(engine *e, const void *blob, uint32_t len, scene_error *err)
@@ -6,8 +7,10 @@ scene_status eng_init(engine *e, const void *blob, uint32_t len, scene_error *er
     scene_status st = scene_load(&e->sc, blob, len, err);
     if (st != SCENE_OK) return st;
     e->mode = RENDER_SPANS;
-    e->work.mem = 0;
-    e->work.bytes = 0;
+    e->work.mem = e->rwork.mem = 0;
+    e->work.bytes = e->rwork.bytes = 0;
+    e->world = (world_state){0, 0, 0, 0};
+    e->t_ms = 0;
     e->present = HAL_PRESENT_FLIP;
     e->frame = 0;
     e->stats = (render_stats){0};
@@ -16,25 +19,44 @@ scene_status eng_init(engine *e, const void *blob, uint32_t len, scene_error *er
     return SCENE_OK;
 }
 
+/* The renderer's need for the scene's own objects (their models are fixed: the
+ * state only moves them). */
+static uint32_t render_bytes(const engine *e)
+{
+    world_state proto = {0, e->sc.nobjects, 0, 0};
+    return render_work_bytes(&e->sc, &proto);
+}
+
 uint32_t eng_work_bytes(const engine *e)
 {
-    return render_work_bytes(&e->sc);
+    uint64_t world = obj_state_bytes(&e->sc), render = render_bytes(e);
+    if (render == 0 || world + render > 0xFFFFFFF0u) return 0;
+    return (uint32_t)(world + render);
 }
 
 int eng_set_work(engine *e, void *mem, uint32_t bytes)
 {
-    uint32_t need = render_work_bytes(&e->sc);
-    if (need == 0 || bytes < need) return -1;
+    uint32_t need = eng_work_bytes(e), world = obj_state_bytes(&e->sc);
+    if (need == 0 || bytes < need || !mem) return -1;
+    if (obj_init(&e->world, &e->sc, mem, world) != 0) return -1;
     e->work.mem = mem;
     e->work.bytes = bytes;
+    e->rwork.mem = (uint8_t *)mem + world; /* world is a multiple of 8: the rest stays aligned */
+    e->rwork.bytes = bytes - world;
+    e->t_ms = 0;
     return 0;
+}
+
+static const world_state *world_of(const engine *e)
+{
+    return e->world.ceil ? &e->world : 0;
 }
 
 void eng_render(engine *e, uint32_t *ids)
 {
     hal_surface surf = hal_begin_frame(e->present);
     rast_target t = {&surf, ids};
-    render_frame(&e->sc, &e->cam.view, e->mode, &t, &e->work, &e->stats);
+    render_frame(&e->sc, world_of(e), &e->cam.view, e->mode, &t, &e->rwork, &e->stats);
     hal_present(e->present);
     e->frame++;
 }
@@ -43,7 +65,9 @@ void eng_step(engine *e, uint32_t input, uint32_t dt_ms)
 {
     if (input & HAL_KEY_NEXT_MODE) e->mode = (render_mode)((e->mode + 1) % RENDER_MODE_COUNT);
     if (input & HAL_KEY_NEXT_PRESENT) e->present = (hal_present_mode)((e->present + 1) % HAL_PRESENT_COUNT);
-    cam_move(&e->cam, &e->sc, input, dt_ms);
+    cam_move(&e->cam, &e->sc, world_of(e), input, dt_ms);
+    e->t_ms += dt_ms; /* wraps after 49.7 days (a jump along the paths; doors only see dt) */
+    if (e->world.ceil) obj_update(&e->world, &e->sc, e->t_ms, dt_ms, e->cam.view.x, e->cam.view.y);
     eng_render(e, 0);
     hal_frame_done();
 }

@@ -9,19 +9,33 @@
 #include "fixed.h"
 #include "scene.h"
 
+#define OBJ_DOOR_REACH 64      /* units: a door opens for a player this near one of its walls */
+#define OBJ_DOOR_SPEED 128     /* units per second, up and down */
+#define OBJ_DOOR_WAIT_MS 3000u /* open this long after the player left, then close */
+
 typedef struct {
     uint32_t model; /* index into the scene's models */
     fx_t x, y, z;   /* the model's origin, 16.16 map units, inside the world box */
     fx_t yaw_deg;   /* degrees, 16.16, 0 = the model's +x along east, counter-clockwise */
 } obj_state;
 
+/* A door's motion, kept as times so that the ceiling depends on the sum of the
+ * frame times only, not on how they were split into frames. */
+typedef struct {
+    uint32_t travel_ms; /* time spent rising from closed, 0 .. the door's full travel */
+    uint32_t wait_ms;   /* time it will still stay fully open */
+    uint32_t opening;   /* 1 rising or open, 0 closing or closed */
+} obj_door;
+
 typedef struct {
     obj_state *objs;   /* n objects, drawn with ids RAST_ID(RAST_KIND_OBJECT, i) */
     uint32_t n;
     fx_t *ceil;        /* current ceiling of every sector (nsectors entries), or NULL: as compiled */
+    obj_door *doors;   /* motion of every sector's door (nsectors entries; unused for non-doors),
+                        * or NULL: obj_update leaves the ceilings alone */
 } world_state;
 
-/* Bytes of RAM the state of a scene needs (objects and ceilings). */
+/* Bytes of RAM the state of a scene needs (objects, ceilings, doors); a multiple of 8. */
 uint32_t obj_state_bytes(const scene *s);
 
 /* Point w at mem (obj_state_bytes(s) bytes, 4-byte aligned) and set every object
@@ -30,7 +44,20 @@ int obj_init(world_state *w, const scene *s, void *mem, uint32_t bytes);
 
 /* Objects along their paths at time t_ms; doors open when (px, py) is within 64
  * units of one of their walls and close 3 s after it left, moving 128 units per
- * second (dt_ms since the last call drives them). */
+ * second (dt_ms since the last call drives them).
+ *
+ * Paths (docs/objects.md), exact functions of t_ms, with s = t_ms mod period:
+ *   circle: origin = centre + R (cos th, sin th), th = 360 s / period degrees,
+ *           yaw = yaw0 + th + 90 (facing along the motion);
+ *   line:   origin = start + f (dx, dy), f = 2 s / period rising to 1, then back;
+ *   spin:   yaw += spin t_ms / 1000 (every path); yaw kept in [0, 360).
+ * w->objs[i] follows the scene's object i for i < min(w->n, s->nobjects); objects
+ * beyond the scene's (placed by hand) are left alone.
+ *
+ * Doors: the player is a point; "within 64 units" is decided exactly on a grid
+ * of 1/16 unit. A door triggered (player near or in its sector) rises; once fully
+ * open it waits 3 s counting from the last frame it was triggered, then falls;
+ * triggered while falling, it rises again. */
 void obj_update(world_state *w, const scene *s, uint32_t t_ms, uint32_t dt_ms, fx_t px, fx_t py);
 
 /* The ceiling of sector i now (the compiled one when w or w->ceil is NULL). */

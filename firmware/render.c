@@ -28,12 +28,13 @@ void render_clear(const rast_target *t, uint8_t colour)
     for (int y = 0; y < VIEW_H; y++) rast_span(t, y, 0, VIEW_W, colour, RAST_ID(RAST_KIND_NONE, 0));
 }
 
-uint32_t render_work_bytes(const scene *s)
+uint32_t render_work_bytes(const scene *s, const world_state *w)
 {
-    return span_work_bytes(s);
+    uint32_t spans = span_work_bytes(s, w), painter = painter_work_bytes(s, w);
+    return spans == 0 ? 0 : (spans > painter ? spans : painter);
 }
 
-void render_frame(const scene *s, const camera *cam, render_mode mode, const rast_target *t,
+void render_frame(const scene *s, const world_state *w, const camera *cam, render_mode mode, const rast_target *t,
                   const render_work *work, render_stats *stats)
 {
     render_stats local;
@@ -43,10 +44,10 @@ void render_frame(const scene *s, const camera *cam, render_mode mode, const ras
     view_setup(&v, cam);
     switch (mode) {
     case RENDER_PAINTER:
-        painter_render(s, &v, t, st);
+        painter_render(s, w, &v, t, work, st);
         break;
     default:
-        spans_render(s, &v, t, st, work ? work->mem : 0, work ? work->bytes : 0);
+        spans_render(s, w, &v, t, st, work ? work->mem : 0, work ? work->bytes : 0);
         break;
     }
 }

@@ -3,6 +3,7 @@
 #define RENDER_H
 
 #include <stdint.h>
+#include "objects.h"
 #include "raster.h"
 #include "scene.h"
 #include "view.h"
@@ -26,6 +27,8 @@ typedef struct {
     uint32_t spans;        /* spans emitted (spans) */
     uint32_t surfaces_drawn; /* surface batches filled (spans) */
     uint32_t refused;      /* 1: the work memory given was smaller than the scene needs */
+    uint32_t objects_visible; /* objects drawn: in view (spans: and in a leaf the walk visited) */
+    uint32_t object_faces;    /* object faces that reached the rasteriser */
 } render_stats;
 
 const char *render_mode_name(render_mode m);
@@ -37,18 +40,26 @@ typedef struct {
     uint32_t bytes;
 } render_work;
 
-/* Work bytes the scene needs in any mode. */
-uint32_t render_work_bytes(const scene *s);
+/* Work bytes the scene needs in any mode, with w's objects (w NULL: no objects;
+ * w->objs NULL: the scene's own objects, as obj_init will place them). 0 if it
+ * would not fit in 32 bits: the caller must refuse the scene. */
+uint32_t render_work_bytes(const scene *s, const world_state *w);
 
 /* Draw the scene seen from cam into t: every pixel of the frame is written (once
- * in mode spans). stats may be NULL. */
-void render_frame(const scene *s, const camera *cam, render_mode mode, const rast_target *t,
+ * in mode spans). w: the objects and ceilings now (NULL: the static world as
+ * compiled, no objects). A frame that needs more work memory than given is not
+ * drawn: the background only, and stats->refused. stats may be NULL. */
+void render_frame(const scene *s, const world_state *w, const camera *cam, render_mode mode, const rast_target *t,
                   const render_work *work, render_stats *stats);
 
 /* Shared by the modes. */
 void render_clear(const rast_target *t, uint8_t colour);
 
-/* Draw the back-to-front (painter) frame. */
-void painter_render(const scene *s, const view_xform *v, const rast_target *t, render_stats *st);
+/* Draw the back-to-front (painter) frame; each object right after the nearest
+ * visited leaf its box touches (the leaves' numbers and the objects' order need
+ * painter_work_bytes of the work memory). */
+void painter_render(const scene *s, const world_state *w, const view_xform *v, const rast_target *t,
+                    const render_work *work, render_stats *st);
+uint32_t painter_work_bytes(const scene *s, const world_state *w);
 
 #endif

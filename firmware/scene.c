@@ -95,6 +95,11 @@ static scene_status check_geometry(const scene *s, scene_error *err)
         const scn_sector *sec = &s->sectors[i];
         if (!coord_ok(sec->floor_h, SCN_HEIGHT_MAX) || !coord_ok(sec->ceil_h, SCN_HEIGHT_MAX))
             return fail(err, SCENE_ERR_RANGE, SCN_SEC_SECTORS, i);
+        /* a door's ceiling moves between ceil_h and open_h; every other ceiling stays put */
+        int door_ok = (sec->flags & SCN_SECTOR_DOOR)
+                          ? sec->open_h >= sec->ceil_h && coord_ok(sec->open_h, SCN_HEIGHT_MAX)
+                          : sec->open_h == sec->ceil_h;
+        if (!door_ok) return fail(err, SCENE_ERR_RANGE, SCN_SEC_SECTORS, i);
     }
     for (uint32_t i = 0; i < s->nlines; i++) {
         const scn_line *l = &s->lines[i];
@@ -128,6 +133,96 @@ static scene_status check_geometry(const scene *s, scene_error *err)
                 if (!coord_ok(n->bbox[c][k], SCN_COORD_MAX))
                     return fail(err, SCENE_ERR_RANGE, SCN_SEC_NODES, i);
         }
+    }
+    return SCENE_OK;
+}
+
+/* Limits of docs/objects.md beyond scene_format.h: they keep an object's path
+ * arithmetic (position = function of t) inside 64 bits. */
+#define OBJ_PERIOD_MAX_MS 3600000u
+#define OBJ_SPIN_MAX 3600
+
+/* Is r the smallest whole raw radius that holds a vertex at squared distance
+ * d2: (r - 1)^2 < d2 <= r^2? d2 < 2^53 and r < 2^27, so every square fits. */
+static int radius_matches(int32_t r, uint64_t d2)
+{
+    if (r < 0 || r > ((int32_t)SCN_MODEL_MAX << 16) * 2) return 0;
+    uint64_t ur = (uint64_t)r;
+    return ur * ur >= d2 && (ur == 0 || (ur - 1) * (ur - 1) < d2);
+}
+
+/* Models, their vertices, faces and face indices, then the objects that place
+ * them: every range inside its section, every face vertex inside its model, the
+ * stored bounds equal to those of the vertices, every path inside the box. */
+static scene_status check_objects(const scene *s, scene_error *err)
+{
+    for (uint32_t i = 0; i < s->nmverts; i++) {
+        const scn_mvert *v = &s->mverts[i];
+        if (!coord_ok(v->x, SCN_MODEL_MAX) || !coord_ok(v->y, SCN_MODEL_MAX) ||
+            !coord_ok(v->z, SCN_MODEL_MAX))
+            return fail(err, SCENE_ERR_RANGE, SCN_SEC_MVERTS, i);
+    }
+    for (uint32_t i = 0; i < s->nfaces; i++) {
+        const scn_face *f = &s->faces[i];
+        if (f->num_index < 3 || f->num_index > SCN_MAX_FACE_VERTS ||
+            (uint64_t)f->first_index + f->num_index > s->nfindex)
+            return fail(err, SCENE_ERR_INDEX, SCN_SEC_FACES, i);
+    }
+    for (uint32_t i = 0; i < s->nmodels; i++) {
+        const scn_model *m = &s->models[i];
+        if (m->num_verts < 3 || m->num_verts > SCN_MAX_MODEL_VERTS || m->num_faces < 1 ||
+            m->num_faces > SCN_MAX_MODEL_FACES || (uint64_t)m->first_vert + m->num_verts > s->nmverts ||
+            (uint64_t)m->first_face + m->num_faces > s->nfaces)
+            return fail(err, SCENE_ERR_INDEX, SCN_SEC_MODELS, i);
+        for (uint32_t k = 0; k < m->num_faces; k++) {
+            const scn_face *f = &s->faces[m->first_face + k];
+            for (uint32_t j = 0; j < f->num_index; j++)
+                if (s->findex[f->first_index + j] >= m->num_verts)
+                    return fail(err, SCENE_ERR_INDEX, SCN_SEC_MODELS, i);
+        }
+        uint64_t d2 = 0;
+        int32_t zmin = INT32_MAX, zmax = INT32_MIN;
+        for (uint32_t k = 0; k < m->num_verts; k++) {
+            const scn_mvert *v = &s->mverts[m->first_vert + k];
+            uint64_t d = (uint64_t)((int64_t)v->x * v->x) + (uint64_t)((int64_t)v->y * v->y);
+            if (d > d2) d2 = d;
+            if (v->z < zmin) zmin = v->z;
+            if (v->z > zmax) zmax = v->z;
+        }
+        if (!radius_matches(m->radius, d2) || m->zmin != zmin || m->zmax != zmax)
+            return fail(err, SCENE_ERR_RANGE, SCN_SEC_MODELS, i);
+    }
+    if (s->nobjects > SCN_MAX_OBJECTS) return fail(err, SCENE_ERR_RANGE, SCN_SEC_OBJECTS, SCN_MAX_OBJECTS);
+    const int64_t box = (int64_t)SCN_COORD_MAX << 16;
+    for (uint32_t i = 0; i < s->nobjects; i++) {
+        const scn_object *o = &s->objects[i];
+        if (o->model >= s->nmodels) return fail(err, SCENE_ERR_INDEX, SCN_SEC_OBJECTS, i);
+        if (o->path > SCN_PATH_LINE) return fail(err, SCENE_ERR_INDEX, SCN_SEC_OBJECTS, i);
+        /* the extent of the whole path, which for no path is the origin */
+        int64_t lo[2] = {o->x, o->y}, hi[2] = {o->x, o->y};
+        int ok = coord_ok(o->z, SCN_HEIGHT_MAX) && o->spin >= -(OBJ_SPIN_MAX << 16) &&
+                 o->spin <= (OBJ_SPIN_MAX << 16);
+        if (o->path == SCN_PATH_NONE) {
+            ok = ok && o->pa == 0 && o->pb == 0 && o->period_ms == 0;
+        } else {
+            ok = ok && o->period_ms > 0 && o->period_ms <= OBJ_PERIOD_MAX_MS;
+            if (o->path == SCN_PATH_CIRCLE) {
+                ok = ok && o->pa > 0 && o->pb == 0;
+                for (int k = 0; k < 2; k++) {
+                    lo[k] -= o->pa;
+                    hi[k] += o->pa;
+                }
+            } else {
+                int64_t d[2] = {o->pa, o->pb};
+                ok = ok && (o->pa != 0 || o->pb != 0);
+                for (int k = 0; k < 2; k++) {
+                    if (d[k] < 0) lo[k] += d[k];
+                    else hi[k] += d[k];
+                }
+            }
+        }
+        for (int k = 0; k < 2; k++) ok = ok && lo[k] >= -box && hi[k] <= box;
+        if (!ok) return fail(err, SCENE_ERR_RANGE, SCN_SEC_OBJECTS, i);
     }
     return SCENE_OK;
 }
@@ -192,6 +287,7 @@ scene_status scene_load(scene *s, const void *blob, uint32_t len, scene_error *e
     s->root = h->root;
     scene_status st = check_sections(s, base, h, err);
     if (st == SCENE_OK) st = check_geometry(s, err);
+    if (st == SCENE_OK) st = check_objects(s, err);
     if (st == SCENE_OK) st = check_tree(s, err);
     return st;
 }

@@ -2,6 +2,8 @@
 #include "spans.h"
 
 #include "bsp_walk.h"
+#include "eye.h"
+#include "obj_draw.h"
 #include "surfaces.h"
 
 #define SPAN_BUFFER 2048       /* spans collected before a flush */
@@ -16,8 +18,13 @@ typedef struct sp_edge {
 } sp_edge;
 
 typedef struct sp_surf {
-    uint32_t key;              /* BSP order of its leaf: smaller is nearer */
+    uint32_t key;              /* BSP order of its leaf: smaller is nearer (an object's face: kmin) */
     uint32_t id;
+    uint32_t kmax;             /* an object's face: its key range is [key, kmax] */
+    int32_t plane;             /* its 1/z plane in planes[], or -1 (a world surface's, until needed) */
+    uint32_t seg;              /* a world surface's plane: a wall of this seg, or (SCN_NONE) the
+                                * floor or ceiling its id names */
+    uint8_t object;            /* 1: an object's face */
     int32_t state;             /* leading minus trailing edges seen on this line */
     uint8_t colour;
     struct sp_surf *below;     /* next surface down the stack */
@@ -38,6 +45,7 @@ typedef struct {
 
 typedef struct {
     const scene *sc;
+    const world_state *w;
     const view_xform *v;
     const rast_target *t;
     render_stats *st;
@@ -46,6 +54,10 @@ typedef struct {
     uint32_t nedges, max_edges;
     sp_surf *surfs;
     uint32_t nsurfs, max_surfs;
+    uint32_t *leaf_key;        /* with objects: the key each leaf was visited with, 0 if not */
+    objd_plane *planes;        /* with objects: 1/z planes of object faces and of world surfaces */
+    uint32_t nplanes, max_planes;
+    uint32_t object_faces;     /* object faces on the edge lists */
     sp_edge *new_edges[VIEW_H];
     sp_cover cover[VIEW_H];
     occ_columns occ;
@@ -75,16 +87,48 @@ static uint64_t max_surfs(const scene *s)
     return 2u * (uint64_t)s->nleaves + 2u * (uint64_t)s->nsegs;
 }
 
+/* Faces and their clipping-maximal edges of w's objects (0 without objects). */
+static void object_bound(const scene *s, const world_state *w, uint64_t *faces, uint64_t *edges)
+{
+    *faces = *edges = 0;
+    if (!w) return;
+    for (uint32_t i = 0; i < w->n; i++) {
+        uint32_t mi = w->objs ? w->objs[i].model : (i < s->nobjects ? s->objects[i].model : SCN_NONE);
+        if (mi >= s->nmodels) continue; /* nothing to draw */
+        const scn_model *m = &s->models[mi];
+        *faces += m->num_faces;
+        for (uint32_t f = 0; f < m->num_faces; f++) *edges += (uint64_t)s->faces[m->first_face + f].num_index + 5u;
+    }
+}
+
 static uint32_t align8(uint64_t n)
 {
     return (uint32_t)((n + 7u) & ~(uint64_t)7u);
 }
 
-uint32_t span_work_bytes(const scene *s)
+typedef struct {
+    uint64_t edges, surfs, planes, leaves; /* counts; leaves and planes 0 without objects */
+    uint64_t total;                        /* bytes */
+} span_layout;
+
+static void layout(const scene *s, const world_state *w, span_layout *L)
 {
-    uint64_t total = align8(sizeof(span_state)) + align8(max_edges(s) * sizeof(sp_edge)) +
-                     align8(max_surfs(s) * sizeof(sp_surf));
-    return total > 0xFFFFFFF0u ? 0 : (uint32_t)total;
+    uint64_t faces, oedges;
+    object_bound(s, w, &faces, &oedges);
+    L->edges = max_edges(s) + oedges;
+    L->surfs = max_surfs(s) + faces;
+    L->planes = faces ? L->surfs : 0;
+    L->leaves = faces ? s->nleaves : 0;
+    L->total = (uint64_t)align8(sizeof(span_state)) + align8(L->edges * sizeof(sp_edge)) +
+               align8(L->surfs * sizeof(sp_surf)) + align8(L->leaves * sizeof(uint32_t)) +
+               align8(L->planes * sizeof(objd_plane));
+}
+
+uint32_t span_work_bytes(const scene *s, const world_state *w)
+{
+    span_layout L;
+    layout(s, w, &L);
+    return L.total > 0xFFFFFFF0u ? 0 : (uint32_t)L.total;
 }
 
 /* ---- coverage ----------------------------------------------------------- */
@@ -202,7 +246,33 @@ static int box_covered(const span_state *S, const screen_pt *pts, int n)
     return 1;
 }
 
-static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id)
+/* A new surface and its edges (the caller has checked the pools). */
+static sp_surf *add_surface(span_state *S, const screen_pt *pts, int n, uint8_t colour, uint32_t id)
+{
+    sp_surf *s = &S->surfs[S->nsurfs++];
+    s->key = S->key;
+    s->id = id;
+    s->colour = colour;
+    s->state = 0;
+    s->span_head = -1;
+    s->next_drawn = 0;
+    s->object = 0;
+    for (int i = 0; i < n; i++) {
+        screen_pt a = pts[i], b = pts[(i + 1 == n) ? 0 : i + 1];
+        if (a.y == b.y) continue;
+        sp_edge *e = &S->edges[S->nedges];
+        int leading = a.y > b.y; /* going up the screen: a left edge (raster.c) */
+        if (!(leading ? rast_edge_setup(&e->d, b.x, b.y, a.x, a.y) : rast_edge_setup(&e->d, a.x, a.y, b.x, b.y)))
+            continue;
+        e->leading = (uint8_t)leading;
+        e->surf = s;
+        S->nedges++;
+        insert_sorted(&S->new_edges[e->d.row], e);
+    }
+    return s;
+}
+
+static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id, uint32_t seg)
 {
     span_state *S = ctx;
     if (box_covered(S, pts, n)) {
@@ -219,24 +289,10 @@ static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, 
         return;
     }
     if (S->nsurfs >= S->max_surfs || S->nedges + (uint32_t)n > S->max_edges) return; /* bound proven: unreachable */
-    sp_surf *s = &S->surfs[S->nsurfs++];
-    s->key = S->key;
-    s->id = id;
-    s->colour = colour;
-    s->state = 0;
-    s->span_head = -1;
-    s->next_drawn = 0;
-    for (int i = 0; i < n; i++) {
-        screen_pt a = pts[i], b = pts[(i + 1 == n) ? 0 : i + 1];
-        if (a.y == b.y) continue;
-        sp_edge *e = &S->edges[S->nedges];
-        int leading = a.y > b.y; /* going up the screen: a left edge (raster.c) */
-        if (!(leading ? rast_edge_setup(&e->d, b.x, b.y, a.x, a.y) : rast_edge_setup(&e->d, a.x, a.y, b.x, b.y)))
-            continue;
-        e->leading = (uint8_t)leading;
-        e->surf = s;
-        S->nedges++;
-        insert_sorted(&S->new_edges[e->d.row], e);
+    sp_surf *s = add_surface(S, pts, n, colour, id);
+    if (S->leaf_key) { /* objects may meet it: how to find its plane if they do */
+        s->plane = -1;
+        s->seg = seg;
     }
     for (int y = top; y < top + rows; y++) cover(S, y, lo[y], hi[y]);
 }
@@ -245,9 +301,87 @@ static int visit_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
 {
     span_state *S = ctx;
     S->key++;
-    surf_leaf(S->sc, S->v, leaf, clip_mask, &S->sink, S->use_occ ? &S->occ : 0, S->st);
+    if (S->leaf_key) S->leaf_key[leaf] = S->key;
+    surf_leaf(S->sc, S->w, S->v, leaf, clip_mask, &S->sink, S->use_occ ? &S->occ : 0, S->st);
     return S->full_rows == VIEW_H; /* the screen is full: nothing farther can show */
 }
+
+/* ---- objects -------------------------------------------------------------- */
+
+/* Every object in a visited leaf and in view: its faces that face the eye, clipped
+ * and projected, onto the edge lists (no coverage test: they are sorted in the
+ * scan, against the world by key range and 1/z). */
+static void add_objects(span_state *S)
+{
+    const scene *sc = S->sc;
+    const world_state *w = S->w;
+    view_pt verts[SCN_MAX_MODEL_VERTS];
+    screen_pt pts[CLIP_MAX_VERTS];
+    for (uint32_t i = 0; i < w->n; i++) {
+        const obj_state *o = &w->objs[i];
+        uint32_t kmin, kmax;
+        if (o->model >= sc->nmodels || !objd_in_view(sc, o, S->v) || !objd_locate(sc, o, S->leaf_key, &kmin, &kmax))
+            continue;
+        S->st->objects_visible++;
+        const scn_model *m = &sc->models[o->model];
+        objd_transform(sc, o, S->v, verts);
+        for (uint32_t f = m->first_face; f < m->first_face + m->num_faces; f++) {
+            objd_plane pl;
+            if (!objd_face_plane(sc, m, f, verts, &pl)) continue;
+            int n = objd_face_screen(sc, m, f, verts, S->v, pts);
+            if (!n) continue;
+            if (S->nsurfs >= S->max_surfs || S->nedges + (uint32_t)n > S->max_edges || S->nplanes >= S->max_planes)
+                return; /* bound proven: unreachable */
+            S->st->object_faces++;
+            sp_surf *s = add_surface(S, pts, n, sc->faces[f].colour, RAST_ID(RAST_KIND_OBJECT, i));
+            s->key = kmin;
+            s->kmax = kmax;
+            s->object = 1;
+            s->plane = (int32_t)S->nplanes;
+            S->planes[S->nplanes++] = pl;
+            S->object_faces++;
+        }
+    }
+}
+
+static const objd_plane *plane_of(span_state *S, sp_surf *s)
+{
+    if (s->plane < 0) { /* a world surface met by an object: its plane, once */
+        objd_plane *p = &S->planes[S->nplanes];
+        if (s->seg == SCN_NONE) {
+            uint32_t sec = s->id & 0xFFFFFFu;
+            int32_t h = (s->id >> 24) == RAST_KIND_FLOOR ? S->sc->sectors[sec].floor_h : obj_ceil(S->w, S->sc, sec);
+            objd_plane_flat(S->v, h, p);
+        } else {
+            const scn_seg *g = &S->sc->segs[s->seg];
+            objd_plane_wall(S->v, &S->sc->verts[g->v1], &S->sc->verts[g->v2], p);
+        }
+        s->plane = (int32_t)S->nplanes++; /* one per surface at most: the pool holds them all */
+    }
+    return &S->planes[s->plane];
+}
+
+/* Is s (being inserted) in front of p at pixel x of row y? World surfaces by key;
+ * an object's face against the world by key outside its range, else by 1/z; and
+ * faces of objects against each other by 1/z (docs/objects.md). */
+static int mixed_front(span_state *S, sp_surf *s, sp_surf *p, int x, int y)
+{
+    if (!s->object) {
+        if (s->key < p->key) return 1;
+        if (s->key > p->kmax) return 0;
+    } else if (!p->object) {
+        if (p->key < s->key) return 0;
+        if (p->key > s->kmax) return 1;
+    }
+    return objd_front(plane_of(S, s), s->object, plane_of(S, p), p->object, S->v->look, x, y);
+}
+
+static inline __attribute__((always_inline)) int in_front(span_state *S, sp_surf *s, sp_surf *p, int x, int y,
+                                                          int objects)
+{
+    return (objects && (s->object | p->object)) ? mixed_front(S, s, p, x, y) : s->key < p->key;
+}
+
 
 /* ---- spans ---------------------------------------------------------------- */
 
@@ -280,48 +414,150 @@ static void emit_span(span_state *S, sp_surf *s, int y, int x0, int x1)
     S->st->spans++;
 }
 
+/* ---- the stack with objects: intersecting spans --------------------------- */
+
+/* Pairs sorted by 1/z can change order along a line: a Doom thing whose box
+ * reaches into a wall, two objects that interpenetrate. The order found when a
+ * surface is inserted (independent sorting) would then hold for the rest of the
+ * span; instead, on lines with an object on the stack the top stays the nearest
+ * surface at every pixel (Black Book ch. 67's intersecting span sorting). The
+ * first pixel where another surface overtakes the top is found by bisection
+ * (1/z is linear along the line, so "in front" flips at most once) and kept as
+ * the line's next event beside the edges; it is found again whenever the top
+ * changes, and a surface slotted in below is checked against the top. When the
+ * top ends, the nearest of the rest takes over, wherever it sat in the stack. */
+#define OVERTAKES_MAX 32 /* at one pixel: only orders that are no depth could need more */
+
+typedef struct {
+    int x;      /* first pixel where s is in front of the top, VIEW_W: none */
+    sp_surf *s;
+} sp_next;
+
+static int may_cross(const sp_surf *s, const sp_surf *p)
+{
+    if (!(s->object | p->object)) return 0;
+    if (s->object && p->object) return 1;
+    const sp_surf *o = s->object ? s : p, *w = s->object ? p : s;
+    return w->key >= o->key && w->key <= o->kmax;
+}
+
+/* Put s, somewhere below top, on top. */
+static sp_surf *raise_surf(sp_surf *top, sp_surf *s)
+{
+    s->above->below = s->below;
+    if (s->below) s->below->above = s->above;
+    s->below = top;
+    s->above = 0;
+    top->above = s;
+    return s;
+}
+
+/* The first pixel from x on where p is in front of top (VIEW_W: none). */
+static int overtakes_at(span_state *S, sp_surf *top, sp_surf *p, int x, int y)
+{
+    if (x >= VIEW_W || !may_cross(p, top) || !mixed_front(S, p, top, VIEW_W - 1, y)) return VIEW_W;
+    int lo = x - 1, hi = VIEW_W - 1; /* in front at hi; lo is before the range */
+    while (hi - lo > 1) {
+        int mid = lo + (hi - lo) / 2;
+        if (mixed_front(S, p, top, mid, y)) hi = mid;
+        else lo = mid;
+    }
+    return hi;
+}
+
+static void note(span_state *S, sp_next *n, sp_surf *top, sp_surf *p, int x, int y)
+{
+    int at = overtakes_at(S, top, p, x, y);
+    if (at < n->x || (at == n->x && at < VIEW_W && in_front(S, p, n->s, at, y, 1))) {
+        n->x = at;
+        n->s = p;
+    }
+}
+
+/* The next overtaking of top from pixel x on. */
+static sp_next plan(span_state *S, sp_surf *top, int x, int y)
+{
+    sp_next n = {VIEW_W, 0};
+    for (sp_surf *p = top->below; p; p = p->below) note(S, &n, top, p, x, y);
+    return n;
+}
+
+/* The nearest surface of the stack at x, on top. */
+static sp_surf *nearest(span_state *S, sp_surf *top, int x, int y)
+{
+    sp_surf *best = top;
+    for (sp_surf *p = top->below; p; p = p->below)
+        if (in_front(S, p, best, x, y, 1)) best = p;
+    return best == top ? top : raise_surf(top, best);
+}
+
+/* Overtakings before pixel col: each ends the top's span and puts the nearer on top. */
+static sp_surf *overtake(span_state *S, sp_surf *top, sp_next *n, int *cur, int col, int y)
+{
+    for (int k = 0; n->x < col && k < OVERTAKES_MAX; k++) {
+        int at = n->x < *cur ? *cur : n->x;
+        emit_span(S, top, y, *cur, at);
+        *cur = at;
+        top = raise_surf(top, n->s);
+        *n = plan(S, top, at, y);
+    }
+    return top;
+}
+
 /* One scan line: walk the active edges left to right, keeping the stack of
- * surfaces under the current x sorted by key; the top one owns the pixels. */
-static void scan_line(span_state *S, sp_edge *active, int y)
+ * surfaces under the current x sorted front to back; the top one owns the
+ * pixels. Without objects the order is the key alone. */
+static inline __attribute__((always_inline)) void scan_line(span_state *S, sp_edge *active, int y, int objects)
 {
     sp_surf *top = &S->background;
     int cur = 0;
+    int nobj = 0, mixed = 0;        /* object faces on the stack; any on this line so far */
+    sp_next next = {VIEW_W, 0};     /* with objects: the next overtaking of the top */
     for (sp_edge *e = active; e; e = e->next) {
         int col = rast_first_sample(e->d.x);
         if (col < 0) col = 0;
         if (col > VIEW_W) col = VIEW_W;
         sp_surf *s = e->surf;
+        if (objects && next.x < col) top = overtake(S, top, &next, &cur, col, y);
         if (e->leading) {
             if (++s->state != 1) continue;
-            if (s->key < top->key) {            /* nearer than the top: it takes over */
+            if (objects && s->object) nobj++, mixed = 1;
+            if (in_front(S, s, top, col, y, objects)) { /* nearer than the top: it takes over */
                 emit_span(S, top, y, cur, col);
                 cur = col;
                 s->below = top;
                 s->above = 0;
                 top->above = s;
                 top = s;
-            } else {                            /* slot it in below, by key */
+                if (objects && nobj) next = plan(S, top, col, y);
+            } else {                            /* slot it in below */
                 sp_surf *p = top;
-                while (p->below->key <= s->key) p = p->below;
+                while (!in_front(S, s, p->below, col, y, objects)) p = p->below;
                 s->below = p->below;
                 s->above = p;
                 p->below->above = s;
                 p->below = s;
+                if (objects && nobj) note(S, &next, top, s, col, y);
             }
         } else {
             if (--s->state != 0) continue;
+            if (objects && s->object) nobj--;
             if (s == top) {                     /* the top ends: the next one shows */
                 emit_span(S, s, y, cur, col);
                 cur = col;
                 top = s->below;
                 top->above = 0;
+                if (objects && mixed) top = nearest(S, top, col, y);
+                if (objects) next = nobj ? plan(S, top, col, y) : (sp_next){VIEW_W, 0};
             } else if (s->below || s->above) {  /* leaves from inside the stack */
                 s->above->below = s->below;
                 s->below->above = s->above;
+                if (objects && s == next.s) next = nobj ? plan(S, top, col, y) : (sp_next){VIEW_W, 0};
             }
             s->below = s->above = 0;
         }
     }
+    if (objects && next.x < VIEW_W) top = overtake(S, top, &next, &cur, VIEW_W, y);
     emit_span(S, top, y, cur, VIEW_W);
     /* every surface starts the next line closed, even one whose edges crossed */
     for (sp_edge *e = active; e; e = e->next) {
@@ -330,9 +566,12 @@ static void scan_line(span_state *S, sp_edge *active, int y)
     }
 }
 
-static void scan(span_state *S)
+/* With objects, a line is scanned the object way only while an object's edge is
+ * on it: no object face can be on the stack of any other line. */
+static inline __attribute__((always_inline)) void scan_lines(span_state *S, int objects)
 {
     sp_edge *active = 0;
+    int object_edges = 0; /* active edges of object faces */
     for (int y = 0; y < VIEW_H; y++) {
         /* merge the edges starting on this line (both lists sorted by x) */
         sp_edge **link = &active;
@@ -340,12 +579,16 @@ static void scan(span_state *S)
         while (n) {
             while (*link && (*link)->d.x < n->d.x) link = &(*link)->next;
             sp_edge *next = n->next;
+            if (objects) object_edges += n->surf->object;
             n->next = *link;
             *link = n;
             link = &n->next;
             n = next;
         }
-        scan_line(S, active, y);
+        if (objects && object_edges)
+            scan_line(S, active, y, 1);
+        else
+            scan_line(S, active, y, 0);
         /* drop finished edges, step the rest, and restore x order: stepping
          * reorders only edges that cross, so an edge is moved back only when it
          * passed the one before it */
@@ -353,6 +596,7 @@ static void scan(span_state *S)
         while (*link2) {
             sp_edge *e = *link2;
             if (e->d.end_row <= y + 1) {
+                if (objects) object_edges -= e->surf->object;
                 *link2 = e->next;
                 continue;
             }
@@ -368,37 +612,21 @@ static void scan(span_state *S)
     }
 }
 
-/* 1 if the eye stands inside its leaf's floor polygon (leaf regions also take in
- * void behind walls) and between its sector's floor and ceiling, strictly: an eye
- * on a wall's line sees into the sector beyond as well, where its height may be
- * below that sector's floor and a solid wall there hides nothing. The shifted
- * products are within |dx| + |dy| + |ex| + |ey| + 2 of the exact cross product
- * (scaled by 1/16); a point nearer the edge than that counts as on it, which only
- * costs the occlusion shortcut. */
-static int eye_in_world(const scene *sc, const view_xform *v)
+static void scan(span_state *S, int objects)
 {
-    const scn_leaf *f = &sc->leaves[scene_leaf_at(sc, (int32_t)v->cx, (int32_t)v->cy)];
-    if (f->sector == SCN_NONE || f->num_pverts < 3) return 0;
-    const scn_sector *sec = &sc->sectors[f->sector];
-    if (v->cz <= sec->floor_h || v->cz >= sec->ceil_h) return 0;
-    for (uint32_t i = 0; i < f->num_pverts; i++) {
-        const scn_vertex *a = &sc->pverts[f->first_pvert + i];
-        const scn_vertex *b = &sc->pverts[f->first_pvert + (i + 1 == f->num_pverts ? 0 : i + 1)];
-        /* counter-clockwise polygon: inside is on the left of every edge; the
-         * shifts keep both products below 2^61 (as in surfaces.c) */
-        int64_t dx = fx_asr64((int64_t)b->x - a->x, 1), dy = fx_asr64((int64_t)b->y - a->y, 1);
-        int64_t ex = fx_asr64(v->cx - a->x, 3), ey = fx_asr64(v->cy - a->y, 3);
-        int64_t slack = (dx < 0 ? -dx : dx) + (dy < 0 ? -dy : dy) + (ex < 0 ? -ex : ex) + (ey < 0 ? -ey : ey) + 2;
-        if (dx * ey - dy * ex <= slack) return 0;
-    }
-    return 1;
+    if (objects)
+        scan_lines(S, 1);
+    else
+        scan_lines(S, 0);
 }
 
-void spans_render(const scene *sc, const view_xform *v, const rast_target *t, render_stats *st, void *work,
-                  uint32_t work_bytes)
+void spans_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t, render_stats *st,
+                  void *work, uint32_t work_bytes)
 {
-    if (!work || work_bytes < span_work_bytes(sc) || span_work_bytes(sc) == 0) {
-        st->refused = 1; /* the caller did not provide the memory this scene needs */
+    span_layout L;
+    layout(sc, w, &L);
+    if (!work || L.total > 0xFFFFFFF0u || work_bytes < L.total) {
+        st->refused = 1; /* the caller did not provide the memory this frame needs */
         render_clear(t, BACKGROUND_COLOUR);
         return;
     }
@@ -406,11 +634,21 @@ void spans_render(const scene *sc, const view_xform *v, const rast_target *t, re
     span_state *S = (span_state *)(void *)mem;
     mem += align8(sizeof(span_state));
     S->edges = (sp_edge *)(void *)mem;
-    S->max_edges = (uint32_t)max_edges(sc);
-    mem += align8(max_edges(sc) * sizeof(sp_edge));
+    S->max_edges = (uint32_t)L.edges;
+    mem += align8(L.edges * sizeof(sp_edge));
     S->surfs = (sp_surf *)(void *)mem;
-    S->max_surfs = (uint32_t)max_surfs(sc);
+    S->max_surfs = (uint32_t)L.surfs;
+    mem += align8(L.surfs * sizeof(sp_surf));
+    /* objects need the leaves' keys, and planes for their faces and the world
+     * surfaces they meet; a frame without them pays nothing for either */
+    S->leaf_key = (L.leaves && w->objs) ? (uint32_t *)(void *)mem : 0;
+    mem += align8(L.leaves * sizeof(uint32_t));
+    S->planes = (objd_plane *)(void *)mem;
+    S->max_planes = (uint32_t)L.planes;
+    S->nplanes = 0;
+    S->object_faces = 0;
     S->sc = sc;
+    S->w = w;
     S->v = v;
     S->t = t;
     S->st = st;
@@ -421,21 +659,25 @@ void spans_render(const scene *sc, const view_xform *v, const rast_target *t, re
     S->key = 0;
     S->nspans = 0;
     S->drawn = 0;
-    S->background = (sp_surf){0xFFFFFFFFu, RAST_ID(RAST_KIND_NONE, 0), 0, BACKGROUND_COLOUR, 0, 0, -1, 0};
+    S->background = (sp_surf){.key = 0xFFFFFFFFu, .id = RAST_ID(RAST_KIND_NONE, 0), .plane = -1, .seg = SCN_NONE,
+                              .colour = BACKGROUND_COLOUR, .span_head = -1};
     for (int y = 0; y < VIEW_H; y++) {
         S->new_edges[y] = 0;
         S->cover[y].n = 0;
     }
+    if (S->leaf_key)
+        for (uint32_t i = 0; i < sc->nleaves; i++) S->leaf_key[i] = 0;
     walk_stats ws;
     /* Solid walls close columns only for an eye inside the world: from outside
      * every sector, or above or below its own sector, one sees past them. */
-    occ_columns *occ = eye_in_world(sc, v) ? &S->occ : 0;
+    occ_columns *occ = eye_in_world(sc, w, v) ? &S->occ : 0;
     occ_reset(&S->occ);
     S->use_occ = occ != 0;
     walk_tree(sc, v, WALK_FRONT_TO_BACK, visit_leaf, S, occ, &ws);
     st->nodes = ws.nodes;
     st->boxes_culled = ws.boxes_culled + ws.boxes_hidden;
+    if (S->leaf_key) add_objects(S);
     st->edges = S->nedges;
-    scan(S);
+    scan(S, S->object_faces > 0);
     flush_spans(S);
 }

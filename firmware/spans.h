@@ -27,11 +27,22 @@
 #include "scene.h"
 #include "view.h"
 
-/* Bytes of work memory spans_render needs for this scene (0 if it would not fit
- * in 32 bits: the caller must refuse the scene). */
-uint32_t span_work_bytes(const scene *s);
+/* Bytes of work memory spans_render needs for this scene and w's objects (w
+ * NULL: none; see render_work_bytes), 0 if it would not fit in 32 bits: the
+ * caller must refuse the scene. Objects add, for every face of every object
+ * (all could be in view at once), a surface, its clipping-maximal edges and a
+ * 1/z plane, plus a plane for every world surface and a key per leaf. */
+uint32_t span_work_bytes(const scene *s, const world_state *w);
 
-void spans_render(const scene *sc, const view_xform *v, const rast_target *t, render_stats *st, void *work,
-                  uint32_t work_bytes);
+/* w: doors and objects (NULL: the static world). Objects are drawn after the
+ * walk (docs/objects.md): each one whose box touches a visited leaf enters the
+ * same edge lists, sorted against world surfaces by the key range of its
+ * visited leaves and, inside that range, and against other objects, by 1/z
+ * (obj_draw.h); on lines with an object the top of the stack is also checked
+ * for being overtaken along the line, so objects that reach into walls or into
+ * each other are cut where they cross. Without objects the scan is the
+ * key-only scan above, instruction for instruction. */
+void spans_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t, render_stats *st,
+                  void *work, uint32_t work_bytes);
 
 #endif

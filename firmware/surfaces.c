@@ -8,7 +8,7 @@
 #include "clip.h"
 
 static void emit(const view_xform *v, clip_poly *p, unsigned mask, const surf_sink *sink, uint8_t colour,
-                 uint32_t id, render_stats *st)
+                 uint32_t id, uint32_t seg, render_stats *st)
 {
     if (!clip_polygon(p, v, mask)) {
         st->clipped_away++;
@@ -17,7 +17,7 @@ static void emit(const view_xform *v, clip_poly *p, unsigned mask, const surf_si
     screen_pt s[CLIP_MAX_VERTS];
     clip_project(v, p, s);
     st->polygons++;
-    sink->polygon(sink->ctx, s, p->n, colour, id);
+    sink->polygon(sink->ctx, s, p->n, colour, id, seg);
 }
 
 /* Front-facing: the eye strictly on the right of a -> b (edge-on is culled).
@@ -31,7 +31,8 @@ static int faces_eye(const view_xform *v, const scn_vertex *a, const scn_vertex 
 }
 
 static void wall_part(const view_xform *v, const scn_vertex *a, const scn_vertex *b, int32_t bottom, int32_t top,
-                      unsigned mask, const surf_sink *sink, uint8_t colour, uint32_t id, render_stats *st)
+                      unsigned mask, const surf_sink *sink, uint8_t colour, uint32_t id, uint32_t seg,
+                      render_stats *st)
 {
     if (top <= bottom) return;
     clip_poly p;
@@ -40,7 +41,7 @@ static void wall_part(const view_xform *v, const scn_vertex *a, const scn_vertex
     p.v[1] = view_point(v, b->x, b->y, top);
     p.v[2] = view_point(v, b->x, b->y, bottom);
     p.v[3] = view_point(v, a->x, a->y, bottom);
-    emit(v, &p, mask, sink, colour, id, st);
+    emit(v, &p, mask, sink, colour, id, seg, st);
 }
 
 /* A wall with no opening hides everything behind it in the columns it covers.
@@ -51,9 +52,17 @@ static void close_columns(occ_columns *occ, int x0, int x1)
     occ_close(occ, x0 > 0 ? x0 + 1 : 0, x1 < VIEW_W ? x1 - 1 : VIEW_W);
 }
 
-static void seg_parts(const scene *sc, const view_xform *v, const scn_seg *g, unsigned mask, const surf_sink *sink,
-                      occ_columns *occ, render_stats *st)
+/* A sector's ceiling now: obj_ceil's rule, with its test of w made once per leaf
+ * (ceil: w->ceil, or NULL for the ceilings as compiled). */
+static inline int32_t ceil_now(const scene *sc, const fx_t *ceil, uint32_t i)
 {
+    return ceil ? ceil[i] : sc->sectors[i].ceil_h;
+}
+
+static void seg_parts(const scene *sc, const fx_t *ceil, const view_xform *v, uint32_t gi, unsigned mask,
+                      const surf_sink *sink, occ_columns *occ, render_stats *st)
+{
+    const scn_seg *g = &sc->segs[gi];
     const scn_vertex *a = &sc->verts[g->v1], *b = &sc->verts[g->v2];
     st->segs++;
     if (!faces_eye(v, a, b)) {
@@ -69,33 +78,35 @@ static void seg_parts(const scene *sc, const view_xform *v, const scn_seg *g, un
         }
     }
     const scn_line *l = &sc->lines[g->line];
-    const scn_sector *front = &sc->sectors[l->sector[g->side]];
-    uint32_t back_index = l->sector[g->side ^ 1u];
+    uint32_t front_index = l->sector[g->side], back_index = l->sector[g->side ^ 1u];
+    const scn_sector *front = &sc->sectors[front_index];
+    int32_t front_ceil = ceil_now(sc, ceil, front_index);
     uint32_t id = RAST_ID(RAST_KIND_WALL, g->line * 2u + g->side);
     const uint8_t *colour = l->color[g->side];
     if (back_index == SCN_NONE) {
-        wall_part(v, a, b, front->floor_h, front->ceil_h, mask, sink, colour[SCN_PART_MIDDLE], id, st);
+        wall_part(v, a, b, front->floor_h, front_ceil, mask, sink, colour[SCN_PART_MIDDLE], id, gi, st);
         if (occ) close_columns(occ, c0, c1);
         return;
     }
     const scn_sector *back = &sc->sectors[back_index];
-    if (back->ceil_h < front->ceil_h) {
-        int32_t low = back->ceil_h > front->floor_h ? back->ceil_h : front->floor_h;
+    int32_t back_ceil = ceil_now(sc, ceil, back_index);
+    if (back_ceil < front_ceil) {
+        int32_t low = back_ceil > front->floor_h ? back_ceil : front->floor_h;
         /* Doom's sky rule: between two sky ceilings there is no upper wall but more
          * sky. The step is drawn as the front sector's sky ceiling, so the view
          * through it has no hole. */
         if (front->flags & back->flags & SCN_SECTOR_SKY)
-            wall_part(v, a, b, low, front->ceil_h, mask, sink, front->ceil_color,
-                      RAST_ID(RAST_KIND_CEILING, l->sector[g->side]), st);
+            wall_part(v, a, b, low, front_ceil, mask, sink, front->ceil_color,
+                      RAST_ID(RAST_KIND_CEILING, front_index), gi, st);
         else
-            wall_part(v, a, b, low, front->ceil_h, mask, sink, colour[SCN_PART_UPPER], id, st);
+            wall_part(v, a, b, low, front_ceil, mask, sink, colour[SCN_PART_UPPER], id, gi, st);
     }
     if (back->floor_h > front->floor_h) {
-        int32_t high = back->floor_h < front->ceil_h ? back->floor_h : front->ceil_h;
-        wall_part(v, a, b, front->floor_h, high, mask, sink, colour[SCN_PART_LOWER], id, st);
+        int32_t high = back->floor_h < front_ceil ? back->floor_h : front_ceil;
+        wall_part(v, a, b, front->floor_h, high, mask, sink, colour[SCN_PART_LOWER], id, gi, st);
     }
     /* closed door: no opening between the two sectors */
-    int32_t top = back->ceil_h < front->ceil_h ? back->ceil_h : front->ceil_h;
+    int32_t top = back_ceil < front_ceil ? back_ceil : front_ceil;
     int32_t bottom = back->floor_h > front->floor_h ? back->floor_h : front->floor_h;
     if (occ && top <= bottom) close_columns(occ, c0, c1);
 }
@@ -114,22 +125,24 @@ static void plane(const scene *sc, const view_xform *v, const scn_leaf *f, int32
         const scn_vertex *q = &sc->pverts[f->first_pvert + (reverse ? n - 1 - i : i)];
         p.v[i] = view_point(v, q->x, q->y, h);
     }
-    emit(v, &p, mask, sink, colour, id, st);
+    emit(v, &p, mask, sink, colour, id, SCN_NONE, st);
 }
 
-void surf_leaf(const scene *sc, const view_xform *v, uint32_t leaf, unsigned mask, const surf_sink *sink,
-               occ_columns *occ, render_stats *st)
+void surf_leaf(const scene *sc, const world_state *w, const view_xform *v, uint32_t leaf, unsigned mask,
+               const surf_sink *sink, occ_columns *occ, render_stats *st)
 {
     const scn_leaf *f = &sc->leaves[leaf];
+    const fx_t *ceil = w ? w->ceil : 0;
     st->leaves++;
     if (f->sector != SCN_NONE) {
         const scn_sector *sec = &sc->sectors[f->sector];
         if (v->cz > sec->floor_h)
             plane(sc, v, f, sec->floor_h, 1, mask, sink, sec->floor_color, RAST_ID(RAST_KIND_FLOOR, f->sector), st);
-        if (v->cz < sec->ceil_h)
-            plane(sc, v, f, sec->ceil_h, 0, mask, sink, sec->ceil_color, RAST_ID(RAST_KIND_CEILING, f->sector), st);
+        int32_t top = ceil_now(sc, ceil, f->sector);
+        if (v->cz < top)
+            plane(sc, v, f, top, 0, mask, sink, sec->ceil_color, RAST_ID(RAST_KIND_CEILING, f->sector), st);
     }
-    for (uint32_t i = 0; i < f->num_segs; i++) seg_parts(sc, v, &sc->segs[f->first_seg + i], mask, sink, occ, st);
+    for (uint32_t i = 0; i < f->num_segs; i++) seg_parts(sc, ceil, v, f->first_seg + i, mask, sink, occ, st);
 }
 
 uint32_t surf_max_polygon_verts(const scene *s)

@@ -7,6 +7,7 @@
 #define SURFACES_H
 
 #include <stdint.h>
+#include "objects.h"
 #include "render.h"
 #include "scene.h"
 #include "occlusion.h"
@@ -14,17 +15,20 @@
 
 typedef struct {
     /* Called once per polygon that survived clipping: n >= 3 screen vertices,
-     * clockwise on screen, inside [0,320] x [0,200]. */
-    void (*polygon)(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id);
+     * clockwise on screen, inside [0,320] x [0,200]. seg: the seg whose wall it is
+     * part of, or SCN_NONE for the floor or ceiling its id names (a sky step has
+     * a ceiling's id but is a wall: its seg tells). */
+    void (*polygon)(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id, uint32_t seg);
     void *ctx;
 } surf_sink;
 
 /* Emit the leaf's surfaces in an order that is correct back to front within the
- * leaf (floor and ceiling first, then walls). clip_mask: planes still to clip
- * against (bsp_walk.h). occ (may be NULL): closed columns; wall pieces wholly
- * inside them are skipped, and solid walls close the columns they cover. */
-void surf_leaf(const scene *s, const view_xform *v, uint32_t leaf, unsigned clip_mask, const surf_sink *sink,
-               occ_columns *occ, render_stats *st);
+ * leaf (floor and ceiling first, then walls). w: the ceilings now (doors; NULL:
+ * as compiled). clip_mask: planes still to clip against (bsp_walk.h). occ (may
+ * be NULL): closed columns; wall pieces wholly inside them are skipped, and
+ * solid walls (one-sided, or a closed door's) close the columns they cover. */
+void surf_leaf(const scene *s, const world_state *w, const view_xform *v, uint32_t leaf, unsigned clip_mask,
+               const surf_sink *sink, occ_columns *occ, render_stats *st);
 
 /* The most screen vertices surf_leaf can hand a sink for this scene (bounds the
  * edge pool of the span renderer). */

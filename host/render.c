@@ -2,6 +2,7 @@
  * present mode in; PNG, raw frame, surface-id buffer and one JSON object of
  * counters out. Runs the firmware on the null target. */
 #include <errno.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -11,6 +12,7 @@
 #include "fxtext.h"
 #include "hal.h"
 #include "hal_null.h"
+#include "objects.h"
 #include "png.h"
 #include "scene_file.h"
 
@@ -39,7 +41,31 @@ static const char usage[] =
     "                     kind << 24 | index (0 none, 1 wall, 2 floor, 3 ceiling, 4 object)\n"
     "  --repeat N         render the same frame N times (default 1); counters are\n"
     "                     those of the last frame\n"
-    "  -h, --help         this text\n";
+    "  -h, --help         this text\n"
+    "\n"
+    "Moving objects and doors (docs/objects.md):\n"
+    "  --time MS          objects along their paths at MS milliseconds, and doors as\n"
+    "                     they would be after MS ms with the player standing at the\n"
+    "                     camera from time 0 (default: time 0, doors as compiled)\n"
+    "  --objects FILE     replace the scene's objects by FILE's: one per line,\n"
+    "                     'object MODEL X Y Z YAW' (map units, degrees; no paths;\n"
+    "                     '#' starts a comment). MODEL is a model number, or a\n"
+    "                     model name when SCENE is a text scene (names are read\n"
+    "                     from its 'model' lines: a compiled scene or a WAD map\n"
+    "                     has no names; a WAD's models are numbered in order of\n"
+    "                     first use by its things)\n"
+    "  --no-objects       draw no objects\n"
+    "  --door SECTOR=H    set door SECTOR's ceiling to H, between its closed and\n"
+    "                     open heights (repeatable; after --time)\n"
+    "The JSON gains \"objects\" (each object as drawn: model, x, y, z, yaw, the exact\n"
+    "16.16 values), \"ceilings\" (sectors whose ceiling is not the compiled one) and the\n"
+    "renderer's \"objects_visible\" and \"object_faces\".\n";
+
+typedef struct {
+    const char *arg; /* as given, for messages */
+    uint32_t sector;
+    fx_t h;
+} door_opt;
 
 typedef struct {
     const char *scene, *png, *raw, *ids;
@@ -49,6 +75,11 @@ typedef struct {
     hal_present_mode present;
     bspc_options bspc;
     long repeat;
+    uint32_t time_ms;
+    int have_time, no_objects;
+    const char *objects; /* --objects FILE */
+    door_opt *doors;     /* room for every argument */
+    int ndoors;
 } options;
 
 static int die(const char *fmt, const char *a, const char *b)
@@ -83,6 +114,9 @@ static int parse_args(options *o, int argc, char **argv)
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             fputs(usage, stdout);
             exit(0);
+        } else if (!strcmp(a, "--no-objects")) {
+            o->no_objects = 1;
+            takes = 0;
         } else if (a[0] != '-' || !strcmp(a, "-")) {
             if (o->scene) return die("more than one scene given: '%s'%s", a, "");
             o->scene = a;
@@ -120,6 +154,28 @@ static int parse_args(options *o, int argc, char **argv)
             o->raw = val;
         } else if (!strcmp(a, "--ids")) {
             o->ids = val;
+        } else if (!strcmp(a, "--time")) {
+            char *end;
+            errno = 0;
+            unsigned long long v = strtoull(val, &end, 10);
+            if (*end || !*val || val[0] == '-' || errno || v > UINT32_MAX)
+                return die("--time '%s': expected whole milliseconds 0..4294967295%s", val, "");
+            o->time_ms = (uint32_t)v;
+            o->have_time = 1;
+        } else if (!strcmp(a, "--objects")) {
+            o->objects = val;
+        } else if (!strcmp(a, "--door")) {
+            const char *eq = strchr(val, '=');
+            char *end;
+            errno = 0;
+            unsigned long v = strtoul(val, &end, 10);
+            door_opt *d = &o->doors[o->ndoors];
+            if (!eq || end != eq || end == val || val[0] == '-' || errno || v >= SCN_NONE ||
+                fxtext_parse(eq + 1, &d->h))
+                return die("--door '%s': expected SECTOR=H (a sector number and a height)%s", val, "");
+            d->arg = val;
+            d->sector = (uint32_t)v;
+            o->ndoors++;
         } else if (!strcmp(a, "--repeat")) {
             char *end;
             o->repeat = strtol(val, &end, 10);
@@ -130,6 +186,203 @@ static int parse_args(options *o, int argc, char **argv)
         i += takes;
     }
     if (!o->scene) return die("no scene given (see --help)%s%s", "", "");
+    if (o->objects && o->no_objects) return die("--objects and --no-objects exclude each other%s%s", "", "");
+    return 0;
+}
+
+/* Model names of a text scene, in the order bspc numbers its models (the order of its
+ * 'model' lines). The compiled blob keeps no names, so --objects resolves them here;
+ * a compiled scene or a WAD map gives none (0). Returns the count, or -1 out of memory. */
+static int text_model_names(const char *spec, char ***names_out)
+{
+    *names_out = NULL;
+    FILE *f = fopen(spec, "rb");
+    if (!f) return 0; /* file.wad:MAP01, not a file of that name */
+    char line[1024];
+    size_t got = fread(line, 1, 4, f);
+    if (got == 4 && !memcmp(line, "BSCN", 4)) {
+        fclose(f);
+        return 0;
+    }
+    rewind(f);
+    char **names = NULL;
+    int n = 0;
+    while (fgets(line, sizeof line, f)) {
+        char *hash = strchr(line, '#');
+        if (hash) *hash = 0;
+        char *save, *w0 = strtok_r(line, " \t\r\n", &save);
+        char *w1 = w0 ? strtok_r(NULL, " \t\r\n", &save) : NULL;
+        if (!w0 || strcmp(w0, "model") || !w1) continue;
+        char **grown = realloc(names, sizeof *names * (size_t)(n + 1));
+        char *copy = grown ? malloc(strlen(w1) + 1) : NULL;
+        if (!copy) {
+            free(grown ? grown : names);
+            fclose(f);
+            return -1;
+        }
+        names = grown;
+        names[n++] = strcpy(copy, w1);
+    }
+    fclose(f);
+    *names_out = names;
+    return n;
+}
+
+static void free_names(char **names, int n)
+{
+    for (int i = 0; i < n; i++) free(names[i]);
+    free(names);
+}
+
+static void file_error(const char *path, int lineno, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+static void file_error(const char *path, int lineno, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "render: %s:%d: ", path, lineno);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+}
+
+/* --objects FILE: 'object MODEL X Y Z YAW' lines into a malloc'd array. Positions must be
+ * inside the world box, as the loader demands of compiled objects. Returns the count, or
+ * -1 after a message naming the file and line. */
+static long read_objects(const char *path, const char *spec, const scene *s, obj_state **out)
+{
+    *out = NULL;
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        fprintf(stderr, "render: %s: cannot read objects: %s\n", path, strerror(errno));
+        return -1;
+    }
+    char **names;
+    int nnames = text_model_names(spec, &names);
+    obj_state *objs = NULL;
+    long n = 0, rc = -1;
+    char line[1024];
+    int lineno = 0;
+    if (nnames < 0) {
+        fprintf(stderr, "render: out of memory\n");
+        goto done;
+    }
+    while (fgets(line, sizeof line, f)) {
+        lineno++;
+        if (!strchr(line, '\n') && !feof(f)) {
+            file_error(path, lineno, "line longer than %u characters", (unsigned)sizeof line - 2);
+            goto done;
+        }
+        char *hash = strchr(line, '#');
+        if (hash) *hash = 0;
+        char *tok[7], *save;
+        int nt = 0;
+        for (char *t = strtok_r(line, " \t\r\n", &save); t; t = strtok_r(NULL, " \t\r\n", &save))
+            if (nt < 7) tok[nt++] = t;
+            else nt++;
+        if (nt == 0) continue;
+        if (strcmp(tok[0], "object") || nt != 6) {
+            file_error(path, lineno, "expected 'object MODEL X Y Z YAW'");
+            goto done;
+        }
+        if (n >= SCN_MAX_OBJECTS) {
+            file_error(path, lineno, "more than %u objects", (unsigned)SCN_MAX_OBJECTS);
+            goto done;
+        }
+        obj_state o;
+        memset(&o, 0, sizeof o);
+        const char *m = tok[1];
+        int named = -1;
+        for (int i = 0; i < nnames; i++)
+            if (!strcmp(names[i], m)) named = i;
+        if (named >= 0) {
+            o.model = (uint32_t)named;
+        } else {
+            char *end;
+            errno = 0;
+            unsigned long v = strtoul(m, &end, 10);
+            if (*end || m[0] < '0' || m[0] > '9' || errno || v >= s->nmodels) {
+                if (s->nmodels == 0)
+                    file_error(path, lineno, "model '%s': the scene has no models", m);
+                else if (nnames > 0)
+                    file_error(path, lineno, "model '%s': no model of that name or number (numbers 0..%u)", m,
+                               (unsigned)s->nmodels - 1);
+                else
+                    file_error(path, lineno, "model '%s': expected a model number 0..%u (only a text scene's "
+                               "models have names)", m, (unsigned)s->nmodels - 1);
+                goto done;
+            }
+            o.model = (uint32_t)v;
+        }
+        static const char *const what[4] = {"X", "Y", "Z", "YAW"};
+        const int64_t coord_max = (int64_t)SCN_COORD_MAX << 16, height_max = (int64_t)SCN_HEIGHT_MAX << 16;
+        const int64_t limit[4] = {coord_max, coord_max, height_max, INT32_MAX};
+        int64_t v[4];
+        int k = 0;
+        for (; k < 4; k++) {
+            if (fxtext_parse64(tok[2 + k], &v[k])) {
+                file_error(path, lineno, "%s '%s' is not a number", what[k], tok[2 + k]);
+                goto done;
+            }
+            if (v[k] < -limit[k] || v[k] > limit[k]) break;
+        }
+        if (k < 2) {
+            file_error(path, lineno, "X, Y outside the world box (|coordinate| <= %d)", SCN_COORD_MAX);
+            goto done;
+        } else if (k == 2) {
+            file_error(path, lineno, "Z outside the height range (|Z| <= %d)", SCN_HEIGHT_MAX);
+            goto done;
+        } else if (k == 3) {
+            file_error(path, lineno, "YAW '%s' outside the 16.16 range", tok[5]);
+            goto done;
+        }
+        o.x = (fx_t)v[0];
+        o.y = (fx_t)v[1];
+        o.z = (fx_t)v[2];
+        o.yaw_deg = (fx_t)v[3];
+        obj_state *grown = realloc(objs, sizeof *objs * (size_t)(n + 1));
+        if (!grown) {
+            fprintf(stderr, "render: out of memory\n");
+            goto done;
+        }
+        objs = grown;
+        objs[n++] = o;
+    }
+    if (ferror(f)) {
+        fprintf(stderr, "render: %s: cannot read objects: %s\n", path, strerror(errno));
+        goto done;
+    }
+    rc = n;
+    *out = objs;
+    objs = NULL;
+done:
+    free(objs);
+    free_names(names, nnames);
+    fclose(f);
+    return rc;
+}
+
+/* The door options, after --time: each must name a door and a ceiling between its closed
+ * and open heights, so the renderer sees only states a door can be in. */
+static int apply_doors(const options *o, const scene *s, world_state *w)
+{
+    for (int i = 0; i < o->ndoors; i++) {
+        const door_opt *d = &o->doors[i];
+        if (d->sector >= s->nsectors || !(s->sectors[d->sector].flags & SCN_SECTOR_DOOR)) {
+            fprintf(stderr, "render: --door '%s': sector %u is not a door of %s\n", d->arg, (unsigned)d->sector,
+                    o->scene);
+            return -1;
+        }
+        const scn_sector *sec = &s->sectors[d->sector];
+        if (d->h < sec->ceil_h || d->h > sec->open_h) {
+            char lo[48], hi[48];
+            fxtext_format(sec->ceil_h, lo, sizeof lo);
+            fxtext_format(sec->open_h, hi, sizeof hi);
+            fprintf(stderr, "render: --door '%s': the door moves between %s (closed) and %s (open)\n", d->arg, lo,
+                    hi);
+            return -1;
+        }
+        w->ceil[d->sector] = d->h;
+    }
     return 0;
 }
 
@@ -174,9 +427,31 @@ static void print_json(const options *o, const engine *e, uint32_t crc)
            (unsigned long long)hal_perf_tsc(), bus.vram_cycles, bus.sysmem_cycles);
     const render_stats *st = &e->stats;
     printf("\"nodes\": %u, \"boxes_culled\": %u, \"leaves\": %u, \"segs\": %u, \"culled\": %u, "
-           "\"polygons\": %u, \"occluded\": %u, \"edges\": %u, \"spans\": %u, \"work_bytes\": %u, \"frames\": %ld}\n",
+           "\"polygons\": %u, \"occluded\": %u, \"edges\": %u, \"spans\": %u, \"work_bytes\": %u, \"frames\": %ld, ",
            st->nodes, st->boxes_culled, st->leaves, st->segs, st->culled, st->polygons, st->occluded, st->edges,
            st->spans, e->work.bytes, o->repeat);
+    printf("\"objects_visible\": %u, \"object_faces\": %u, \"objects\": [", st->objects_visible, st->object_faces);
+    const world_state *w = &e->world;
+    for (uint32_t i = 0; i < w->n; i++) {
+        const obj_state *ob = &w->objs[i];
+        printf("%s{\"model\": %u, ", i ? ", " : "", (unsigned)ob->model);
+        print_fx("x", ob->x, ", ");
+        print_fx("y", ob->y, ", ");
+        print_fx("z", ob->z, ", ");
+        print_fx("yaw", ob->yaw_deg, "}");
+    }
+    printf("], \"ceilings\": {");
+    int first = 1;
+    for (uint32_t i = 0; i < e->sc.nsectors; i++) {
+        fx_t h = obj_ceil(w, &e->sc, i);
+        if (h == e->sc.sectors[i].ceil_h) continue;
+        char key[16];
+        snprintf(key, sizeof key, "%u", (unsigned)i);
+        printf("%s", first ? "" : ", ");
+        print_fx(key, h, "");
+        first = 0;
+    }
+    printf("}}\n");
 }
 
 int main(int argc, char **argv)
@@ -187,6 +462,8 @@ int main(int argc, char **argv)
     o.present = HAL_PRESENT_FLIP;
     o.bspc = bspc_defaults();
     o.repeat = 1;
+    door_opt doors[argc > 0 ? argc : 1];
+    o.doors = doors;
     int rc = parse_args(&o, argc, argv);
     if (rc) return rc;
 
@@ -206,11 +483,26 @@ int main(int argc, char **argv)
         free(blob);
         return 1;
     }
+    obj_state *file_objs = NULL;
+    long nfile = 0;
+    if (o.objects && (nfile = read_objects(o.objects, o.scene, &e.sc, &file_objs)) < 0) {
+        free(blob);
+        return 1;
+    }
+    /* The renderer's work memory depends on the objects drawn: the file's may need more
+     * than the scene's own, which is what eng_work_bytes provides for. */
     uint32_t need = eng_work_bytes(&e);
+    if (o.objects && need) {
+        world_state mine = {file_objs, (uint32_t)nfile, 0, 0};
+        uint64_t r = render_work_bytes(&e.sc, &mine), total = (uint64_t)obj_state_bytes(&e.sc) + r;
+        if (r == 0 || total > 0xFFFFFFF0u) need = 0;
+        else if (total > need) need = (uint32_t)total;
+    }
     void *work = need ? malloc(need) : NULL;
     if (!work || eng_set_work(&e, work, need) != 0) {
         fprintf(stderr, "render: %s: the scene needs %u bytes of work memory, which could not be had\n", o.scene, need);
         free(work);
+        free(file_objs);
         free(blob);
         return 1;
     }
@@ -227,6 +519,24 @@ int main(int argc, char **argv)
     } else {
         e.cam.view.z = CAM_EYE_HEIGHT;
         cam_follow_floor(&e.cam, &e.sc);
+    }
+    /* Paths are exact functions of t and a door's motion depends only on the total time,
+     * so one update from time 0 stands for every frame in between, the player at the camera. */
+    if (o.have_time) {
+        e.t_ms = o.time_ms;
+        obj_update(&e.world, &e.sc, o.time_ms, o.time_ms, e.cam.view.x, e.cam.view.y);
+    }
+    if (apply_doors(&o, &e.sc, &e.world) != 0) {
+        free(work);
+        free(file_objs);
+        free(blob);
+        return 1;
+    }
+    if (o.objects) {
+        e.world.objs = file_objs;
+        e.world.n = (uint32_t)nfile;
+    } else if (o.no_objects) {
+        e.world.n = 0;
     }
 
     uint32_t *ids = o.ids ? calloc(HAL_PAGE_BYTES, sizeof *ids) : NULL;
@@ -252,6 +562,7 @@ int main(int argc, char **argv)
     }
     print_json(&o, &e, crc);
     free(ids);
+    free(file_objs);
     free(work);
     free(blob);
     return failed ? 1 : 0;

@@ -24,7 +24,8 @@ def test_all_freedoom_maps_compile(split):
     freedoom("freedoom1.wad"), freedoom("freedoom2.wad")
     for spec in MAPS:
         s = stats(spec, "--split", split)
-        for key in ("input_walls", "segs", "splits", "leaves", "nodes", "max_depth", "mean_depth", "build_ms"):
+        for key in ("input_walls", "segs", "splits", "leaves", "nodes", "max_depth", "mean_depth", "build_ms",
+                    "models", "objects"):
             assert key in s, (spec, key)
         assert s["leaves"] == s["nodes"] + 1, spec
         assert s["segs"] >= s["input_walls"], spec
@@ -34,6 +35,22 @@ def test_all_freedoom_maps_compile(split):
 def test_sanitized_compile_of_a_large_map():
     s = stats("freedoom2.wad:MAP01", sanitized=True)
     assert s["leaves"] > 100
+
+
+def test_stats_count_models_and_objects(tmp_path):
+    """--stats counts the models and objects (docs/objects.md); a Doom map's things are objects."""
+    path = tmp_path / "objects.scene"
+    path.write_text(ROOM.format(name="a", far=256, floor=0, ceil=64) +
+                    "model crate\npart box w=32 d=32 h=32\nend\n"
+                    "model post\npart prism sides=6 r=4 h=40\npart box w=16 d=16 h=2 at=0,0,40\nend\n"
+                    "object crate 100 100\nobject post 50 50 yaw=45\nobject crate 200 200 z=8 path=circle:20:1000\n")
+    s = stats(path, sanitized=True)
+    assert (s["models"], s["objects"]) == (2, 3)
+    s = stats(str(ROOT / "tests/scenes/default.scene"))
+    assert (s["models"], s["objects"]) == (0, 0)
+    freedoom("freedoom2.wad")
+    s = stats("freedoom2.wad:MAP01")
+    assert s["objects"] > 50 and 0 < s["models"] < s["objects"]
 
 
 def test_help():

@@ -193,7 +193,7 @@ def test_freedoom_map01_linedefs_numbered_like_bspc():
 
 # ---- a hand-made WAD: a room with an alcove, a zero-length linedef, a back sidedef ----------
 
-def make_wad(path):
+def make_wad(path, things=None):
     """PWAD with MAP01: room (sector 0) 256x256, alcove (sector 1, raised floor, lowered
     ceiling) east of it behind a two-sided linedef whose front (sidedef 0) is the alcove.
     Linedef 2 has zero length (two vertices at one point): bspc skips it, so the two-sided
@@ -217,7 +217,7 @@ def make_wad(path):
         linedefs += struct.pack("<HHHHHHH", v1, v2, 4 if b is not None else 1, 0, 0, *ids)
     sectors = struct.pack("<hh8s8shhh", 0, 128, b"FLOOR4_8", b"CEIL3_5", 160, 0, 0) + \
         struct.pack("<hh8s8shhh", 32, 96, b"FLOOR4_8", b"CEIL3_5", 160, 0, 0)
-    things = struct.pack("<hhhHH", 64, 128, 0, 1, 7)
+    things = struct.pack("<hhhHH", 64, 128, 0, 1, 7) + (things or b"")
     vertexes = b"".join(struct.pack("<hh", x, y) for x, y in verts)
     lumps = [(b"MAP01", b""), (b"THINGS", things), (b"LINEDEFS", linedefs), (b"SIDEDEFS", sides),
              (b"VERTEXES", vertexes), (b"SECTORS", sectors)]
@@ -351,3 +351,209 @@ def test_accuracy_cli(tmp_path):
     (tmp_path / "short.bin").write_bytes(b"\0" * 100)
     bad = run([PY, ROOT / "tools" / "accuracy.py", tmp_path / "short.bin", tmp_path / "b.bin"], check=False)
     assert bad.returncode == 1 and "short.bin" in bad.stderr
+
+
+# ---- objects (docs/objects.md) --------------------------------------------------------------
+
+OBJ = 4 << 24
+BOX_ROOM = ROOM.replace("player 128 128 0\n", "") + """\
+model crate
+part box w=32 d=32 h=32
+end
+model tri
+part prism sides=4 r={r} h=32
+end
+model stack
+part box w=32 d=32 h=16
+part box w=32 d=32 h=16 at=0,0,16
+end
+object crate 128 128
+player 32 128 0
+"""
+
+
+@pytest.fixture
+def box_room(tmp_path):
+    path = tmp_path / "box.scene"
+    path.write_text(BOX_ROOM.format(r=16 * math.sqrt(2)))
+    return str(path)
+
+
+def silhouette(ids, obj=0):
+    rows, cols = np.nonzero(ids == OBJ | obj)
+    return rows.min(), rows.max(), cols.min(), cols.max(), rows.size
+
+
+def test_box_straight_ahead(box_room):
+    """A 32-unit crate on the floor, its near face 80 units ahead (x 112..144, y 112..144, eye at
+    (32, 128, 41)). Columns: the near face spans +-16 units at depth 80, xv in [-0.2, 0.2], pixel
+    centres 127.5..191.5: columns 128..191. Rows: the top face is seen from above; its far edge at
+    depth 112, 9 units below the eye, is at row centre 100 + 160 * 9 / 112 = 112.86 (first row
+    113); the near face's bottom edge at depth 80, 41 below, at 100 + 82 = 182.0, a centre exactly
+    on the edge, which the top-left rule gives to the floor below (last row 181). Row 113's centre
+    (113.5) meets the top face at depth 9 * 160 / 13.5 = 106.67, where its +-16 units are +-24
+    pixels: columns 136..183."""
+    ids = refrender.render_ids(box_room, 32, 128, angle=0)
+    top, bottom, left, right, n = silhouette(ids)
+    assert (top, bottom, left, right) == (113, 181, 128, 191)
+    assert (ids[118:182, 128:192] == OBJ).all()          # the near face: rows 118..181
+    row = np.nonzero(ids[113] == OBJ)[0]
+    assert (row.min(), row.max()) == (136, 183)
+    assert ids[182, 160] == FLOOR | 0 and ids[112, 160] == WALL | 4
+    # the same object seen from the far side of the room: mirrored; without objects: no object
+    back = refrender.render_ids(box_room, 224, 128, angle=180)
+    assert silhouette(back)[:4] == (113, 181, 128, 191)
+    assert not (refrender.render_ids(box_room, 32, 128, angle=0, objects=[]) >> 24 == 4).any()
+
+
+def test_objects_argument_and_order(box_room):
+    """objects= replaces the scene's: tuples or build/render's JSON dicts; ids are the list
+    positions; the nearer object hides the farther one wherever they overlap."""
+    near = (0, 80, 128, 0, 0)                       # near face at x 64: depth 32
+    far = {"model": 0, "x": 200, "y": 140, "z": 0, "yaw": 0}
+    ids = refrender.render_ids(box_room, 32, 128, angle=0, objects=[far, near])
+    # at depth 32 the near crate's face spans +-16 / 32 * 160 = 80 pixels: columns 80..239
+    assert silhouette(ids, 1)[2:4] == (80, 239)
+    # the far crate (depth 152..184) shows only above the near one: rows whose ray passes over
+    # the near crate's top (32 units up, 9 below the eye: row centre < 100 + 160 * 9 / 64 = 122.5)
+    rows = np.nonzero((ids == OBJ | 0).any(axis=1))[0]
+    assert rows.size and rows.max() < 123
+    assert (ids == OBJ | 0).sum() < (refrender.render_ids(box_room, 32, 128, angle=0,
+                                                           objects=[far]) == OBJ).sum()
+
+
+def test_prism_and_yaw(box_room):
+    """A square prism of circumradius 16 sqrt 2 turned by 45 degrees is the crate (up to the
+    rounding of its vertices to 16.16); a crate turned by 90 degrees is itself."""
+    ref = refrender.render_ids(box_room, 32, 128, angle=0)
+    prism = refrender.render_ids(box_room, 32, 128, angle=0, objects=[(1, 128, 128, 0, 45)])
+    assert (prism != ref).sum() <= 4
+    turned = refrender.render_ids(box_room, 32, 128, angle=0, objects=[(0, 128, 128, 0, 90)])
+    assert (turned == ref).all()
+    # a yaw of 45: the crate's corner points at the eye; its silhouette is sqrt 2 wider, the
+    # corner edge nearest at depth 96 - 16 sqrt 2, the side corners at depth 96, +-22.63 units:
+    # +-37.71 pixels, centres 122.29..197.71: columns 122..197
+    diag = refrender.render_ids(box_room, 32, 128, angle=0, objects=[(0, 128, 128, 0, 45)])
+    assert silhouette(diag)[2:4] == (122, 197)
+
+
+def test_multi_part_model(box_room):
+    """Two stacked boxes are one object: the same silhouette and id as the 32-unit crate."""
+    ref = refrender.render_ids(box_room, 32, 128, angle=0)
+    stack = refrender.render_ids(box_room, 32, 128, angle=0, objects=[(2, 128, 128, 0, 0)])
+    assert (stack == ref).all()
+
+
+def test_eye_inside_near_plane_and_behind_walls(box_room):
+    """An eye inside a crate sees none of it (its faces are all back faces); a crate behind the
+    eye or outside the room (beyond the east wall) is not drawn."""
+    inside = refrender.render_ids(box_room, 128, 128, 20, angle=0)
+    assert not (inside >> 24 == 4).any()
+    behind = refrender.render_ids(box_room, 200, 128, angle=0, objects=[(0, 150, 128, 0, 0)])
+    assert not (behind >> 24 == 4).any()
+    outside = refrender.render_ids(box_room, 32, 128, angle=0, objects=[(0, 300, 128, 0, 0)])
+    assert not (outside >> 24 == 4).any()
+    # a crate 16.5 units ahead: on the centre column its near face from row 187 (its top edge,
+    # 9 below the eye, at row centre 100 + 160 * 9 / 16.5 = 187.3), its top face up to row 130
+    # (the far edge: 100 + 160 * 9 / 48.5 = 129.7), and the east wall above that (row 129
+    # reaches it 160.5 ahead, 41 - 160.5 * 29.5 / 160 = 11.4 units up)
+    close = refrender.render_ids(box_room, 95.5, 128, angle=0)
+    assert (close[130:, 160] == OBJ).all() and close[129, 160] == WALL | 4
+
+
+def test_object_states_paths(tmp_path):
+    """Paths as docs/objects.md defines them: a circle of radius 100 and period 4000 ms at
+    t = 1000 is a quarter turn (origin at centre + (0, 100), facing west: yaw 180); a line path
+    at a quarter period is half way out; spin adds degrees per second; z is the floor."""
+    scene = tmp_path / "paths.scene"
+    scene.write_text(ROOM.replace("ceil=128", "ceil=128").replace("player 128 128 0\n", "") + """\
+model m
+part box w=8 d=8 h=8
+end
+object m 128 128 path=circle:100:4000
+object m 50 60 z=10 yaw=5 path=line:40:-20:2000 spin=90
+player 32 32 0
+""")
+    s = refrender.object_states(str(scene), 1000)
+    assert s[0][0] == 0 and s[0][1:4] == pytest.approx((128, 228, 0)) and s[0][4] == pytest.approx(180)
+    assert s[1][1:] == pytest.approx((90, 40, 10, 5 + 90))           # at the far end
+    s = refrender.object_states(str(scene), 500)
+    assert s[1][1:3] == pytest.approx((70, 50)) and s[0][1:3] == pytest.approx((128 + 50 * 2 ** .5,
+                                                                                128 + 50 * 2 ** .5))
+    assert refrender.object_states(str(scene), 4000)[0][1:3] == pytest.approx((228, 128))
+
+
+def test_door_ceilings(tmp_path):
+    """A closed door (ceiling = floor) is a wall; given its open ceiling the room beyond shows."""
+    scene = tmp_path / "door.scene"
+    scene.write_text("""\
+sector a floor=0 ceil=128
+sector d floor=0 ceil=0 door=100
+sector b floor=0 ceil=128
+wall 0 0 0 128 a
+wall 0 128 128 128 a
+wall 128 128 128 80 a
+wall 128 80 128 48 a d
+wall 128 48 128 0 a
+wall 128 0 0 0 a
+wall 128 80 144 80 d
+wall 144 80 144 48 d b
+wall 144 48 128 48 d
+wall 144 128 256 128 b
+wall 256 128 256 0 b
+wall 256 0 144 0 b
+wall 144 0 144 48 b
+wall 144 80 144 128 b
+player 64 64 0
+""")
+    m = refrender.load(str(scene))
+    assert list(m.open_h) == [128, 100, 128]
+    shut = refrender.render_ids(str(scene), 20, 64, angle=0)
+    assert shut[100, 160] == WALL | (3 * 2)
+    open_ = refrender.render_ids(str(scene), 20, 64, angle=0, ceilings={"1": 100})
+    assert open_[100, 160] == WALL | (10 * 2)                   # b's east wall through the door
+    # the door's top, 59 above the eye at depth 108: rows whose centre is above
+    # 100 - 160 * 59 / 108 = 12.6 see the upper step over it, the next the door's own ceiling
+    assert (open_[:13, 160] == WALL | (3 * 2)).all() and open_[13, 160] == CEIL | 1
+
+
+def test_object_statements_errors(tmp_path):
+    bad = {"part box w=1 d=1 h=1\n": "part outside a model",
+           "model m\npart cone r=1\nend\n": "box' or 'prism",
+           "model m\npart prism sides=2 r=1 h=1\nend\n": "3..16",
+           "object nosuch 1 1\n": "unknown model",
+           "model m\npart box w=1 d=1 h=1\n": "no 'end'"}
+    for text, msg in bad.items():
+        path = tmp_path / "bad.scene"
+        path.write_text(ROOM + text)
+        refrender._cache.pop(str(path), None)
+        with pytest.raises(ValueError, match=msg):
+            refrender.load(str(path))
+
+
+def test_wad_things_become_objects(tmp_path):
+    """Things of tools/bspc/things.txt in skill 3 and not multiplayer-only are objects, in THINGS
+    order, boxes of their radius and height on the floor under them (the alcove's is 32 up); the
+    compiled scene has the same objects, and build/render draws them where the reference does."""
+    table = refrender.read_things_table()
+    r, h, _ = table[3004]
+    things = (struct.pack("<hhhHH", 160, 100, 90, 3004, 7)         # object 0, yaw 90
+              + struct.pack("<hhhHH", 160, 160, 0, 3004, 1)        # skill 1 only: left out
+              + struct.pack("<hhhHH", 160, 60, 0, 3004, 7 | 0x10)  # multiplayer only: left out
+              + struct.pack("<hhhHH", 288, 128, 45, 3004, 2)       # object 1, in the alcove
+              + struct.pack("<hhhHH", 100, 100, 0, 11, 7))         # a deathmatch start: not one
+    wad = tmp_path / "things.wad"
+    make_wad(wad, things)
+    spec = f"{wad}:MAP01"
+    m = refrender.load(spec)
+    assert len(m.models) == 1 and len(m.objects) == 2
+    verts = m.models[0].parts[0][0]
+    assert verts.min(axis=0).tolist() == [-r, -r, 0] and verts.max(axis=0).tolist() == [r, r, h]
+    states = refrender.object_states(spec, 0)
+    assert states == [(0, 160, 100, 0, 90), (0, 288, 128, 32, 45)]
+    out = tmp_path / "c.bin"
+    j = json.loads(run([program("render"), spec, "--at", "32,128", "--angle", "0", "--ids", out]).stdout)
+    assert [(o["model"], o["x"], o["y"], o["z"], o["yaw"]) for o in j["objects"]] == states
+    ids = refrender.render_ids(spec, 32, 128, angle=0)
+    assert OBJ | 0 in ids and OBJ | 1 in ids
+    assert accuracy.differ(ids, accuracy.read_ids(out)) < 0.005

@@ -87,7 +87,7 @@ static int free_dist(const scene *s, fx_t x, fx_t y, fx_t z, int deg, int maxd, 
     for (d = 16; d <= maxd; d += 16) {
         fx_t px = (fx_t)(x + ((c * d * FX_ONE) >> FX_TRIG_SHIFT));
         fx_t py = (fx_t)(y + ((sn * d * FX_ONE) >> FX_TRIG_SHIFT));
-        if (!col_line_of_sight(s, x, y, z, px, py, z)) break;
+        if (!col_line_of_sight(s, NULL, x, y, z, px, py, z)) break;
         sc += 64 / (1 + *cell(px, py));
     }
     if (score) *score = sc;

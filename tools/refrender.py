@@ -5,7 +5,8 @@ It reads the SOURCE map (a text scene, docs/scene-format.md, or a Doom-format ma
 and casts one ray through the centre of each of the 320x200 pixels, in double precision, against
 every wall of the map. The output is the surface-id buffer of /work/shared/DESIGN.md: 320x200
 uint32, row-major, id = kind << 24 | index (0 nothing, 1 wall = linedef*2 + side, 2 floor = sector,
-3 ceiling = sector). It is the yardstick for the integer renderer's id buffers (tools/accuracy.py).
+3 ceiling = sector, 4 object = object). It is the yardstick for the integer renderer's id buffers
+(tools/accuracy.py).
 
 Reading, numbered exactly as build/bspc numbers them (tools/bspc/scene_text.c, wad.c):
 - text scene: sectors in declaration order, walls in file order; numbers rounded to 16.16
@@ -56,15 +57,47 @@ ignores; each ray then starts in the near-side sector of the first wall it cross
 really goes into) rather than in the eye's sector, and a ray that crosses no wall (it leaves the
 map at once: the eye is on the map's outer edge, looking out) sees nothing.
 
+Objects (docs/objects.md). Text scenes: `model NAME` ... `end` blocks of `part box w= d= h=
+[at=X,Y,Z]` (vertices at at + (+-W/2, +-D/2, 0 or H), a half of an odd number of 1/65536 units
+rounded away from the centre) and `part prism sides=N r=R h=H [at=...]` (vertex k of the bottom
+at at + R (cos 360k/N, sin 360k/N), the offset rounded to 16.16, then the same ring H higher),
+as tools/bspc/models.c builds them; models numbered in declaration order; `object
+MODEL X Y [z=] [yaw=] [path=circle:R:MS | line:DX:DY:MS] [spin=]` numbered in file order, z by
+default the floor of the sector under (X, Y); `door=H` a sector's open ceiling. WAD maps: the
+things of tools/bspc/things.txt (type radius height colour name) that are in skill 3, not
+multiplayer-only, not at x or y = -32768 and inside a sector, in THINGS order, each an upright box
+2r x 2r x height on the floor under it, yawed by its angle, one model per distinct (radius,
+height, colour) in order of first use. WAD doors: the back sector of a line with a door special,
+or for the remote specials 63 and 90 the sectors with the line's tag; open at the lowest ceiling
+across their two-sided lines - 4, never below their own. Yaws are taken modulo 360.
+object_states() gives the objects at a time t along their paths in exact arithmetic. A model's yaw turns model x (forward) towards map
+y: world = origin + (x cos yaw - y sin yaw, x sin yaw + y cos yaw, z).
+
+Each object part is a convex solid, the intersection of its faces' half-spaces (planes in world
+space, double precision). A ray meets it over [t_in, t_out], t_in the largest depth at which it
+enters a face's half-space and t_out the smallest at which it leaves one (Cyrus-Beck, done per
+face over all pixels at once with numpy: the ray's component along a face normal is a sum of a
+per-column and a per-row term, restricted to the part's screen bounding box when it is wholly in
+front of the near plane); the part is seen at depth t_in when t_in < t_out (a ray grazing an edge
+or vertex sees nothing) and t_in >= the near plane, which is what the C renderer's clipped,
+back-face-culled faces show: an eye inside a part, or a part cut by the near plane, sees nothing
+of it where its front faces are behind the near plane. The nearest part of any object wins; the
+object wins a pixel where its depth is smaller than the world's (the depth of whichever wall,
+floor or ceiling event above decided the pixel), and the pixel gets 4 << 24 | object index.
+The tie-break samples (TIE_DX, TIE_DY) are the same rays, so exact ties at object edges fall as
+the top-left fill rule has them. Doors: render_ids(ceilings={sector: h}) replaces those ceilings
+(a closed door is a sector whose ceiling is its floor).
+
 Eye sector (default eye height = its floor + 41, or 41 in none): even-odd ray crossing over each
 sector's lines (a line with the sector on both sides counts twice and cancels); if several
 sectors claim the point (a map whose sectors overlap), the one facing the point across the
 nearest line crossing the ray to +x wins.
 
 usage: tools/refrender.py SCENE --at X,Y[,Z] --angle DEG [--look PX] --ids OUT.bin [--png OUT.png]
-                          [--sky-owner far|near]
+                          [--sky-owner far|near] [--time MS] [--no-objects] [--door SECTOR=H]...
 """
 import argparse
+import math
 import os
 import struct
 import sys
@@ -83,14 +116,15 @@ ZNEAR = 1.0 / 1024.0
 # else (both are far below the C renderer's own 2^-16 pixel rounding).
 TIE_DX = 2.0 ** -20
 TIE_DY = 2.0 ** -40
-KIND_NONE, KIND_WALL, KIND_FLOOR, KIND_CEIL = 0, 1, 2, 3
+KIND_NONE, KIND_WALL, KIND_FLOOR, KIND_CEIL, KIND_OBJECT = 0, 1, 2, 3, 4
 NONE = -1
 
 
 class Map:
     """A source map: lines (v1, v2 as float coordinates, front and back sector), sectors."""
 
-    def __init__(self, name, x1, y1, x2, y2, front, back, floor, ceil, sky, player):
+    def __init__(self, name, x1, y1, x2, y2, front, back, floor, ceil, sky, player,
+                 models=(), objects=(), open_h=None):
         self.name = name
         self.x1, self.y1 = np.asarray(x1, float), np.asarray(y1, float)
         self.x2, self.y2 = np.asarray(x2, float), np.asarray(y2, float)
@@ -100,6 +134,9 @@ class Map:
         self.ceil = np.asarray(ceil, float)
         self.sky = np.asarray(sky, bool)
         self.player = player                           # (x, y, angle)
+        self.models = list(models)                     # Model, numbered as bspc numbers them
+        self.objects = list(objects)                   # SceneObject, in file / THINGS order
+        self.open_h = self.ceil.copy() if open_h is None else np.asarray(open_h, float)
 
     @property
     def nlines(self):
@@ -131,12 +168,137 @@ def _num(tok, what):
         raise ValueError(f"{what}: '{tok}' is not a number") from None
 
 
+# ---- models and objects (docs/objects.md) -------------------------------------------------
+
+class Model:
+    """A model: convex parts, each (verts, faces): verts an (n, 3) array in model space (x
+    forward, y left, z up, rounded to 16.16 as bspc stores them), faces lists of vertex numbers
+    counter-clockwise seen from outside."""
+
+    def __init__(self, name, parts=()):
+        self.name = name
+        self.parts = list(parts)
+
+
+class SceneObject:
+    """An object statement (or a WAD thing): model number, position (z None: the floor under
+    (x, y)), yaw in degrees, path ("none", "circle", "line") with pa, pb, period_ms, and spin in
+    degrees per second."""
+
+    def __init__(self, model, x, y, z=None, yaw=0.0, path="none", pa=0.0, pb=0.0, period_ms=0,
+                 spin=0.0):
+        self.model, self.x, self.y, self.z, self.yaw = model, x, y, z, yaw
+        self.path, self.pa, self.pb, self.period_ms, self.spin = path, pa, pb, period_ms, spin
+
+
+def _round_away(v):
+    """The nearest integer, ties away from zero."""
+    return math.floor(v + 0.5) if v >= 0 else -math.floor(-v + 0.5)
+
+
+def box_part(w, d, h, at=(0.0, 0.0, 0.0)):
+    """A box W along x, D along y, H along z, its bottom face centred on `at`. Its corners are
+    at +-half the size, a half of an odd number of 1/65536 units rounded away from the centre
+    (as bspc builds them, tools/bspc/models.c)."""
+    ax, ay, az = at
+    hw, hd = math.ceil(w * 65536 / 2) / 65536, math.ceil(d * 65536 / 2) / 65536
+    zs = (az, az + h)
+    # vertex number = 4 * level + corner, corners counter-clockwise seen from above
+    corners = [(ax - hw, ay - hd), (ax + hw, ay - hd), (ax + hw, ay + hd), (ax - hw, ay + hd)]
+    verts = np.array([(cx, cy, z) for z in zs for cx, cy in corners], float)
+    faces = [[3, 2, 1, 0], [4, 5, 6, 7]] + [[i, (i + 1) % 4, 4 + (i + 1) % 4, 4 + i] for i in range(4)]
+    return verts, faces
+
+
+def prism_part(sides, r, h, at=(0.0, 0.0, 0.0)):
+    """An upright prism on the regular N-gon of circumradius R round `at`, the first vertex at
+    angle 0, counter-clockwise seen from above; each corner's offset from `at`, R (cos, sin) of
+    360 k / N degrees, rounded to 16.16 (nearest, ties away from zero), as bspc builds it."""
+    ax, ay, az = at
+    ring = [(ax + _round_away(r * 65536 * math.cos(2 * math.pi * k / sides)) / 65536,
+             ay + _round_away(r * 65536 * math.sin(2 * math.pi * k / sides)) / 65536)
+            for k in range(sides)]
+    zs = (az, az + h)
+    verts = np.array([(cx, cy, z) for z in zs for cx, cy in ring], float)
+    n = sides
+    faces = [list(range(n - 1, -1, -1)), list(range(n, 2 * n))] + \
+        [[i, (i + 1) % n, n + (i + 1) % n, n + i] for i in range(n)]
+    return verts, faces
+
+
+def _kv(tokens, what):
+    kv = {}
+    for t in tokens:
+        if "=" not in t:
+            raise ValueError(f"{what}: expected KEY=VALUE, got '{t}'")
+        k, v = t.split("=", 1)
+        if k in kv:
+            raise ValueError(f"{what}: {k} given twice")
+        kv[k] = v
+    return kv
+
+
+def _triple(v, what):
+    parts = v.split(",")
+    if len(parts) != 3:
+        raise ValueError(f"{what}: expected X,Y,Z, got '{v}'")
+    return tuple(_num(c, what) for c in parts)
+
+
+def parse_part(tok):
+    """A `part box ...` or `part prism ...` statement's solid."""
+    if len(tok) < 2 or tok[1] not in ("box", "prism"):
+        raise ValueError("part: expected 'box' or 'prism'")
+    kv = _kv(tok[2:], f"part {tok[1]}")
+    at = _triple(kv["at"], "part: at") if "at" in kv else (0.0, 0.0, 0.0)
+    if tok[1] == "box":
+        return box_part(_num(kv["w"], "part: w"), _num(kv["d"], "part: d"), _num(kv["h"], "part: h"), at)
+    sides = int(kv["sides"])
+    if not 3 <= sides <= 16:
+        raise ValueError(f"part prism: sides={sides}, expected 3..16")
+    return prism_part(sides, _num(kv["r"], "part: r"), _num(kv["h"], "part: h"), at)
+
+
+def parse_object(tok, model_names, nmodels):
+    """An `object MODEL X Y [z=Z] [yaw=DEG] [path=...] [spin=S]` statement."""
+    ref = tok[1]
+    if ref in model_names:
+        model = model_names[ref]
+    elif ref.isdigit() and int(ref) < nmodels:
+        model = int(ref)
+    else:
+        raise ValueError(f"object: unknown model '{ref}'")
+    o = SceneObject(model, _num(tok[2], "object: x"), _num(tok[3], "object: y"))
+    kv = _kv(tok[4:], "object")
+    if "z" in kv:
+        o.z = _num(kv["z"], "object: z")
+    if "yaw" in kv:
+        o.yaw = _num(kv["yaw"], "object: yaw") % 360.0
+    if "spin" in kv:
+        o.spin = _num(kv["spin"], "object: spin")
+    if "path" in kv:
+        f = kv["path"].split(":")
+        if f[0] == "circle" and len(f) == 3:
+            o.path, o.pa, o.period_ms = "circle", _num(f[1], "path: R"), int(f[2])
+        elif f[0] == "line" and len(f) == 4:
+            o.path, o.pa, o.pb = "line", _num(f[1], "path: DX"), _num(f[2], "path: DY")
+            o.period_ms = int(f[3])
+        else:
+            raise ValueError(f"object: path '{kv['path']}': expected circle:R:PERIOD_MS or "
+                             "line:DX:DY:PERIOD_MS")
+        if o.period_ms <= 0:
+            raise ValueError("object: a path's period must be > 0")
+    return o
+
+
 # ---- text scenes --------------------------------------------------------------------------
 
 def read_text(path):
-    names, floor, ceil, sky = {}, [], [], []
+    names, floor, ceil, sky, open_h = {}, [], [], [], []
     x1, y1, x2, y2, front, back = [], [], [], [], [], []
     player = None
+    models, model_names, objects = [], {}, []
+    in_model = None
 
     def sector_ref(tok, lineno):
         if tok[:1].isdigit():      # a number, read as strtol(tok, 0) reads it: 0x.. hex, 0.. octal
@@ -157,7 +319,25 @@ def read_text(path):
             if not tok:
                 continue
             try:
-                if tok[0] == "sector":
+                if in_model is not None and tok[0] not in ("part", "end"):
+                    raise ValueError(f"model {in_model.name}: '{tok[0]}' before 'end'")
+                if tok[0] == "model":
+                    if len(tok) != 2:
+                        raise ValueError("model: expected 'model NAME'")
+                    in_model = Model(tok[1])
+                    model_names[tok[1]] = len(models)
+                    models.append(in_model)
+                elif tok[0] == "part":
+                    if in_model is None:
+                        raise ValueError("part outside a model")
+                    in_model.parts.append(parse_part(tok))
+                elif tok[0] == "end":
+                    if in_model is None or not in_model.parts:
+                        raise ValueError("end without a model of one part or more")
+                    in_model = None
+                elif tok[0] == "object":
+                    objects.append(parse_object(tok, model_names, len(models)))
+                elif tok[0] == "sector":
                     i = 1
                     if i < len(tok) and "=" not in tok[i] and tok[i] != "sky":
                         names[tok[i]] = len(floor)
@@ -172,6 +352,7 @@ def read_text(path):
                             kv[k] = v
                     floor.append(_num(kv["floor"], "sector: floor"))
                     ceil.append(_num(kv["ceil"], "sector: ceil"))
+                    open_h.append(_num(kv["door"], "sector: door") if "door" in kv else ceil[-1])
                     sky.append(is_sky)
                 elif tok[0] == "wall":
                     a = [_num(t, "wall") for t in tok[1:5]]
@@ -193,9 +374,11 @@ def read_text(path):
             except ValueError as e:
                 msg = str(e)
                 raise ValueError(msg if msg.startswith(path) else f"{path}:{lineno}: {msg}") from None
+    if in_model is not None:
+        raise ValueError(f"{path}: model {in_model.name} has no 'end'")
     if not front:
         raise ValueError(f"{path}: no walls")
-    return Map(path, x1, y1, x2, y2, front, back, floor, ceil, sky, player)
+    return Map(path, x1, y1, x2, y2, front, back, floor, ceil, sky, player, models, objects, open_h)
 
 
 # ---- WAD maps -----------------------------------------------------------------------------
@@ -215,6 +398,81 @@ def find_wad(name):
 
 def _name8(b):
     return b.split(b"\0", 1)[0].decode("latin-1").upper()
+
+
+THINGS_TXT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "bspc", "things.txt")
+DOOR_SPECIALS = {1, 26, 27, 28, 31, 32, 33, 34, 63, 90, 117, 118}
+NOT_OBJECTS = {1, 2, 3, 4, 11, 14}     # player and deathmatch starts, teleport destinations
+RAMPS = ["grey", "red", "orange", "yellow", "lime", "green", "teal", "cyan", "blue", "violet",
+         "magenta", "brown", "sand", "moss", "slate", "plum"]
+
+
+def colour_index(text):
+    """A colour as docs/scene-format.md writes it (0..255, 0x.., RAMP or RAMP:SHADE) -> index,
+    so that two spellings of one colour make one model."""
+    t = text.strip().lower()
+    if t[:1].isdigit():
+        return int(t, 16) if t.startswith("0x") else int(t)
+    ramp, _, shade = t.partition(":")
+    return RAMPS.index(ramp) * 16 + (int(shade) if shade else 10)
+
+
+def read_things_table(path=THINGS_TXT):
+    """tools/bspc/things.txt: {type: (radius, height, colour index)}; `#` starts a comment."""
+    table = {}
+    with open(path, "r", encoding="utf-8") as fh:
+        for lineno, line in enumerate(fh, 1):
+            tok = line.split("#", 1)[0].split()
+            if not tok:
+                continue
+            try:
+                table[int(tok[0])] = (float(tok[1]), float(tok[2]), colour_index(tok[3]))
+            except (IndexError, ValueError):
+                raise ValueError(f"{path}:{lineno}: expected 'type radius height colour name'") from None
+    return table
+
+
+def wad_objects(thing, table, inside):
+    """Things -> (models, objects) per docs/objects.md: the things of skill 3 that are not
+    multiplayer-only, whose type the table lists, inside the coordinate range (x, y > -32768) and
+    inside a sector (inside(x, y)), in THINGS order; one upright box model per distinct (radius,
+    height, colour), numbered in order of first use; z None (the floor)."""
+    models, by_key, objects = [], {}, []
+    for t in thing:
+        typ, flags, x, y = int(t["type"]), int(t["fl"]), int(t["x"]), int(t["y"])
+        if typ in NOT_OBJECTS or typ not in table or not flags & 0x0002 or flags & 0x0010:
+            continue
+        if x == -32768 or y == -32768 or not inside(x, y):
+            continue
+        key = table[typ]
+        if key not in by_key:
+            r, h, _ = key
+            by_key[key] = len(models)
+            models.append(Model(f"thing{typ}", [box_part(2 * r, 2 * r, h)]))
+        objects.append(SceneObject(by_key[key], float(x), float(y), None, float(int(t["a"]) % 360)))
+    return models, objects
+
+
+def wad_door_heights(sec_ceil, sec_tag, lin_special, lin_tag, front, back):
+    """Open ceilings: a door opens to the lowest ceiling among its neighbours (the sectors across
+    its two-sided linedefs, zero-length ones included) minus 4, never below its closed ceiling;
+    other sectors keep their ceiling. Doors: the back sector of a linedef with a door special,
+    or for the remote specials 63 and 90 the sectors tagged with the line's non-zero tag."""
+    open_h = sec_ceil.astype(float).copy()
+    two = back >= 0
+    doors = set()
+    for i in np.nonzero(np.isin(lin_special, list(DOOR_SPECIALS)))[0]:
+        if lin_special[i] in (63, 90):
+            if lin_tag[i]:
+                doors.update(int(d) for d in np.nonzero(sec_tag == lin_tag[i])[0])
+        elif back[i] >= 0:
+            doors.add(int(back[i]))
+    for d in doors:
+        nb = np.concatenate((back[two & (front == d)], front[two & (back == d)]))
+        nb = nb[nb != d]
+        if len(nb):
+            open_h[d] = max(float(sec_ceil[d]), float(sec_ceil[nb].min()) - 4)
+    return open_h
 
 
 def read_wad(spec):
@@ -273,8 +531,14 @@ def read_wad(spec):
     if len(starts):
         t = thing[starts[0]]
         player = (float(t["x"]), float(t["y"]), float(int(t["a"]) % 360))
-    return Map(spec, x1[keep], y1[keep], x2[keep], y2[keep], front[keep], back[keep],
-               sec["f"].astype(float), sec["c"].astype(float), sky, player)
+    open_h = wad_door_heights(sec["c"], sec["tag"], lin["sp"].astype(np.int64),
+                              lin["tag"].astype(np.int64), front, back)
+    m = Map(spec, x1[keep], y1[keep], x2[keep], y2[keep], front[keep], back[keep],
+            sec["f"].astype(float), sec["c"].astype(float), sky, player, open_h=open_h)
+    if os.path.exists(THINGS_TXT):
+        m.models, m.objects = wad_objects(thing, read_things_table(),
+                                          lambda x, y: sector_at(m, x, y) is not None)
+    return m
 
 
 _cache = {}
@@ -331,15 +595,124 @@ def eye_height(scene, x, y):
     return EYE_HEIGHT if s is None else float(load(scene).floor[s]) + EYE_HEIGHT
 
 
+# ---- objects at a time, in world space ----------------------------------------------------
+
+def object_states(scene, t_ms=0):
+    """The scene's objects at time t_ms as docs/objects.md defines them, in exact arithmetic:
+    [(model, x, y, z, yaw)]; z None in the scene is the floor of the sector under (x, y) (0 in
+    none). circle: centre (x, y), angle th = 360 t / period, origin at centre + R (cos th,
+    sin th), facing along the motion (yaw + th + 90). line: (x, y) + s (dx, dy) with s going
+    0 -> 1 -> 0 linearly over a period. spin adds spin * t / 1000 degrees."""
+    m = load(scene)
+    out = []
+    for o in m.objects:
+        z = o.z
+        if z is None:
+            sec = sector_at(m, o.x, o.y)
+            z = 0.0 if sec is None else float(m.floor[sec])
+        x, y, yaw = o.x, o.y, o.yaw + o.spin * t_ms / 1000.0
+        if o.path == "circle":
+            th = 360.0 * (t_ms % o.period_ms) / o.period_ms
+            x += o.pa * math.cos(math.radians(th))
+            y += o.pa * math.sin(math.radians(th))
+            yaw += th + 90.0
+        elif o.path == "line":
+            ph = (t_ms % o.period_ms) / o.period_ms
+            f = 2 * ph if ph < 0.5 else 2 - 2 * ph
+            x += f * o.pa
+            y += f * o.pb
+        out.append((o.model, x, y, z, yaw))
+    return out
+
+
+def world_parts(m, states):
+    """Every convex part of every object in world space: [(object index, verts (n, 3), normals
+    (f, 3), offsets (f,))], where the part is {p : normals @ p <= offsets}. The normals come
+    from the faces' vertices (Newell's sum) and point away from the part's centroid."""
+    parts = []
+    for i, (model, x, y, z, yaw) in enumerate(states):
+        model = int(model)
+        if not 0 <= model < len(m.models):
+            raise ValueError(f"object {i}: model {model} does not exist (the scene has "
+                             f"{len(m.models)})")
+        c, s_ = math.cos(math.radians(float(yaw))), math.sin(math.radians(float(yaw)))
+        for verts, faces in m.models[model].parts:
+            w = np.empty_like(verts)
+            w[:, 0] = float(x) + c * verts[:, 0] - s_ * verts[:, 1]
+            w[:, 1] = float(y) + s_ * verts[:, 0] + c * verts[:, 1]
+            w[:, 2] = float(z) + verts[:, 2]
+            centre = w.mean(axis=0)
+            normals, offsets = [], []
+            for f in faces:
+                p = w[f]
+                q = np.roll(p, -1, axis=0)
+                n = np.array([np.sum((p[:, 1] - q[:, 1]) * (p[:, 2] + q[:, 2])),
+                              np.sum((p[:, 2] - q[:, 2]) * (p[:, 0] + q[:, 0])),
+                              np.sum((p[:, 0] - q[:, 0]) * (p[:, 1] + q[:, 1]))])
+                n /= np.linalg.norm(n)
+                d = float(n @ p.mean(axis=0))
+                if n @ centre > d:
+                    n, d = -n, -d
+                normals.append(n)
+                offsets.append(d)
+            parts.append((i, w, np.array(normals), np.array(offsets)))
+    return parts
+
+
+def _object_hits(parts, ex, ey, ez, fxd, fyd, rx, ry, look, dx, dy, yv):
+    """Nearest object hit per pixel: (depth (H, W), object index (H, W), -1 for none)."""
+    best = np.full((H, W), np.inf)
+    who = np.full((H, W), -1, np.int64)
+    for obj, verts, normals, offsets in parts:
+        rel = verts - (ex, ey, ez)
+        depth = rel[:, 0] * fxd + rel[:, 1] * fyd
+        if depth.max() < ZNEAR:
+            continue                                      # wholly behind the near plane
+        c0, c1, r0, r1 = 0, W, 0, H
+        if depth.min() >= ZNEAR:                          # in front: its screen bounding box
+            sx = W / 2 + FOCAL * (rel[:, 0] * rx + rel[:, 1] * ry) / depth
+            sy = H / 2 + look - FOCAL * rel[:, 2] / depth
+            c0, c1 = max(0, int(math.floor(sx.min())) - 1), min(W, int(math.ceil(sx.max())) + 1)
+            r0, r1 = max(0, int(math.floor(sy.min())) - 1), min(H, int(math.ceil(sy.max())) + 1)
+            if c0 >= c1 or r0 >= r1:
+                continue
+        sub_dx, sub_dy, sub_yv = dx[c0:c1], dy[c0:c1], yv[r0:r1]
+        t_in = np.full((r1 - r0, c1 - c0), -np.inf)
+        t_out = np.full((r1 - r0, c1 - c0), np.inf)
+        for n, off in zip(normals, offsets):
+            # the ray E + t (dx, dy, yv) is inside the face's half-space where t * nd <= num
+            num = off - (n[0] * ex + n[1] * ey + n[2] * ez)
+            nd = (n[0] * sub_dx + n[1] * sub_dy)[None, :] + n[2] * sub_yv[:, None]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                t = num / nd
+            t_in = np.where(nd < 0, np.maximum(t_in, t), t_in)
+            t_out = np.where(nd > 0, np.minimum(t_out, t), t_out)
+            if num < 0:                                   # parallel and outside: missed
+                t_out = np.where(nd == 0, -np.inf, t_out)
+        # an eye inside the part, or a part cut by the near plane, shows nothing of it there:
+        # its front faces are behind the eye or clipped away, its back faces culled
+        seen = (t_in < t_out) & (t_in >= ZNEAR)
+        sub = best[r0:r1, c0:c1]
+        nearer = seen & (t_in < sub)
+        sub[nearer] = t_in[nearer]
+        who[r0:r1, c0:c1][nearer] = obj
+    return best, who
+
+
 # ---- rendering ----------------------------------------------------------------------------
 
-def render_ids(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="near"):
+def render_ids(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="near",
+               objects=None, ceilings=None):
     """Surface ids of the view from (x, y, z) at angle degrees: numpy uint32 (200, 320).
 
     z None: the floor of the eye's sector + 41. fx: round the camera to 16.16 first, as
     build/render does (pass False for the exact values). sky_owner: whose ceiling the sky seen
-    over the missing upper wall between two sky sectors is: "far" (the sector beyond, the
-    default) or "near" (the sector on the eye's side, as Doom's visplanes have it)."""
+    over the missing upper wall between two sky sectors is: "near" (the sector on the eye's
+    side, as Doom's visplanes have it, the default) or "far" (the sector beyond).
+    objects: [(model, x, y, z, yaw)] in map units and degrees (build/render's JSON "objects",
+    as dicts with those keys or as tuples), drawn with ids 4 << 24 | their position in the
+    list; None: the scene's own objects at time 0 (object_states). ceilings: {sector: height}
+    (keys may be strings, as in build/render's JSON "ceilings"), for doors."""
     m = load(scene_spec)
     rnd = fx_round if fx else float
     x, y, angle = rnd(x), rnd(y), rnd(angle)
@@ -348,6 +721,13 @@ def render_ids(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="
     eye_sec = sector_at(m, x, y)
     if z is None:
         z = EYE_HEIGHT if eye_sec is None else float(m.floor[eye_sec]) + EYE_HEIGHT
+    if objects is None:
+        states = object_states(m, 0)
+    else:
+        states = [(o["model"], o["x"], o["y"], o["z"], o["yaw"]) if isinstance(o, dict) else tuple(o)
+                  for o in objects]
+        states = [(int(mo), rnd(ox), rnd(oy), rnd(oz), rnd(oyaw)) for mo, ox, oy, oz, oyaw in states]
+    parts = world_parts(m, states)
     a = np.radians(float(angle) % 360.0)
     fxd, fyd = np.cos(a), np.sin(a)
     rx, ry = fyd, -fxd
@@ -372,9 +752,14 @@ def render_ids(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="
     wall_id = (KIND_WALL << 24) | (np.arange(m.nlines, dtype=np.int64) * 2 + side)
 
     fl = np.append(m.floor, np.nan)      # index NONE (-1) -> nan: no floor, no ceiling
-    ce = np.append(m.ceil, np.nan)
+    ce = m.ceil.copy()
+    for sec, h in (ceilings or {}).items():
+        ce[int(sec)] = rnd(h)
+    ce = np.append(ce, np.nan)
     sk = np.append(m.sky, False)
     out = np.zeros((H, W), np.uint32)
+    # the world's depth per pixel, where objects must be compared with it
+    world_t = np.full((H, W), np.inf) if parts else None
     start = NONE if eye_sec is None else eye_sec
     # the eye exactly on a wall (or vertex): which sector a ray starts in depends on its direction;
     # take the near-side sector of the first wall it crosses
@@ -435,8 +820,21 @@ def render_ids(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="
         ids[:, 1::2] = np.where(over_sky, sky_id[None, :], wall_id[li][None, :])
         first = np.argmax(ev, axis=1)
         col = ids[np.arange(H), first]
-        col[~ev[np.arange(H), first]] = 0
+        got = ev[np.arange(H), first]
+        col[~got] = 0
         out[:, px] = col.astype(np.uint32)
+        if world_t is not None:
+            with np.errstate(divide="ignore", invalid="ignore"):
+                tp = np.where(ceil_hit, cc, cf) - z
+                tp = tp / yv[:, None]
+            tev = np.empty((H, 2 * k + 1))
+            tev[:, 0::2] = tp
+            tev[:, 1::2] = tk[None, :]
+            world_t[:, px] = np.where(got, tev[np.arange(H), first], np.inf)
+    if parts:
+        obj_t, obj = _object_hits(parts, x, y, z, fxd, fyd, rx, ry, look, dx, dy, yv)
+        front = obj_t < world_t
+        out[front] = ((KIND_OBJECT << 24) | obj[front]).astype(np.uint32)
     return out
 
 
@@ -500,6 +898,11 @@ def main(argv=None):
     for i in range(len(argv) - 1):     # let "--at -192,-160" through argparse
         if argv[i] in ("--at", "--angle", "--look") and argv[i + 1].startswith("-"):
             argv[i:i + 2] = [argv[i] + "=" + argv[i + 1], ""]
+    ap.add_argument("--time", type=int, default=0,
+                    help="the scene's objects along their paths at MS milliseconds (default 0)")
+    ap.add_argument("--no-objects", action="store_true", help="draw no objects")
+    ap.add_argument("--door", action="append", default=[], metavar="SECTOR=H",
+                    help="set a sector's ceiling (repeatable)")
     a = ap.parse_args([v for v in argv if v != ""])
     try:
         m = load(a.scene)
@@ -515,7 +918,15 @@ def main(argv=None):
             pa = a.angle
         if not -100 <= a.look <= 100:
             ap.error("--look: expected -100..100")
-        ids = render_ids(m, px, py, z, pa, a.look, sky_owner=a.sky_owner)
+        ceilings = {}
+        for d in a.door:
+            sec, eq, h = d.partition("=")
+            if not eq or not sec.isdigit() or int(sec) >= m.nsectors:
+                ap.error(f"--door '{d}': expected SECTOR=H with SECTOR < {m.nsectors}")
+            ceilings[int(sec)] = _num(h, "--door")
+        objs = [] if a.no_objects else object_states(m, a.time)
+        ids = render_ids(m, px, py, z, pa, a.look, sky_owner=a.sky_owner, objects=objs,
+                         ceilings=ceilings)
         write_ids(a.ids, ids)
         if a.png:
             write_png_rgb(a.png, false_colour(ids))

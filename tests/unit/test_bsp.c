@@ -12,6 +12,12 @@
  *   another leaf polygon's edge; node boxes hold everything below them.
  * Tolerances are in raw 16.16 units (1/65536 map unit): TOL for "on a line".
  *
+ * Objects and doors (docs/objects.md): models of text scenes compile to the
+ * vertices, faces, colours and bounds the contract defines; objects land on the
+ * floor; doors carry their open ceiling; freedoom2.wad:MAP01's things and door
+ * sectors are found as counted here from its lumps; every bad statement is
+ * refused with its line.
+ *
  * Build: gcc -std=c11 -Ifirmware -Itools/bspc tests/unit/test_bsp.c, every
  * tools/bspc C file but main.c, firmware/crc32.c, -lcmocka -lm; run from the
  * repository root (it reads tests/scenes/default.scene).
@@ -31,6 +37,7 @@
 
 #include "bspc.h"
 #include "crc32.h"
+#include "scene.h"
 #include "scene_format.h"
 
 __extension__ typedef __int128 i128;
@@ -731,6 +738,397 @@ static void test_all_freedoom_maps(void **state)
     }
 }
 
+/* ------------------------------------------------------------ objects and doors */
+
+static const char *objects_scene =
+    "sector room floor=0 ceil=128 floor_color=sand:7\n"
+    "sector dais floor=24 ceil=128\n"
+    "sector door1 floor=0 ceil=0 door=112 floor_color=grey:6 ceil_color=grey:5\n"
+    "wall 0 0 0 256 room\n"
+    "wall 0 256 256 256 room\n"
+    "wall 256 256 256 0 room\n"
+    "wall 256 0 128 0 room\n"
+    "wall 128 0 96 0 room door1\n"
+    "wall 96 0 0 0 room\n"
+    "wall 128 0 128 -16 door1\n"
+    "wall 128 -16 96 -16 door1\n"
+    "wall 96 -16 96 0 door1\n"
+    /* a raised square in the room's north-east: a hole in room, the dais in it */
+    "wall 160 160 160 224 dais room\n"
+    "wall 160 224 224 224 dais room\n"
+    "wall 224 224 224 160 dais room\n"
+    "wall 224 160 160 160 dais room\n"
+    "player 64 128 0\n"
+    "model crate\n"
+    "part box w=32 d=32.00001 h=32 at=1,2,3 color=brown:8 top=brown:10 bottom=1\n"
+    "end\n"
+    "model ship  # two touching parts\n"
+    "part box   w=48 d=16 h=8  at=0,0,0   color=grey:9\n"
+    "part prism sides=3 r=12 h=4 at=30,0,2 color=red:8 top=red:10\n"
+    "end\n"
+    "model gem\n"
+    "part prism sides=7 r=10.3 h=5 at=0.5,-0.25,-2 side=blue:15 color=blue:0\n"
+    "end\n"
+    "object crate 64 64\n"                      /* on the room's floor */
+    "object gem 192 192 yaw=-30\n"              /* on the dais */
+    "object 1 128 128 z=96 yaw=450 path=circle:64:8000\n"
+    "object ship 20 20 z=-16383 path=line:200:-10:4000 spin=-45.5\n";
+
+static void *sec_copy(const uint8_t *b, size_t len, int k, size_t rec, uint32_t *count)
+{
+    scn_header h;
+    memcpy(&h, b, sizeof h);
+    *count = h.sec[k].count;
+    return section(b, len, &h, k, rec);
+}
+
+/* Newell normal of a face, in doubles */
+static void face_normal(const scn_mvert *v, const uint32_t *idx, int n, double nrm[3])
+{
+    nrm[0] = nrm[1] = nrm[2] = 0;
+    for (int i = 0; i < n; i++) {
+        const scn_mvert *a = &v[idx[i]], *c = &v[idx[(i + 1) % n]];
+        nrm[0] += ((double)a->y - c->y) * ((double)a->z + c->z);
+        nrm[1] += ((double)a->z - c->z) * ((double)a->x + c->x);
+        nrm[2] += ((double)a->x - c->x) * ((double)a->y + c->y);
+    }
+}
+
+static int64_t round_away(double v) { return (int64_t)(v < 0 ? -floor(-v + 0.5) : floor(v + 0.5)); }
+
+static void test_objects_and_doors(void **state)
+{
+    (void)state;
+    uint8_t *b = NULL;
+    size_t len = 0;
+    bspc_stats st;
+    char err[512];
+    int rc = compile_text(objects_scene, BSPC_SPLIT_MIXED, &b, &len, &st, err, sizeof err, NULL);
+    if (rc) fprintf(stderr, "%s\n", err);
+    assert_int_equal(rc, 0);
+    check_blob(b, len);
+    assert_int_equal(st.models, 3);
+    assert_int_equal(st.objects, 4);
+    assert_int_equal(st.doors, 1);
+    /* the loader takes it */
+    uint32_t *al = malloc(len + 4);
+    memcpy(al, b, len);
+    scene sc;
+    scene_error se;
+    assert_int_equal(scene_load(&sc, al, (uint32_t)len, &se), SCENE_OK);
+    free(al);
+
+    uint32_t nm, nv, nf, ni, no, ns;
+    scn_model *m = sec_copy(b, len, SCN_SEC_MODELS, sizeof *m, &nm);
+    scn_mvert *mv = sec_copy(b, len, SCN_SEC_MVERTS, sizeof *mv, &nv);
+    scn_face *f = sec_copy(b, len, SCN_SEC_FACES, sizeof *f, &nf);
+    uint32_t *fi = sec_copy(b, len, SCN_SEC_FINDEX, sizeof *fi, &ni);
+    scn_object *o = sec_copy(b, len, SCN_SEC_OBJECTS, sizeof *o, &no);
+    scn_sector *sec = sec_copy(b, len, SCN_SEC_SECTORS, sizeof *sec, &ns);
+    assert_int_equal(nm, 3);
+    assert_int_equal(no, 4);
+    assert_int_equal(nv, 8 + 8 + 6 + 14);
+    assert_int_equal(nf, 6 + 6 + 5 + 9);
+
+    /* the crate: d = 32.00001 rounds to 2097153 raw, an odd size whose half
+     * rounds away from the centre */
+    const int32_t U = 65536;
+    assert_int_equal(m[0].first_vert, 0);
+    assert_int_equal(m[0].num_verts, 8);
+    assert_int_equal(m[0].first_face, 0);
+    assert_int_equal(m[0].num_faces, 6);
+    static const int sx[4] = {-1, 1, 1, -1}, sy[4] = {-1, -1, 1, 1};
+    for (int k = 0; k < 8; k++) {
+        assert_int_equal(mv[k].x, 1 * U + sx[k % 4] * 16 * U);
+        assert_int_equal(mv[k].y, 2 * U + sy[k % 4] * (16 * U + 1));
+        assert_int_equal(mv[k].z, k < 4 ? 3 * U : 35 * U);
+    }
+    assert_int_equal(m[0].zmin, 3 * U);
+    assert_int_equal(m[0].zmax, 35 * U);
+    {
+        /* ceil of the exact distance of the farthest corner (17, 18 + 1 raw) */
+        double d = sqrt((double)(17 * U) * (17 * U) + (double)(18 * U + 1) * (18 * U + 1));
+        assert_true(m[0].radius == (int32_t)ceil(d));
+    }
+    /* outward normals: every face's normal points away from its part's centre */
+    for (uint32_t mi = 0; mi < nm; mi++)
+        for (uint32_t k = 0; k < m[mi].num_faces; k++) {
+            const scn_face *F = &f[m[mi].first_face + k];
+            assert_true(F->num_index >= 3 && F->num_index <= SCN_MAX_FACE_VERTS);
+            const scn_mvert *base = mv + m[mi].first_vert;
+            double c[3] = {0, 0, 0}, fc[3] = {0, 0, 0}, nrm[3];
+            uint32_t cnt = 0;
+            for (uint32_t j = 0; j < m[mi].num_faces; j++) { /* the part's centre: mean of its faces' vertices */
+                const scn_face *G = &f[m[mi].first_face + j];
+                if (G->part != F->part) continue;
+                for (uint32_t q = 0; q < G->num_index; q++) {
+                    c[0] += base[fi[G->first_index + q]].x;
+                    c[1] += base[fi[G->first_index + q]].y;
+                    c[2] += base[fi[G->first_index + q]].z;
+                    cnt++;
+                }
+            }
+            for (uint32_t q = 0; q < F->num_index; q++) {
+                assert_true(fi[F->first_index + q] < m[mi].num_verts);
+                fc[0] += base[fi[F->first_index + q]].x / (double)F->num_index;
+                fc[1] += base[fi[F->first_index + q]].y / (double)F->num_index;
+                fc[2] += base[fi[F->first_index + q]].z / (double)F->num_index;
+            }
+            face_normal(base, fi + F->first_index, F->num_index, nrm);
+            double dot = 0;
+            for (int a = 0; a < 3; a++) dot += nrm[a] * (fc[a] - c[a] / cnt);
+            assert_true(dot > 0);
+        }
+    /* crate colours: sides brown:8 with contrast (edge along x: lighter), top brown:10, bottom 1 */
+    assert_int_equal(f[0].colour, 11 * 16 + 9); /* (-,-) -> (+,-): runs along x */
+    assert_int_equal(f[1].colour, 11 * 16 + 7); /* (+,-) -> (+,+): runs along y */
+    assert_int_equal(f[2].colour, 11 * 16 + 9);
+    assert_int_equal(f[3].colour, 11 * 16 + 7);
+    assert_int_equal(f[4].colour, 11 * 16 + 10);
+    assert_int_equal(f[5].colour, 1);
+    /* crate faces in the documented order */
+    static const uint32_t crate_faces[6][4] = {{0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7},
+                                               {4, 5, 6, 7}, {0, 3, 2, 1}};
+    for (int k = 0; k < 6; k++) {
+        assert_int_equal(f[k].num_index, 4);
+        assert_int_equal(f[k].part, 0);
+        for (int q = 0; q < 4; q++) assert_int_equal(fi[f[k].first_index + q], crate_faces[k][q]);
+    }
+
+    /* the ship: two parts; the prism's corners by the documented formula */
+    assert_int_equal(m[1].first_vert, 8);
+    assert_int_equal(m[1].num_verts, 14);
+    assert_int_equal(m[1].num_faces, 11);
+    assert_int_equal(f[m[1].first_face + 6].part, 1);
+    for (int k = 0; k < 3; k++) {
+        double a = 2 * M_PI * k / 3;
+        const scn_mvert *v = &mv[8 + 8 + k];
+        assert_int_equal(v->x, 30 * U + round_away(12.0 * U * cos(a)));
+        assert_int_equal(v->y, round_away(12.0 * U * sin(a)));
+        assert_int_equal(v->z, 2 * U);
+        assert_int_equal(mv[8 + 8 + 3 + k].z, 6 * U);
+    }
+    assert_int_equal(mv[8 + 8 + 1].x, 24 * U); /* touches the box's +x face */
+    assert_int_equal(m[1].radius, 42 * U);
+    assert_int_equal(m[1].zmin, 0);
+    assert_int_equal(m[1].zmax, 8 * U);
+    /* the prism's sides: 0 diagonal (red:8), 1 along y (darker), 2 diagonal; top red:10 */
+    assert_int_equal(f[m[1].first_face + 6].colour, 16 + 8);
+    assert_int_equal(f[m[1].first_face + 7].colour, 16 + 7);
+    assert_int_equal(f[m[1].first_face + 9].colour, 16 + 10);
+    assert_int_equal(f[m[1].first_face + 10].colour, 16 + 8);
+    assert_int_equal(f[m[1].first_face + 9].num_index, 3);
+
+    /* the gem: fractional radius and centre; shades clamp at 15 and 0 */
+    int32_t r = 675021; /* 10.3 -> 675020.8 raw */
+    for (int k = 0; k < 7; k++) {
+        double a = 2 * M_PI * k / 7;
+        const scn_mvert *v = &mv[22 + k];
+        assert_int_equal(v->x, 32768 + round_away((double)r * cos(a)));
+        assert_int_equal(v->y, -16384 + round_away((double)r * sin(a)));
+        assert_int_equal(v->z, -2 * U);
+        assert_int_equal(mv[22 + 7 + k].z, 3 * U);
+    }
+    /* side 3 (between the corners at 3/7 and 4/7 of a turn) runs along y: one darker */
+    assert_int_equal(mv[22 + 3].x, mv[22 + 4].x);
+    for (int k = 0; k < 7; k++) assert_int_equal(f[m[2].first_face + k].colour, 8 * 16 + (k == 3 ? 14 : 15));
+    assert_int_equal(f[m[2].first_face + 7].colour, 8 * 16);
+    assert_int_equal(f[m[2].first_face + 8].num_index, 7);
+    assert_int_equal(fi[f[m[2].first_face + 8].first_index + 1], 6); /* bottom: 0, 6, 5, ... */
+
+    /* objects: z on the floor under them, yaw modulo 360, paths */
+    assert_int_equal(o[0].model, 0);
+    assert_int_equal(o[0].z, 0);
+    assert_int_equal(o[0].path, SCN_PATH_NONE);
+    assert_int_equal(o[1].model, 2);
+    assert_int_equal(o[1].z, 24 * U);
+    assert_int_equal(o[1].yaw, 330 * U);
+    assert_int_equal(o[2].model, 1);
+    assert_int_equal(o[2].x, 128 * U);
+    assert_int_equal(o[2].z, 96 * U);
+    assert_int_equal(o[2].yaw, 90 * U);
+    assert_int_equal(o[2].path, SCN_PATH_CIRCLE);
+    assert_int_equal(o[2].pa, 64 * U);
+    assert_int_equal(o[2].pb, 0);
+    assert_int_equal(o[2].period_ms, 8000);
+    assert_int_equal(o[3].z, -16383 * U);
+    assert_int_equal(o[3].path, SCN_PATH_LINE);
+    assert_int_equal(o[3].pa, 200 * U);
+    assert_int_equal(o[3].pb, -10 * U);
+    assert_int_equal(o[3].period_ms, 4000);
+    assert_int_equal(o[3].spin, -(45 * U + U / 2));
+
+    /* the door */
+    assert_int_equal(ns, 3);
+    assert_int_equal(sec[2].flags & SCN_SECTOR_DOOR, SCN_SECTOR_DOOR);
+    assert_int_equal(sec[2].ceil_h, 0);
+    assert_int_equal(sec[2].open_h, 112 * U);
+    assert_int_equal(sec[0].flags & SCN_SECTOR_DOOR, 0);
+    assert_int_equal(sec[0].open_h, sec[0].ceil_h);
+    free(m);
+    free(mv);
+    free(f);
+    free(fi);
+    free(o);
+    free(sec);
+    free(b);
+}
+
+/* ---- freedoom2.wad:MAP01 counted from its lumps ---- */
+
+typedef struct {
+    uint8_t *data;
+    uint32_t size;
+} wlump;
+
+static int wad_map_lump(const char *wad, const char *map, const char *name, wlump *out)
+{
+    FILE *fp = fopen(wad, "rb");
+    if (!fp) return -1;
+    uint8_t h[12];
+    int found = -1;
+    if (fread(h, 1, 12, fp) == 12) {
+        uint32_t n = h[4] | h[5] << 8 | h[6] << 16 | (uint32_t)h[7] << 24;
+        uint32_t d = h[8] | h[9] << 8 | h[10] << 16 | (uint32_t)h[11] << 24;
+        uint8_t *dir = malloc((size_t)n * 16);
+        fseek(fp, (long)d, SEEK_SET);
+        if (fread(dir, 16, n, fp) == n) {
+            int in_map = 0;
+            for (uint32_t i = 0; i < n && found < 0; i++) {
+                char nm[9] = {0};
+                memcpy(nm, dir + 16 * i + 8, 8);
+                if (strcmp(nm, map) == 0) in_map = 1;
+                else if (in_map && strcmp(nm, name) == 0) {
+                    uint32_t pos = dir[16 * i] | dir[16 * i + 1] << 8 | dir[16 * i + 2] << 16 |
+                                   (uint32_t)dir[16 * i + 3] << 24;
+                    out->size = dir[16 * i + 4] | dir[16 * i + 5] << 8 | dir[16 * i + 6] << 16 |
+                                (uint32_t)dir[16 * i + 7] << 24;
+                    out->data = malloc(out->size + 1);
+                    fseek(fp, (long)pos, SEEK_SET);
+                    found = fread(out->data, 1, out->size, fp) == out->size ? 0 : -1;
+                }
+            }
+        }
+        free(dir);
+    }
+    fclose(fp);
+    return found;
+}
+
+static unsigned u16(const uint8_t *p) { return p[0] | p[1] << 8; }
+
+static void test_freedoom2_map01_objects_and_doors(void **state)
+{
+    (void)state;
+    if (!have_freedoom2()) skip();
+    char wad[1024];
+    assert_int_equal(bspc_find_wad("freedoom2.wad", wad, sizeof wad), 0);
+    wlump th, ld, sd, se;
+    assert_int_equal(wad_map_lump(wad, "MAP01", "THINGS", &th), 0);
+    assert_int_equal(wad_map_lump(wad, "MAP01", "LINEDEFS", &ld), 0);
+    assert_int_equal(wad_map_lump(wad, "MAP01", "SIDEDEFS", &sd), 0);
+    assert_int_equal(wad_map_lump(wad, "MAP01", "SECTORS", &se), 0);
+
+    /* the thing table, read as the reference renderer reads it */
+    FILE *tf = fopen("tools/bspc/things.txt", "r");
+    assert_non_null(tf);
+    int types[512], ntypes = 0;
+    char line[256];
+    while (fgets(line, sizeof line, tf)) {
+        char *hash = strchr(line, '#');
+        if (hash) *hash = 0;
+        int t, r, h;
+        char col[64], name[128];
+        int got = sscanf(line, "%d %d %d %63s %127s", &t, &r, &h, col, name);
+        if (got <= 0) continue;
+        assert_int_equal(got, 5);
+        assert_true(ntypes < 512);
+        types[ntypes++] = t;
+    }
+    fclose(tf);
+    uint32_t want_objects = 0, nthings = th.size / 10;
+    for (uint32_t i = 0; i < nthings; i++) {
+        const uint8_t *r = th.data + 10 * i;
+        unsigned type = u16(r + 6), flags = u16(r + 8);
+        int listed = 0;
+        for (int k = 0; k < ntypes; k++) listed |= types[k] == (int)type;
+        if (listed && (flags & 2) && !(flags & 0x10)) want_objects++;
+    }
+
+    /* door sectors by the contract's rule */
+    uint32_t nsec = se.size / 26, nlines = ld.size / 14;
+    uint8_t *door = calloc(nsec, 1);
+    uint32_t want_doors = 0;
+    for (uint32_t i = 0; i < nlines; i++) {
+        const uint8_t *r = ld.data + 14 * i;
+        unsigned sp = u16(r + 6), tag = u16(r + 8), back = u16(r + 12);
+        int manual = sp == 1 || (sp >= 26 && sp <= 28) || (sp >= 31 && sp <= 34) || sp == 117 || sp == 118;
+        if (manual && back != 0xFFFF) door[u16(sd.data + 30 * back + 28)] = 1;
+        if ((sp == 63 || sp == 90) && tag)
+            for (uint32_t k = 0; k < nsec; k++)
+                if (u16(se.data + 26 * k + 24) == tag) door[k] = 1;
+    }
+    for (uint32_t k = 0; k < nsec; k++) want_doors += door[k];
+
+    uint8_t *b = NULL;
+    size_t len = 0;
+    bspc_stats st;
+    char err[512];
+    int rc = bspc_compile("freedoom2.wad:MAP01", NULL, &b, &len, &st, err, sizeof err);
+    if (rc) fprintf(stderr, "%s\n", err);
+    assert_int_equal(rc, 0);
+    uint32_t no, ns, nm;
+    scn_object *o = sec_copy(b, len, SCN_SEC_OBJECTS, sizeof *o, &no);
+    scn_sector *sec = sec_copy(b, len, SCN_SEC_SECTORS, sizeof *sec, &ns);
+    scn_model *m = sec_copy(b, len, SCN_SEC_MODELS, sizeof *m, &nm);
+    fprintf(stderr, "MAP01: %u things -> %u objects on %u models; %u doors\n", nthings, no, nm, want_doors);
+    assert_true(want_objects > 50);
+    assert_int_equal(no, want_objects);
+    assert_int_equal(st.objects, no);
+    assert_int_equal(st.models, nm);
+    assert_true(nm >= 5 && nm < no);
+    assert_true(want_doors >= 3);
+    assert_int_equal(st.doors, want_doors);
+    /* objects in THINGS order, each on the floor of some sector, yaw = angle */
+    uint32_t j = 0;
+    for (uint32_t i = 0; i < nthings && j < no; i++) {
+        const uint8_t *r = th.data + 10 * i;
+        if ((int16_t)u16(r) * 65536 != o[j].x || (int16_t)u16(r + 2) * 65536 != o[j].y) continue;
+        int a = ((int16_t)u16(r + 4) % 360 + 360) % 360;
+        assert_int_equal(o[j].yaw, a * 65536);
+        int on_floor = 0;
+        for (uint32_t k = 0; k < ns; k++) on_floor |= sec[k].floor_h == o[j].z;
+        assert_true(on_floor);
+        assert_true(o[j].model < nm);
+        assert_int_equal(m[o[j].model].zmin, 0);
+        j++;
+    }
+    assert_int_equal(j, no);
+    for (uint32_t k = 0; k < ns; k++) {
+        assert_int_equal(!!(sec[k].flags & SCN_SECTOR_DOOR), door[k]);
+        if (door[k]) {
+            assert_true(sec[k].open_h >= sec[k].ceil_h);
+            assert_true(sec[k].open_h <= SCN_HEIGHT_MAX * 65536);
+        } else {
+            assert_int_equal(sec[k].open_h, sec[k].ceil_h);
+        }
+    }
+    uint32_t *al = malloc(len + 4);
+    memcpy(al, b, len);
+    scene sc;
+    assert_int_equal(scene_load(&sc, al, (uint32_t)len, NULL), SCENE_OK);
+    free(al);
+    free(o);
+    free(sec);
+    free(m);
+    free(door);
+    free(b);
+    free(th.data);
+    free(ld.data);
+    free(sd.data);
+    free(se.data);
+}
+
 /* ------------------------------------------------------------ errors */
 
 typedef struct {
@@ -766,6 +1164,63 @@ static const bad_case bad[] = {
     {"sector a floor=0\n", 1, "missing ceil"},
     {"sector a floor=0 ceil=64\nsector a floor=0 ceil=64\n", 2, "already used"},
     {"", 0, "no walls"},
+    /* models, objects and doors (docs/objects.md) */
+#define ROOM_ "sector a floor=0 ceil=64\nwall 0 0 0 64 a\nwall 0 64 64 64 a\nwall 64 64 64 0 a\nwall 64 0 0 0 a\nplayer 32 32 0\n"
+    {ROOM_ "object crate 10 10\n", 7, "unknown model 'crate'"},
+    {ROOM_ "object 0 10 10\n", 7, "unknown model 0"},
+    {ROOM_ "model m\nend\n", 8, "has no parts"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\n", 7, "'end' missing"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nwall 0 0 1 1 a\nend\n", 9, "not allowed inside model 'm'"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nmodel n\n", 9, "not allowed inside model"},
+    {ROOM_ "part box w=1 d=1 h=1\n", 7, "outside a model"},
+    {ROOM_ "end\n", 7, "outside a model"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nend\nmodel m\n", 10, "name 'm' already used"},
+    {ROOM_ "model 9m\n", 7, "bad name"},
+    {ROOM_ "model m\npart cone r=1 h=1\n", 8, "expected 'part box"},
+    {ROOM_ "model m\npart box w=1 d=1\n", 8, "missing h="},
+    {ROOM_ "model m\npart prism r=1 h=1\n", 8, "missing sides="},
+    {ROOM_ "model m\npart prism sides=17 r=1 h=1\n", 8, "sides=17"},
+    {ROOM_ "model m\npart prism sides=2 r=1 h=1\n", 8, "sides=2"},
+    {ROOM_ "model m\npart box w=0 d=1 h=1\n", 8, "w=0 out of range"},
+    {ROOM_ "model m\npart box w=-3 d=1 h=1\n", 8, "w=-3 out of range"},
+    {ROOM_ "model m\npart box w=2049 d=1 h=1\n", 8, "out of range"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1 r=3\n", 8, "unknown key 'r'"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1 h=2\n", 8, "h given twice"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1 at=1,2\n", 8, "expected at=X,Y,Z"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1 at=1,2,1025\n", 8, "out of range"},
+    {ROOM_ "model m\npart box w=2000 d=1 h=1 at=100,0,0\n", 8, "outside the model's range"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1000 at=0,0,100\n", 8, "outside the model's range"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1 color=pink\n", 8, "unknown colour"},
+    {ROOM_ "model m\npart prism sides=16 r=0.00002 h=1\n", 8, "too small"},
+    {ROOM_ "model m\npart box w=10 d=10 h=10\npart box w=10 d=10 h=10 at=9.99,0,0\n", 9, "overlaps part 1"},
+    {ROOM_ "model m\npart box w=10 d=10 h=10\npart prism sides=16 r=5 h=10 at=0,0,9\n", 9, "overlaps part 1"},
+    {ROOM_ "model m\npart prism sides=16 r=1 h=1\npart prism sides=16 r=1 h=1 at=0,0,1\n"
+           "part prism sides=16 r=1 h=1 at=0,0,2\n",
+     10, "more than 64"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nend\nobject m 10\n", 10, "expected 'object MODEL X Y"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nend\nobject m 40000 10\n", 10, "out of range"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nend\nobject m 100 100\n", 10, "not inside any sector"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nend\nobject m 10 10 z=16384\n", 10, "z=16384 out of range"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nend\nobject m 10 10 z=1 z=2\n", 10, "z given twice"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nend\nobject m 10 10 speed=2\n", 10, "unknown key 'speed'"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nend\nobject m 10 10 spin=3601\n", 10, "spin=3601 out of range"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nend\nobject m 10 10 yaw=x\n", 10, "not a number"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nend\nobject m 10 10 path=circle:5\n", 10, "expected circle:R:PERIOD_MS"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nend\nobject m 10 10 path=spiral:5:100\n", 10, "expected circle"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nend\nobject m 10 10 path=circle:0:100\n", 10, "radius out of range"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nend\nobject m 10 10 path=circle:5:0\n", 10, "period 0"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nend\nobject m 10 10 path=circle:5:3600001\n", 10, "period 3600001"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nend\nobject m 10 10 path=circle:5:1.5\n", 10, "period 1.5"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nend\nobject m 10 10 path=line:0:0:100\n", 10, "zero length"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nend\nobject m 10 10 path=line:1:2:3:4\n", 10, "expected circle"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nend\nobject m 32000 10 z=0 path=circle:800:100\n", 10,
+     "leaves the world box"},
+    {ROOM_ "model m\npart box w=1 d=1 h=1\nend\nobject m -32000 10 z=0 path=line:-800:0:100\n", 10,
+     "leaves the world box"},
+    {"sector a floor=0 ceil=64 door=63\n", 1, "door=H is below ceil"},
+    {"sector a floor=0 ceil=64 door=16384\n", 1, "door=16384 out of range"},
+    {"sector a floor=0 ceil=64 door=64 door=70\n", 1, "door given twice"},
+#undef ROOM_
 };
 
 static void test_bad_text_scenes(void **state)
@@ -924,6 +1379,8 @@ int main(void)
         cmocka_unit_test(test_decimal_coordinates),
         cmocka_unit_test(test_extreme_scene),
         cmocka_unit_test(test_freedoom2_map01),
+        cmocka_unit_test(test_objects_and_doors),
+        cmocka_unit_test(test_freedoom2_map01_objects_and_doors),
         cmocka_unit_test(test_all_freedoom_maps),
         cmocka_unit_test(test_bad_text_scenes),
         cmocka_unit_test(test_missing_file),

@@ -203,7 +203,7 @@ static int inside_some_sector(const scene *s, const walls *w, int64_t px, int64_
 
 static void walk(const scene *s, fx_t *x, fx_t *y, fx_t *fz, double dx, double dy, int steps)
 {
-    for (int i = 0; i < steps; i++) col_move(s, NULL, x, y, fz, U(dx), U(dy));
+    for (int i = 0; i < steps; i++) col_move(s, NULL, NULL, x, y, fz, U(dx), U(dy));
 }
 
 static void test_wall_stops_at_radius(void **state)
@@ -216,7 +216,7 @@ static void test_wall_stops_at_radius(void **state)
         for (int fast = 0; fast < 2; fast++) {
             fx_t x = U(128), y = U(128), fz = 0;
             if (fast)
-                col_move(&l.s, NULL, &x, &y, &fz, (int64_t)U(1000) * dir[k][0], (int64_t)U(1000) * dir[k][1]);
+                col_move(&l.s, NULL, NULL, &x, &y, &fz, (int64_t)U(1000) * dir[k][0], (int64_t)U(1000) * dir[k][1]);
             else
                 walk(&l.s, &x, &y, &fz, 8 * dir[k][0], 8 * dir[k][1], 40);
             double ex = dir[k][0] ? 128 + 112 * dir[k][0] : 128, ey = dir[k][1] ? 128 + 112 * dir[k][1] : 128;
@@ -228,8 +228,8 @@ static void test_wall_stops_at_radius(void **state)
         }
     /* a single step blocked exactly: reported */
     fx_t x = U(230), y = U(128), fz = 0;
-    assert_true(col_move(&l.s, NULL, &x, &y, &fz, U(20), 0) & COL_BLOCKED);
-    assert_false(col_move(&l.s, NULL, &x, &y, &fz, -U(20), 0) & COL_BLOCKED);
+    assert_true(col_move(&l.s, NULL, NULL, &x, &y, &fz, U(20), 0) & COL_BLOCKED);
+    assert_false(col_move(&l.s, NULL, NULL, &x, &y, &fz, -U(20), 0) & COL_BLOCKED);
     unload(&l);
 }
 
@@ -240,13 +240,13 @@ static void test_slide_keeps_parallel_component(void **state)
     load_room(&l);
     /* at 45 degrees into the east wall: x stops, y keeps all of its motion */
     fx_t x = U(200), y = U(64), fz = 0;
-    col_move(&l.s, NULL, &x, &y, &fz, U(100), U(100));
+    col_move(&l.s, NULL, NULL, &x, &y, &fz, U(100), U(100));
     assert_true(fabs(un(x) - 240) <= 1.0 / 32);
     assert_true(fabs(un(y) - 164) <= 1.0 / 16);
     /* many small steps along the wall: no sticking, no creeping in */
     for (int i = 0; i < 50; i++) {
-        col_move(&l.s, NULL, &x, &y, &fz, -U(4), -U(4));
-        col_move(&l.s, NULL, &x, &y, &fz, U(5), -U(1));
+        col_move(&l.s, NULL, NULL, &x, &y, &fz, -U(4), -U(4));
+        col_move(&l.s, NULL, NULL, &x, &y, &fz, U(5), -U(1));
         assert_true(un(x) <= 240 + 1.0 / 4096);
     }
     assert_true(un(y) >= 16 - 1.0 / 4096); /* down into the corner, not through the floor wall */
@@ -259,7 +259,7 @@ static void test_slide_keeps_parallel_component(void **state)
                   "wall 256 128 256 0 r\nwall 256 0 0 0 r\nplayer 100 100 0\n");
     x = U(150);
     y = U(160);
-    col_move(&l.s, NULL, &x, &y, &fz, U(100), 0);
+    col_move(&l.s, NULL, NULL, &x, &y, &fz, U(100), 0);
     double d = (384 - un(x) - un(y)) / sqrt(2.0);      /* distance to the diagonal */
     double along = (un(x) - 150 - (un(y) - 160)) / sqrt(2.0); /* motion along it */
     assert_true(d >= 16 - 1.0 / 1024 && d <= 16 + 1.0 / 16);
@@ -276,7 +276,7 @@ static void test_corner(void **state)
     walls_of(&l.s, &w);
     fx_t x = U(128), y = U(128), fz = 0;
     for (int i = 0; i < 200; i++) {
-        col_move(&l.s, NULL, &x, &y, &fz, U(3), U(5));
+        col_move(&l.s, NULL, NULL, &x, &y, &fz, U(3), U(5));
         assert_true(solid_dist(&w, x, y) >= 16 - 1.0 / 1024);
     }
     assert_true(fabs(un(x) - 240) <= 1.0 / 32 && fabs(un(y) - 240) <= 1.0 / 32);
@@ -297,12 +297,12 @@ static void test_steps_up(void **state)
     assert_true(fabs(un(x) - 496) <= 1.0 / 32);
     assert_int_equal(fz, U(24));
     x = U(128), y = U(128), fz = 0; /* in one call */
-    col_move(&l.s, NULL, &x, &y, &fz, U(1000), 0);
+    col_move(&l.s, NULL, NULL, &x, &y, &fz, U(1000), 0);
     assert_true(fabs(un(x) - 496) <= 1.0 / 32);
     assert_int_equal(fz, U(24));
     /* standing over the edge: the circle overhangs the step, the floor is the step's */
     x = U(250), y = U(128);
-    col_move(&l.s, NULL, &x, &y, &fz, 0, 0);
+    col_move(&l.s, NULL, NULL, &x, &y, &fz, 0, 0);
     assert_int_equal(fz, U(24));
     fx_t leaf;
     assert_true(col_floor_at(&l.s, x, y, &leaf) && leaf == 0);
@@ -314,7 +314,7 @@ static void test_steps_up(void **state)
     assert_true(fabs(un(x) - 240) <= 1.0 / 32);
     assert_int_equal(fz, 0);
     x = U(128), y = U(128);
-    col_move(&l.s, NULL, &x, &y, &fz, U(1000), U(3));
+    col_move(&l.s, NULL, NULL, &x, &y, &fz, U(1000), U(3));
     assert_true(un(x) <= 240 + 1.0 / 4096 && un(x) >= 240 - 1.0 / 32);
     unload(&l);
 
@@ -369,7 +369,7 @@ static void test_walk_down_steps(void **state)
     fx_t x = U(128), y = U(128), fz = 0;
     fx_t prev = 0;
     for (int i = 0; i < 120; i++) {
-        col_move(&l.s, NULL, &x, &y, &fz, U(8), 0);
+        col_move(&l.s, NULL, NULL, &x, &y, &fz, U(8), 0);
         assert_true(fz <= prev); /* only down */
         prev = fz;
     }
@@ -401,7 +401,7 @@ static void test_fast_moves_never_tunnel(void **state)
         double a = (double)(rng >> 11) / 9007199254740992.0 * 2 * M_PI;
         double len = (i % 3 == 0) ? 1000 : (double)((rng >> 20) % 5000);
         fx_t px = x, py = y;
-        col_move(&l.s, NULL, &x, &y, &fz, (int64_t)(len * cos(a) * 65536), (int64_t)(len * sin(a) * 65536));
+        col_move(&l.s, NULL, NULL, &x, &y, &fz, (int64_t)(len * cos(a) * 65536), (int64_t)(len * sin(a) * 65536));
         assert_true(un(x) <= 300 - 16 + 1.0 / 4096);
         assert_true(solid_dist(&w, x, y) >= 16 - 1.0 / 1024);
         assert_true(inside_some_sector(&l.s, &w, x, y));
@@ -415,10 +415,10 @@ static void test_fast_moves_never_tunnel(void **state)
                   "wall 300 64 301 64 r\nwall 301 64 301 192 r\nwall 301 192 300 192 r\nwall 300 192 300 64 r\n"
                   "player 100 128 0\n");
     x = U(100), y = U(128);
-    col_move(&l.s, NULL, &x, &y, &fz, U(30000), 0);
+    col_move(&l.s, NULL, NULL, &x, &y, &fz, U(30000), 0);
     assert_true(fabs(un(x) - 284) <= 1.0 / 32);
     x = U(550), y = U(128);
-    col_move(&l.s, NULL, &x, &y, &fz, -(int64_t)U(30000) * 4, 0); /* a huge move (clamped) */
+    col_move(&l.s, NULL, NULL, &x, &y, &fz, -(int64_t)U(30000) * 4, 0); /* a huge move (clamped) */
     assert_true(fabs(un(x) - 317) <= 1.0 / 32);
     walls_free(&w);
     unload(&l);
@@ -433,41 +433,41 @@ static void test_degenerate_starts(void **state)
     fx_t x, y, fz = 0;
     uint32_t fl;
     x = 0, y = U(128); /* on the west wall */
-    fl = col_move(&l.s, NULL, &x, &y, &fz, -U(50), 0);
+    fl = col_move(&l.s, NULL, NULL, &x, &y, &fz, -U(50), 0);
     assert_true(fl & COL_STUCK);
     assert_true(x >= 0);
-    col_move(&l.s, NULL, &x, &y, &fz, U(50), 0);
+    col_move(&l.s, NULL, NULL, &x, &y, &fz, U(50), 0);
     assert_true(fabs(un(x) - 50) <= 1.0 / 32 && y == U(128));
     x = 0, y = U(128); /* along the wall line: allowed, it does not go deeper */
-    col_move(&l.s, NULL, &x, &y, &fz, 0, U(20));
+    col_move(&l.s, NULL, NULL, &x, &y, &fz, 0, U(20));
     assert_true(x >= 0 && un(y) > 128);
     x = 0, y = 0; /* on the corner vertex */
-    col_move(&l.s, NULL, &x, &y, &fz, -U(50), -U(50));
+    col_move(&l.s, NULL, NULL, &x, &y, &fz, -U(50), -U(50));
     assert_true(x >= 0 && y >= 0 && x <= U(1) / 4 && y <= U(1) / 4); /* (slides push it off the walls) */
     fx_t x0 = x, y0 = y;
-    col_move(&l.s, NULL, &x, &y, &fz, U(50), U(50));
+    col_move(&l.s, NULL, NULL, &x, &y, &fz, U(50), U(50));
     assert_true(x == x0 + U(50) && y == y0 + U(50));
     x = U(16), y = U(128); /* exactly radius from the wall: free to slide along it */
-    fl = col_move(&l.s, NULL, &x, &y, &fz, -U(1), U(50));
+    fl = col_move(&l.s, NULL, NULL, &x, &y, &fz, -U(1), U(50));
     assert_true(x >= U(16) && x <= U(16) + EPS);
     assert_true(fabs(un(y) - 178) <= 1.0 / 16);
     x = U(5), y = U(5); /* inside both corner walls: out diagonally */
-    col_move(&l.s, NULL, &x, &y, &fz, U(100), U(100));
+    col_move(&l.s, NULL, NULL, &x, &y, &fz, U(100), U(100));
     assert_true(fabs(un(x) - 105) <= 1.0 / 32 && fabs(un(y) - 105) <= 1.0 / 32);
     x = -U(100), y = U(128); /* outside the map: the wall still holds */
-    col_move(&l.s, NULL, &x, &y, &fz, U(200), 0);
+    col_move(&l.s, NULL, NULL, &x, &y, &fz, U(200), 0);
     assert_true(un(x) <= -16 + 1.0 / 4096);
     unload(&l);
 
     int f[] = {0, 0}, c[] = {128, 128};
     load_chain(&l, 2, f, c);
     x = U(256), y = U(128); /* on a two-sided line: both ways */
-    col_move(&l.s, NULL, &x, &y, &fz, U(40), 0);
+    col_move(&l.s, NULL, NULL, &x, &y, &fz, U(40), 0);
     assert_int_equal(x, U(296));
-    col_move(&l.s, NULL, &x, &y, &fz, -U(80), 0);
+    col_move(&l.s, NULL, NULL, &x, &y, &fz, -U(80), 0);
     assert_int_equal(x, U(216));
     x = U(256), y = 0; /* on the vertex where it meets the outer walls */
-    col_move(&l.s, NULL, &x, &y, &fz, 0, U(60));
+    col_move(&l.s, NULL, NULL, &x, &y, &fz, 0, U(60));
     assert_true(x == U(256) && y == U(60));
     unload(&l);
 }
@@ -495,7 +495,7 @@ static void test_many_walls_big_body(void **state)
     for (int i = 0; i < 300; i++) {
         rng = rng * 6364136223846793005ull + 1442695040888963407ull;
         double a = (double)(rng >> 11) / 9007199254740992.0 * 2 * M_PI;
-        blocked += (col_move(&l.s, &big, &x, &y, &fz, (int64_t)(60 * cos(a) * 65536),
+        blocked += (col_move(&l.s, NULL, &big, &x, &y, &fz, (int64_t)(60 * cos(a) * 65536),
                              (int64_t)(60 * sin(a) * 65536)) & COL_BLOCKED) != 0;
         assert_true(solid_dist(&w, x, y) >= 300 - 1.0 / 1024);
     }
@@ -503,7 +503,7 @@ static void test_many_walls_big_body(void **state)
     /* pressed against the teeth, sliding east along them */
     x = U(400), y = U(400);
     for (int i = 0; i < 100; i++) {
-        col_move(&l.s, &big, &x, &y, &fz, U(4), U(8));
+        col_move(&l.s, NULL, &big, &x, &y, &fz, U(4), U(8));
         assert_true(solid_dist(&w, x, y) >= 300 - 1.0 / 1024);
     }
     assert_true(un(y) >= 499.9 && un(x) > 700); /* (resting on the teeth's slopes, a little under 500) */
@@ -521,38 +521,38 @@ static void test_line_of_sight(void **state)
     load_chain(&l, 3, f, c);
     const scene *s = &l.s;
     fx_t y = U(128);
-    assert_true(col_line_of_sight(s, U(128), y, U(60), U(640), y, U(60)));
-    assert_false(col_line_of_sight(s, U(128), y, U(40), U(640), y, U(40)));
-    assert_false(col_line_of_sight(s, U(128), y, U(100), U(640), y, U(100)));
-    assert_true(col_line_of_sight(s, U(128), y, U(48), U(640), y, U(48)));  /* on the sill: passes */
-    assert_true(col_line_of_sight(s, U(128), y, U(96), U(640), y, U(96)));  /* on the lintel */
-    assert_true(col_line_of_sight(s, U(128), y, U(50), U(640), y, U(90)));  /* 60 and 80 at the lines */
-    assert_false(col_line_of_sight(s, U(128), y, U(0), U(640), y, U(120))); /* 30 at the first */
-    assert_false(col_line_of_sight(s, U(128), y, U(120), U(640), y, U(0)));  /* 90, then 30 */
+    assert_true(col_line_of_sight(s, NULL, U(128), y, U(60), U(640), y, U(60)));
+    assert_false(col_line_of_sight(s, NULL, U(128), y, U(40), U(640), y, U(40)));
+    assert_false(col_line_of_sight(s, NULL, U(128), y, U(100), U(640), y, U(100)));
+    assert_true(col_line_of_sight(s, NULL, U(128), y, U(48), U(640), y, U(48)));  /* on the sill: passes */
+    assert_true(col_line_of_sight(s, NULL, U(128), y, U(96), U(640), y, U(96)));  /* on the lintel */
+    assert_true(col_line_of_sight(s, NULL, U(128), y, U(50), U(640), y, U(90)));  /* 60 and 80 at the lines */
+    assert_false(col_line_of_sight(s, NULL, U(128), y, U(0), U(640), y, U(120))); /* 30 at the first */
+    assert_false(col_line_of_sight(s, NULL, U(128), y, U(120), U(640), y, U(0)));  /* 90, then 30 */
     /* slopes that pass exactly through an edge of the opening: 0 -> 96 over 512,
      * crossing x=256 at 24 (below) */
-    assert_false(col_line_of_sight(s, U(128), y, U(0), U(640), y, U(96)));
+    assert_false(col_line_of_sight(s, NULL, U(128), y, U(0), U(640), y, U(96)));
     /* symmetric */
-    assert_true(col_line_of_sight(s, U(640), y, U(90), U(128), y, U(50)));
+    assert_true(col_line_of_sight(s, NULL, U(640), y, U(90), U(128), y, U(50)));
     /* inside one room: nothing in the way at any height */
-    assert_true(col_line_of_sight(s, U(20), U(20), U(-500), U(230), U(230), U(500)));
+    assert_true(col_line_of_sight(s, NULL, U(20), U(20), U(-500), U(230), U(230), U(500)));
     /* through the outer wall */
-    assert_false(col_line_of_sight(s, U(128), y, U(60), U(900), y, U(60)));
-    assert_false(col_line_of_sight(s, U(128), y, U(60), U(128), U(-10), U(60)));
+    assert_false(col_line_of_sight(s, NULL, U(128), y, U(60), U(900), y, U(60)));
+    assert_false(col_line_of_sight(s, NULL, U(128), y, U(60), U(128), U(-10), U(60)));
     /* along the two-sided line x = 256 (collinear): the opening decides */
-    assert_true(col_line_of_sight(s, U(256), U(10), U(60), U(256), U(200), U(70)));
-    assert_false(col_line_of_sight(s, U(256), U(10), U(30), U(256), U(200), U(70)));
+    assert_true(col_line_of_sight(s, NULL, U(256), U(10), U(60), U(256), U(200), U(70)));
+    assert_false(col_line_of_sight(s, NULL, U(256), U(10), U(30), U(256), U(200), U(70)));
     /* a corner grazed: blocks (the end point of a one-sided wall) */
-    assert_false(col_line_of_sight(s, U(200), U(-56), U(60), U(312), U(56), U(60)));
+    assert_false(col_line_of_sight(s, NULL, U(200), U(-56), U(60), U(312), U(56), U(60)));
     /* a point */
-    assert_true(col_line_of_sight(s, U(100), U(100), U(10), U(100), U(100), U(20)));
+    assert_true(col_line_of_sight(s, NULL, U(100), U(100), U(10), U(100), U(100), U(20)));
     unload(&l);
 
     /* a closed door (floor = ceiling) blocks at every height */
     int fd[] = {0, 0, 0}, cd[] = {128, 0, 128};
     load_chain(&l, 3, fd, cd);
     for (int z = -10; z <= 130; z += 10)
-        assert_false(col_line_of_sight(&l.s, U(128), U(128), U(z), U(640), U(128), U(z)));
+        assert_false(col_line_of_sight(&l.s, NULL, U(128), U(128), U(z), U(640), U(128), U(z)));
     unload(&l);
 
     /* against an exact oracle on many random sight lines in the window scene:
@@ -590,7 +590,7 @@ static void test_line_of_sight(void **state)
             if (zz > (i128)U(96) * den || zz < (i128)U(48) * den) expect = 0;
         }
         if (p[0] == p[3]) continue;
-        int got = col_line_of_sight(&l.s, (fx_t)p[0], (fx_t)p[1], (fx_t)p[2], (fx_t)p[3], (fx_t)p[4], (fx_t)p[5]);
+        int got = col_line_of_sight(&l.s, NULL, (fx_t)p[0], (fx_t)p[1], (fx_t)p[2], (fx_t)p[3], (fx_t)p[4], (fx_t)p[5]);
         assert_int_equal(got, expect);
         vis += got;
         blk += !got;
@@ -649,7 +649,7 @@ static int random_start(const scene *s, const walls *w, uint64_t *rng, fx_t *x, 
         *x = (fx_t)(sx / lf->num_pverts);
         *y = (fx_t)(sy / lf->num_pverts);
         if (solid_dist(w, *x, *y) < 17 || !inside_some_sector(s, w, *x, *y)) continue;
-        if (col_move(s, NULL, x, y, fz, 0, 0) & COL_STUCK) continue;
+        if (col_move(s, NULL, NULL, x, y, fz, 0, 0) & COL_STUCK) continue;
         if (!standing_sound(s, w, *x, *y, *fz, 1)) continue;
         return 1;
     }
@@ -667,7 +667,7 @@ static void random_walk(const char *spec, int moves, int want_sectors)
     walls w;
     walls_of(s, &w);
     fx_t x = s->hdr->player_x, y = s->hdr->player_y, fz = 0;
-    col_move(s, NULL, &x, &y, &fz, 0, 0);
+    col_move(s, NULL, NULL, &x, &y, &fz, 0, 0);
     assert_true(solid_dist(&w, x, y) >= 16);
     assert_true(standing_sound(s, &w, x, y, fz, 0));
     uint64_t rng = 2024;
@@ -682,7 +682,7 @@ static void random_walk(const char *spec, int moves, int want_sectors)
         int long_move = i % 3000 >= 2700;
         double len = long_move ? (double)((rng >> 13) % 3000) : (double)((rng >> 13) % 31001) / 1000;
         fx_t px = x, py = y, pz = fz;
-        uint32_t fl = col_move(s, NULL, &x, &y, &fz, (int64_t)(len * cos(heading) * 65536),
+        uint32_t fl = col_move(s, NULL, NULL, &x, &y, &fz, (int64_t)(len * cos(heading) * 65536),
                                (int64_t)(len * sin(heading) * 65536));
         assert_false(fl & COL_STUCK);
         if (fl & COL_BLOCKED) {
@@ -801,7 +801,7 @@ static void test_map01_sight(void **state)
             i128 zz = (i128)p[2] * den + (i128)(p[5] - p[2]) * num;
             if (zz > (i128)hi * den || zz < (i128)lo * den) expect = 0;
         }
-        int got = col_line_of_sight(s, (fx_t)p[0], (fx_t)p[1], (fx_t)p[2], (fx_t)p[3], (fx_t)p[4], (fx_t)p[5]);
+        int got = col_line_of_sight(s, NULL, (fx_t)p[0], (fx_t)p[1], (fx_t)p[2], (fx_t)p[3], (fx_t)p[4], (fx_t)p[5]);
         if (got != expect)
             fprintf(stderr, "sight %d: (%.4f %.4f %.4f)-(%.4f %.4f %.4f) got %d\n", i, un(p[0]), un(p[1]), un(p[2]),
                     un(p[3]), un(p[4]), un(p[5]), got);
@@ -827,8 +827,8 @@ static void test_camera_walks_and_climbs(void **state)
     assert_int_equal(cam.view.z, U(41));
     fx_t prevz = cam.view.z;
     for (int i = 0; i < 80; i++) {
-        cam_move(&cam, &l.s, HAL_KEY_FORWARD, 28);
-        cam_move(&twin, &l.s, HAL_KEY_FORWARD, 28);
+        cam_move(&cam, &l.s, NULL, HAL_KEY_FORWARD, 28);
+        cam_move(&twin, &l.s, NULL, HAL_KEY_FORWARD, 28);
         fx_t floor;
         assert_true(col_floor_at(&l.s, cam.view.x, cam.view.y, &floor));
         assert_true(cam.view.z >= floor + U(17));   /* eased, but never near the floor */
@@ -841,19 +841,19 @@ static void test_camera_walks_and_climbs(void **state)
     assert_int_equal(cam.view.z, U(24 + 41));
     assert_int_equal(cam.feet, U(24));
     /* fly up: the eye rises, walking still collides */
-    for (int i = 0; i < 10; i++) cam_move(&cam, &l.s, HAL_KEY_FLY_UP | HAL_KEY_FORWARD, 100);
+    for (int i = 0; i < 10; i++) cam_move(&cam, &l.s, NULL, HAL_KEY_FLY_UP | HAL_KEY_FORWARD, 100);
     assert_true(llabs((int64_t)cam.view.z - U(24 + 41 + 128)) <= 16); /* 12.8 units a frame, truncated */
     assert_true(un(cam.view.x) <= 496 + 1.0 / 4096);
-    for (int i = 0; i < 30; i++) cam_move(&cam, &l.s, HAL_KEY_FLY_DOWN, 100);
+    for (int i = 0; i < 30; i++) cam_move(&cam, &l.s, NULL, HAL_KEY_FLY_DOWN, 100);
     assert_int_equal(cam.view.z, U(24 + 41)); /* not below floor + 41 */
     /* walking back down the step eases the eye down to 41 */
-    for (int i = 0; i < 40; i++) cam_move(&cam, &l.s, HAL_KEY_BACK, 28);
+    for (int i = 0; i < 40; i++) cam_move(&cam, &l.s, NULL, HAL_KEY_BACK, 28);
     assert_true(cam.view.z > U(41) && cam.view.z < U(24 + 41)); /* on the way down */
-    for (int i = 0; i < 20; i++) cam_move(&cam, &l.s, 0, 28);
+    for (int i = 0; i < 20; i++) cam_move(&cam, &l.s, NULL, 0, 28);
     assert_int_equal(cam.view.z, U(41));
     /* noclip walks through the wall */
     cam.noclip = 1;
-    for (int i = 0; i < 80; i++) cam_move(&cam, &l.s, HAL_KEY_FORWARD, 28);
+    for (int i = 0; i < 80; i++) cam_move(&cam, &l.s, NULL, HAL_KEY_FORWARD, 28);
     assert_true(un(cam.view.x) > 512);
     /* cam_follow_floor puts the eye on the floor at once */
     cam.noclip = 0;

@@ -77,7 +77,7 @@ static int setup(void **state)
     if (rc) fprintf(stderr, "%s\n", err);
     assert_int_equal(rc, 0);
     assert_int_equal(scene_load(&W.s, W.blob, (uint32_t)len, NULL), SCENE_OK);
-    W.work.bytes = render_work_bytes(&W.s);
+    W.work.bytes = render_work_bytes(&W.s, NULL);
     W.work.mem = malloc(W.work.bytes);
     assert_non_null(W.work.mem);
     for (int m = 0; m < RENDER_MODE_COUNT; m++) W.ids[m] = calloc(VIEW_W * VIEW_H, sizeof(uint32_t));
@@ -98,7 +98,7 @@ static void draw(const camera *cam, render_mode mode, render_stats *st)
     hal_surface surf = hal_begin_frame(HAL_PRESENT_FLIP);
     rast_target t = {&surf, W.ids[mode]};
     memset(st, 0, sizeof *st);
-    render_frame(&W.s, cam, mode, &t, &W.work, st);
+    render_frame(&W.s, NULL, cam, mode, &t, &W.work, st);
     hal_present(HAL_PRESENT_FLIP);
 }
 

@@ -99,7 +99,7 @@ int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *l
     for (uint32_t i = 0; i < t->nleaves; i++) npv += t->leaves[i].poly.n;
     uint32_t counts[SCN_SEC_COUNT] = {t->nverts, s->nsectors, s->nlines, t->nsegs,
                                       t->nnodes, t->nleaves,  npv,       256,
-                                      0,         0,           0,         0,     0};
+                                      s->nmodels, s->nmverts, s->nfaces, s->nfindex, s->nobjects};
     static const uint32_t recsz[SCN_SEC_COUNT] = {8, 12 + 4, 24, 16, 56, 20, 8, 3, 28, 12, 8, 4, 40};
     uint32_t off[SCN_SEC_COUNT];
     uint64_t at = sizeof(scn_header);
@@ -154,7 +154,7 @@ int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *l
         w8(&w, c->ceil_color);
         w8(&w, c->light);
         w8(&w, c->flags);
-        wi32(&w, c->ceil_h); /* open_h: no doors yet */
+        wi32(&w, (c->flags & SCN_SECTOR_DOOR) ? c->open_h : c->ceil_h);
     }
     w.at = off[SCN_SEC_LINES];
     for (uint32_t i = 0; i < s->nlines; i++) {
@@ -211,6 +211,47 @@ int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *l
         }
     w.at = off[SCN_SEC_PALETTE];
     bs_palette(p + w.at);
+    w.at = off[SCN_SEC_MODELS];
+    for (uint32_t i = 0; i < s->nmodels; i++) {
+        const bs_model *m = &s->models[i];
+        w32(&w, m->first_vert);
+        w32(&w, m->num_verts);
+        w32(&w, m->first_face);
+        w32(&w, m->num_faces);
+        wi32(&w, m->radius);
+        wi32(&w, m->zmin);
+        wi32(&w, m->zmax);
+    }
+    w.at = off[SCN_SEC_MVERTS];
+    for (uint32_t i = 0; i < s->nmverts; i++) {
+        wi32(&w, s->mverts[i].x);
+        wi32(&w, s->mverts[i].y);
+        wi32(&w, s->mverts[i].z);
+    }
+    w.at = off[SCN_SEC_FACES];
+    for (uint32_t i = 0; i < s->nfaces; i++) {
+        const bs_face *f = &s->faces[i];
+        w32(&w, f->first_index);
+        w16(&w, f->num_index);
+        w8(&w, f->colour);
+        w8(&w, f->part);
+    }
+    w.at = off[SCN_SEC_FINDEX];
+    for (uint32_t i = 0; i < s->nfindex; i++) w32(&w, s->findex[i]);
+    w.at = off[SCN_SEC_OBJECTS];
+    for (uint32_t i = 0; i < s->nobjects; i++) {
+        const bs_object *o = &s->objects[i];
+        w32(&w, o->model);
+        wi32(&w, o->x);
+        wi32(&w, o->y);
+        wi32(&w, o->z);
+        wi32(&w, o->yaw);
+        w32(&w, o->path);
+        wi32(&w, o->pa);
+        wi32(&w, o->pb);
+        w32(&w, o->period_ms);
+        wi32(&w, o->spin);
+    }
 
     uint32_t crc = crc_update(0, p + 16, (size_t)at - 16);
     w.at = 12;

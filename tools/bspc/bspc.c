@@ -57,6 +57,32 @@ static uint32_t walk_sector(const bs_tree *t, int32_t x, int32_t y)
     return n == SCN_NONE ? SCN_NONE : t->leaves[n & ~SCN_LEAF_BIT].sector;
 }
 
+/* An object without a height rests on the floor under it: the floor of its
+ * leaf's sector, as the renderer finds it (the player start does the same), or
+ * by winding number where the leaf has no sector. A map thing in neither is
+ * dropped. */
+static void place_objects(bs_scene *s, const bs_tree *t, const bspc_options *opt)
+{
+    uint32_t kept = 0, dropped = 0;
+    for (uint32_t i = 0; i < s->nobjects; i++) {
+        bs_object o = s->objects[i];
+        if (!o.has_z) {
+            uint32_t sec = walk_sector(t, o.x, o.y);
+            if (sec == SCN_NONE) sec = bs_point_sector(s, o.x, o.y);
+            if (sec == SCN_NONE) {
+                if (dropped++ < 10)
+                    bs_warn(opt, "%s: thing %d is inside no sector; left out", s->name, o.src_line);
+                continue;
+            }
+            o.z = s->sectors[sec].floor_h;
+            o.has_z = 1;
+        }
+        s->objects[kept++] = o;
+    }
+    if (dropped) bs_note(opt, "%s: %u thing(s) inside no sector left out", s->name, dropped);
+    s->nobjects = kept;
+}
+
 int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, size_t *len,
                  bspc_stats *stats, char *err, size_t errlen)
 {
@@ -104,6 +130,16 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
         goto out;
     }
 
+    /* objects resting on the floor must stand in a sector (text scenes: an error) */
+    for (uint32_t i = 0; s.is_text && i < s.nobjects; i++) {
+        const bs_object *o = &s.objects[i];
+        if (o->has_z || bs_point_sector(&s, o->x, o->y) != SCN_NONE) continue;
+        char b1[32], b2[32];
+        bs_fail(err, errlen, "%s:%d: object at (%s, %s) is not inside any sector (give z=Z)", s.name,
+                o->src_line, bs_fxstr(o->x, b1), bs_fxstr(o->y, b2));
+        goto out;
+    }
+
     double t0 = bs_now_ms();
     if (bs_build(&s, &opt, &t, err, errlen)) goto out;
     double t_tree = bs_now_ms();
@@ -140,6 +176,7 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
                     "the leaf's", s.name, s.player_sector, walked);
         if (walked != SCN_NONE) s.player_sector = walked;
     }
+    place_objects(&s, &t, &opt);
     if (bs_write_blob(&s, &t, blob, len, err, errlen)) goto out;
     double t1 = bs_now_ms();
     bs_note(&opt, "%s: times: tree %.2f ms, T-junctions %.2f ms, blob %.2f ms", s.name, t_tree - t0,
@@ -149,6 +186,8 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
             "%u leaves, %u vertices, depth %u (mean %.2f), %u polygon vertices inserted, %.2f ms",
             s.name, s.nlines, t.nsegs, t.part_splits, t.tj_splits, t.nnodes, t.nleaves, t.nverts,
             t.max_depth, t.mean_depth, t.tj_pverts, t1 - t0);
+    bs_note(&opt, "%s: %u models (%u vertices, %u faces), %u objects, %u doors", s.name, s.nmodels,
+            s.nmverts, s.nfaces, s.nobjects, s.ndoors);
     if (stats) {
         memset(stats, 0, sizeof *stats);
         stats->input_walls = s.nlines;
@@ -160,6 +199,9 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
         stats->max_depth = t.max_depth;
         stats->mean_depth = t.mean_depth;
         stats->build_ms = t1 - t0;
+        stats->models = s.nmodels;
+        stats->objects = s.nobjects;
+        stats->doors = s.ndoors;
     }
     rc = 0;
 out:

@@ -22,6 +22,7 @@ typedef struct {
     uint32_t max_depth;   /* nodes on the longest root-to-leaf path */
     double mean_depth;    /* mean over leaves */
     double build_ms;      /* wall-clock milliseconds for the tree build and blob write */
+    uint32_t models, objects, doors; /* docs/objects.md */
 } bspc_stats;
 
 /* Default options. */

@@ -55,7 +55,8 @@ double bs_now_ms(void);
 /* ---- the source scene ---- */
 
 typedef struct {
-    int32_t floor_h, ceil_h; /* 16.16 */
+    int32_t floor_h, ceil_h; /* 16.16; ceil_h is a door's closed ceiling */
+    int32_t open_h;          /* 16.16: a door's open ceiling (SCN_SECTOR_DOOR); unused otherwise */
     uint8_t floor_color, ceil_color, light, flags;
     int src_line;            /* text: line of the declaration; WAD: 0 */
     char name[32];           /* text: optional name; WAD: "" */
@@ -67,6 +68,47 @@ typedef struct {
     uint8_t color[2][3];  /* [side][SCN_PART_*] */
     int src_line;         /* text: line number; WAD: linedef index in the lump */
 } bs_line;
+
+/* Models (docs/objects.md): the records of scn_model / scn_mvert / scn_face,
+ * with findex numbers relative to the model's first vertex. */
+typedef struct {
+    int32_t x, y, z; /* 16.16 model space */
+} bs_mvert;
+
+typedef struct {
+    uint32_t first_index; /* into bs_scene.findex */
+    uint16_t num_index;
+    uint8_t colour, part;
+} bs_face;
+
+/* Each part has at least 6 vertices (a 3-sided prism). */
+#define BS_MAX_PARTS (SCN_MAX_MODEL_VERTS / 6)
+
+typedef struct {
+    uint32_t first_vert, num_verts, first_face, num_faces;
+    uint32_t nparts;
+    uint8_t part_vert[BS_MAX_PARTS];  /* a part's first vertex, relative to first_vert */
+    uint8_t part_sides[BS_MAX_PARTS]; /* its ring's corner count */
+    int32_t radius, zmin, zmax; /* set by bs_model_end */
+    int src_line;               /* text: the model statement; WAD: 0 */
+    char name[32];              /* text: its name; WAD: "" */
+} bs_model;
+
+typedef struct {
+    uint32_t model;
+    int32_t x, y, z, yaw; /* 16.16; yaw in degrees, [0, 360) */
+    int has_z;            /* 0: z is the floor under (x, y), found after the build */
+    uint32_t path;        /* SCN_PATH_* */
+    int32_t pa, pb;       /* 16.16 */
+    uint32_t period_ms;
+    int32_t spin;         /* degrees per second, 16.16 */
+    int src_line;         /* text: line; WAD: thing index in the lump */
+} bs_object;
+
+/* Limits beyond scene_format.h that keep the path arithmetic of docs/objects.md
+ * inside 64 bits; the loader enforces the same. */
+#define BS_PERIOD_MAX_MS 3600000u /* one hour */
+#define BS_SPIN_MAX 3600          /* |degrees per second| */
 
 typedef struct {
     char name[300];                 /* for messages: "a.scene" or "x.wad:MAP01" */
@@ -81,6 +123,17 @@ typedef struct {
     int32_t player_x, player_y, player_angle; /* 16.16; angle in degrees */
     int player_line;
     uint32_t player_sector;         /* filled by bs_scene_check / bspc.c */
+    bs_model *models;
+    uint32_t nmodels, mcap;
+    bs_mvert *mverts;
+    uint32_t nmverts, mvcap;
+    bs_face *faces;
+    uint32_t nfaces, fcap;
+    uint32_t *findex;
+    uint32_t nfindex, ficap;
+    bs_object *objects;
+    uint32_t nobjects, ocap;
+    uint32_t ndoors;
 } bs_scene;
 
 void bs_scene_free(bs_scene *s);
@@ -99,6 +152,24 @@ int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_sc
 int bs_check_ranges(const bs_scene *s, char *err, size_t errlen);
 int bs_check_closed(const bs_scene *s, char *err, size_t errlen);
 uint32_t bs_player_sector(const bs_scene *s);
+/* The sector containing (x, y) by the same winding-number rule, or SCN_NONE. */
+uint32_t bs_point_sector(const bs_scene *s, int32_t x, int32_t y);
+
+/* models.c: model geometry (docs/objects.md). A model is begun, given parts, and
+ * ended; each call returns 0, or -1 with a message (without file or line: the
+ * caller prefixes them) in err. */
+typedef struct {
+    int sides;                 /* 4 for a box, N for a prism */
+    int box;                   /* corners at (+-w/2, +-d/2) instead of on a circle */
+    int32_t w, d, r, h;        /* 16.16, > 0 */
+    int32_t at[3];             /* 16.16 */
+    uint8_t top, bottom, side; /* colours; side before fake contrast */
+} bs_mpart;
+int bs_model_begin(bs_scene *s, const char *name, int src_line, char *err, size_t errlen);
+int bs_model_add_part(bs_scene *s, const bs_mpart *p, char *err, size_t errlen);
+int bs_model_end(bs_scene *s, char *err, size_t errlen);
+/* Shade c one step lighter (+1) or darker (-1) within its ramp of 16. */
+uint8_t bs_shade(uint8_t c, int delta);
 
 /* palette.c: the default 256-colour palette: 16 ramps (hues) x 16 shades,
  * index = ramp * 16 + shade, shade 0 darkest. See docs/scene-format.md. */

@@ -127,8 +127,9 @@ int main(int argc, char **argv)
     if (opt.verbose) fprintf(stderr, "bspc: wrote %s (%zu bytes)\n", outp, len);
     if (want_stats)
         printf("{\"input_walls\": %u, \"segs\": %u, \"splits\": %u, \"leaves\": %u, \"nodes\": %u, "
-               "\"vertices\": %u, \"max_depth\": %u, \"mean_depth\": %.3f, \"build_ms\": %.3f}\n",
+               "\"vertices\": %u, \"max_depth\": %u, \"mean_depth\": %.3f, \"build_ms\": %.3f, "
+               "\"models\": %u, \"objects\": %u}\n",
                st.input_walls, st.segs, st.splits, st.leaves, st.nodes, st.vertices, st.max_depth,
-               st.mean_depth, st.build_ms);
+               st.mean_depth, st.build_ms, st.models, st.objects);
     return 0;
 }

@@ -40,6 +40,20 @@ int bs_check_ranges(const bs_scene *s, char *err, size_t errlen)
                            s->name, i, bs_fxstr(c->floor_h, b1), bs_fxstr(c->ceil_h, b2),
                            SCN_HEIGHT_MAX);
     }
+    for (uint32_t i = 0; i < s->nsectors; i++) {
+        const bs_sector *c = &s->sectors[i];
+        if ((c->flags & SCN_SECTOR_DOOR) &&
+            (c->open_h < c->ceil_h || c->open_h > BS_HEIGHT_RAW_MAX))
+            return bs_fail(err, errlen, "%s: sector %u: door opens to %s, below its ceiling %s or above %d",
+                           s->name, i, bs_fxstr(c->open_h, b1), bs_fxstr(c->ceil_h, b2), SCN_HEIGHT_MAX);
+    }
+    for (uint32_t i = 0; i < s->nobjects; i++) {
+        const bs_object *o = &s->objects[i];
+        if (o->x > BS_COORD_RAW_MAX || o->x < -BS_COORD_RAW_MAX || o->y > BS_COORD_RAW_MAX ||
+            o->y < -BS_COORD_RAW_MAX || (o->has_z && (o->z > BS_HEIGHT_RAW_MAX || o->z < -BS_HEIGHT_RAW_MAX)))
+            return bs_fail(err, errlen, "%s: object %u at (%s, %s) outside the world box", s->name, i,
+                           bs_fxstr(o->x, b1), bs_fxstr(o->y, b2));
+    }
     if (s->has_player &&
         (s->player_x > BS_COORD_RAW_MAX || s->player_x < -BS_COORD_RAW_MAX ||
          s->player_y > BS_COORD_RAW_MAX || s->player_y < -BS_COORD_RAW_MAX))
@@ -147,12 +161,18 @@ int bs_check_closed(const bs_scene *s, char *err, size_t errlen)
 
 uint32_t bs_player_sector(const bs_scene *s)
 {
-    /* Winding number of the player point around each sector's boundary (edges
+    if (!s->has_player) return SCN_NONE;
+    return bs_point_sector(s, s->player_x, s->player_y);
+}
+
+uint32_t bs_point_sector(const bs_scene *s, int32_t x, int32_t y)
+{
+    /* Winding number of the point around each sector's boundary (edges
      * oriented with the sector on their right); the first non-zero one wins. */
-    if (!s->has_player || s->nsectors == 0) return SCN_NONE;
+    if (s->nsectors == 0) return SCN_NONE;
     int32_t *wn = calloc(s->nsectors, sizeof *wn);
     if (!wn) return SCN_NONE;
-    const int64_t px = s->player_x, py = s->player_y;
+    const int64_t px = x, py = y;
     for (uint32_t i = 0; i < s->nlines; i++) {
         const bs_line *l = &s->lines[i];
         for (int side = 0; side < 2; side++) {

@@ -5,6 +5,9 @@
  *   wall X1 Y1 X2 Y2 FRONT [BACK] [mid=C] [upper=C] [lower=C]
  *        [back_mid=C] [back_upper=C] [back_lower=C]
  *   player X Y ANGLE
+ *   model NAME / part box|prism KEY=VALUE... / end
+ *   object MODEL X Y [z=Z] [yaw=DEG] [path=...] [spin=DEG_PER_S]
+ * (models and objects: docs/objects.md; sectors also take door=H).
  * Numbers are decimal (fractions allowed) and become 16.16, rounded to nearest.
  * Every error names the file, the line and the problem.
  */
@@ -28,6 +31,7 @@ typedef struct {
     bs_scene *s;
     uint32_t *vhash; /* vertex index + 1 */
     uint32_t hcap;
+    int in_model;    /* between 'model' and 'end' */
 } parser;
 
 static int perr(parser *p, const char *fmt, ...)
@@ -171,7 +175,7 @@ static int do_sector(parser *p, char **tok, int n)
     sec.light = 255;
     sec.floor_color = (uint8_t)(BS_RAMP_BROWN * 16 + 8);
     sec.ceil_color = (uint8_t)(BS_RAMP_GREY * 16 + 9);
-    int i = 1, have_floor = 0, have_ceil = 0, seen_fc = 0, seen_cc = 0, seen_light = 0;
+    int i = 1, have_floor = 0, have_ceil = 0, seen_fc = 0, seen_cc = 0, seen_light = 0, have_door = 0;
     if (i < n && !strchr(tok[i], '=') && strcmp(tok[i], "sky") != 0) {
         if (!valid_name(tok[i]))
             return perr(p, "sector: bad name '%s' (a letter or '_' first, then letters, digits, "
@@ -210,14 +214,25 @@ static int do_sector(parser *p, char **tok, int n)
             if (seen_light++) return perr(p, "sector: light given twice");
             if (parse_int(val, 0, 255, &lv)) return perr(p, "sector: light=%s: expected 0..255", val);
             sec.light = (uint8_t)lv;
+        } else if (strcmp(t, "door") == 0) {
+            if (have_door++) return perr(p, "sector: door given twice");
+            if (height(p, "door", val, &sec.open_h)) return -1;
+            sec.flags |= SCN_SECTOR_DOOR;
         } else {
-            return perr(p, "sector: unknown key '%s' (floor, ceil, floor_color, ceil_color, light, sky)",
-                        t);
+            return perr(p, "sector: unknown key '%s' (floor, ceil, floor_color, ceil_color, light, sky, "
+                           "door)", t);
         }
     }
     if (!have_floor) return perr(p, "sector: missing floor=HEIGHT");
     if (!have_ceil) return perr(p, "sector: missing ceil=HEIGHT");
     if (sec.ceil_h < sec.floor_h) return perr(p, "sector: ceil is below floor");
+    if (have_door && sec.open_h < sec.ceil_h)
+        return perr(p, "sector: door=H is below ceil (the open ceiling of a door is at or above its "
+                       "closed one)");
+    if (have_door)
+        s->ndoors++;
+    else
+        sec.open_h = sec.ceil_h;
     if (bs_grow(&s->sectors, &s->scap, s->nsectors + 1, sizeof sec)) return perr(p, "out of memory");
     s->sectors[s->nsectors++] = sec;
     return 0;
@@ -290,6 +305,255 @@ static int do_player(parser *p, char **tok, int n)
     s->player_angle = (int32_t)a;
     s->has_player = 1;
     s->player_line = p->line;
+    return 0;
+}
+
+/* ---- models and objects (docs/objects.md) ---- */
+
+static const bs_model *cur_model(parser *p) { return &p->s->models[p->s->nmodels - 1]; }
+
+static int do_model(parser *p, char **tok, int n)
+{
+    bs_scene *s = p->s;
+    if (n != 2) return perr(p, "model: expected 'model NAME'");
+    if (!valid_name(tok[1]))
+        return perr(p, "model: bad name '%s' (a letter or '_' first, then letters, digits, '_', '-', "
+                       "'.'; up to 31 characters)", tok[1]);
+    for (uint32_t k = 0; k < s->nmodels; k++)
+        if (strcmp(s->models[k].name, tok[1]) == 0)
+            return perr(p, "model: name '%s' already used by model %u (line %d)", tok[1], k,
+                        s->models[k].src_line);
+    char msg[300];
+    if (bs_model_begin(s, tok[1], p->line, msg, sizeof msg)) return perr(p, "model: %s", msg);
+    p->in_model = 1;
+    return 0;
+}
+
+/* a model-space size: > 0 and at most the model box's width */
+static int model_size(parser *p, const char *key, const char *val, int32_t *out)
+{
+    int64_t v;
+    if (fxtext_parse64(val, &v)) return perr(p, "part: %s=%s is not a number", key, val);
+    if (v <= 0 || v > 2 * (int64_t)SCN_MODEL_MAX * 65536)
+        return perr(p, "part: %s=%s out of range (0 < %s <= %d)", key, val, key, 2 * SCN_MODEL_MAX);
+    *out = (int32_t)v;
+    return 0;
+}
+
+static int do_part(parser *p, char **tok, int n)
+{
+    if (n < 2 || (strcmp(tok[1], "box") != 0 && strcmp(tok[1], "prism") != 0))
+        return perr(p, "part: expected 'part box w=W d=D h=H ...' or 'part prism sides=N r=R h=H ...'");
+    int box = strcmp(tok[1], "box") == 0;
+    bs_mpart pt;
+    memset(&pt, 0, sizeof pt);
+    pt.box = box;
+    pt.sides = box ? 4 : 0;
+    enum { K_W, K_D, K_H, K_R, K_SIDES, K_AT, K_COLOR, K_TOP, K_BOTTOM, K_SIDE, K_N };
+    static const char *keys[K_N] = {"w", "d", "h", "r", "sides", "at", "color", "top", "bottom", "side"};
+    int have[K_N] = {0};
+    uint8_t col[K_N];
+    for (int i = 2; i < n; i++) {
+        char *eq = strchr(tok[i], '=');
+        if (!eq) return perr(p, "part: unexpected '%s' (expected KEY=VALUE)", tok[i]);
+        *eq = 0;
+        const char *val = eq + 1;
+        int k;
+        for (k = 0; k < K_N; k++)
+            if (strcmp(tok[i], keys[k]) == 0) break;
+        if (k == K_N || (box && (k == K_R || k == K_SIDES)) || (!box && (k == K_W || k == K_D)))
+            return perr(p, "part %s: unknown key '%s' (%s, at, color, top, bottom, side)", tok[1], tok[i],
+                        box ? "w, d, h" : "sides, r, h");
+        if (have[k]++) return perr(p, "part: %s given twice", keys[k]);
+        long lv;
+        switch (k) {
+        case K_W: if (model_size(p, "w", val, &pt.w)) return -1; break;
+        case K_D: if (model_size(p, "d", val, &pt.d)) return -1; break;
+        case K_H: if (model_size(p, "h", val, &pt.h)) return -1; break;
+        case K_R: if (model_size(p, "r", val, &pt.r)) return -1; break;
+        case K_SIDES:
+            if (parse_int(val, 3, SCN_MAX_FACE_VERTS, &lv))
+                return perr(p, "part: sides=%s: expected a whole number 3..%d", val, SCN_MAX_FACE_VERTS);
+            pt.sides = (int)lv;
+            break;
+        case K_AT: {
+            char buf[128];
+            snprintf(buf, sizeof buf, "%s", val);
+            char *c[3] = {buf, NULL, NULL};
+            for (int j = 1; j < 3; j++) {
+                c[j] = c[j - 1] ? strchr(c[j - 1], ',') : NULL;
+                if (c[j]) *c[j]++ = 0;
+            }
+            if (!c[1] || !c[2] || strchr(c[2], ','))
+                return perr(p, "part: at=%s: expected at=X,Y,Z", val);
+            for (int j = 0; j < 3; j++) {
+                int64_t v;
+                if (fxtext_parse64(c[j], &v)) return perr(p, "part: at=%s: '%s' is not a number", val, c[j]);
+                if (v > (int64_t)SCN_MODEL_MAX * 65536 || v < -(int64_t)SCN_MODEL_MAX * 65536)
+                    return perr(p, "part: at=%s out of range (|coordinate| <= %d)", val, SCN_MODEL_MAX);
+                pt.at[j] = (int32_t)v;
+            }
+            break;
+        }
+        default:
+            if (parse_color(p, keys[k], val, &col[k])) return -1;
+        }
+    }
+    static const int need_box[3] = {K_W, K_D, K_H}, need_prism[3] = {K_SIDES, K_R, K_H};
+    for (int j = 0; j < 3; j++) {
+        int k = box ? need_box[j] : need_prism[j];
+        if (!have[k]) return perr(p, "part %s: missing %s=", tok[1], keys[k]);
+    }
+    uint8_t base = have[K_COLOR] ? col[K_COLOR] : (uint8_t)(BS_RAMP_GREY * 16 + 10);
+    pt.top = have[K_TOP] ? col[K_TOP] : base;
+    pt.bottom = have[K_BOTTOM] ? col[K_BOTTOM] : base;
+    pt.side = have[K_SIDE] ? col[K_SIDE] : base;
+    char msg[300];
+    if (bs_model_add_part(p->s, &pt, msg, sizeof msg)) {
+        if (strncmp(msg, "part", 4) == 0) return perr(p, "%s", msg);
+        return perr(p, "part: %s", msg);
+    }
+    return 0;
+}
+
+static int find_model(parser *p, const char *t, uint32_t *out)
+{
+    bs_scene *s = p->s;
+    if (isdigit((unsigned char)t[0])) {
+        long v;
+        if (parse_int(t, 0, 0x7FFFFFFF, &v) == 0 && (uint32_t)v < s->nmodels) {
+            *out = (uint32_t)v;
+            return 0;
+        }
+        return perr(p, "object: unknown model %s (%u model(s) declared above this line)", t, s->nmodels);
+    }
+    for (uint32_t i = 0; i < s->nmodels; i++)
+        if (strcmp(s->models[i].name, t) == 0) {
+            *out = i;
+            return 0;
+        }
+    return perr(p, "object: unknown model '%s' (models must be declared before the objects that use them)",
+                t);
+}
+
+/* "A:B[:C...]" -> its fields, in place; returns the count */
+static int split_colons(char *t, char **f, int max)
+{
+    int n = 0;
+    while (n < max) {
+        f[n++] = t;
+        t = strchr(t, ':');
+        if (!t) break;
+        *t++ = 0;
+    }
+    return t ? max + 1 : n;
+}
+
+static int period(parser *p, const char *t, uint32_t *out)
+{
+    char *end;
+    errno = 0;
+    long v = isdigit((unsigned char)t[0]) ? strtol(t, &end, 10) : 0;
+    if (!isdigit((unsigned char)t[0]) || *end || errno || v < 1 || v > (long)BS_PERIOD_MAX_MS)
+        return perr(p, "object: period %s: expected whole milliseconds 1..%u", t, BS_PERIOD_MAX_MS);
+    *out = (uint32_t)v;
+    return 0;
+}
+
+static int do_object(parser *p, char **tok, int n)
+{
+    bs_scene *s = p->s;
+    if (n < 4)
+        return perr(p, "object: expected 'object MODEL X Y [z=Z] [yaw=DEG] [path=circle:R:PERIOD_MS | "
+                       "path=line:DX:DY:PERIOD_MS] [spin=DEG_PER_S]'");
+    if (s->nobjects >= SCN_MAX_OBJECTS) return perr(p, "object: more than %d objects", SCN_MAX_OBJECTS);
+    bs_object o;
+    memset(&o, 0, sizeof o);
+    o.src_line = p->line;
+    o.path = SCN_PATH_NONE;
+    if (find_model(p, tok[1], &o.model)) return -1;
+    if (coord(p, "object: x", tok[2], &o.x) || coord(p, "object: y", tok[3], &o.y)) return -1;
+    int have_z = 0, have_yaw = 0, have_path = 0, have_spin = 0;
+    for (int i = 4; i < n; i++) {
+        char *eq = strchr(tok[i], '=');
+        if (!eq) return perr(p, "object: unexpected '%s' (expected KEY=VALUE)", tok[i]);
+        *eq = 0;
+        char *val = eq + 1;
+        int64_t v;
+        if (strcmp(tok[i], "z") == 0) {
+            if (have_z++) return perr(p, "object: z given twice");
+            if (fxtext_parse64(val, &v)) return perr(p, "object: z=%s is not a number", val);
+            if (v > BS_HEIGHT_RAW_MAX || v < -BS_HEIGHT_RAW_MAX)
+                return perr(p, "object: z=%s out of range (|height| <= %d)", val, SCN_HEIGHT_MAX);
+            o.z = (int32_t)v;
+            o.has_z = 1;
+        } else if (strcmp(tok[i], "yaw") == 0) {
+            if (have_yaw++) return perr(p, "object: yaw given twice");
+            if (fxtext_parse64(val, &v)) return perr(p, "object: yaw=%s is not a number", val);
+            const int64_t turn = (int64_t)360 << 16;
+            v %= turn;
+            if (v < 0) v += turn;
+            o.yaw = (int32_t)v;
+        } else if (strcmp(tok[i], "spin") == 0) {
+            if (have_spin++) return perr(p, "object: spin given twice");
+            if (fxtext_parse64(val, &v)) return perr(p, "object: spin=%s is not a number", val);
+            if (v > (int64_t)BS_SPIN_MAX * 65536 || v < -(int64_t)BS_SPIN_MAX * 65536)
+                return perr(p, "object: spin=%s out of range (|degrees per second| <= %d)", val, BS_SPIN_MAX);
+            o.spin = (int32_t)v;
+        } else if (strcmp(tok[i], "path") == 0) {
+            if (have_path++) return perr(p, "object: path given twice");
+            char text[128];
+            snprintf(text, sizeof text, "%s", val);
+            char *f[5];
+            int nf = split_colons(val, f, 4);
+            int64_t a, b;
+            if (strcmp(f[0], "circle") == 0 && nf == 3) {
+                if (fxtext_parse64(f[1], &a))
+                    return perr(p, "object: path=%s: radius '%s' is not a number", text, f[1]);
+                if (a <= 0 || a > 2 * BS_COORD_RAW_MAX)
+                    return perr(p, "object: path=%s: radius out of range (0 < R <= %d)", text,
+                                2 * SCN_COORD_MAX);
+                if (period(p, f[2], &o.period_ms)) return -1;
+                o.path = SCN_PATH_CIRCLE;
+                o.pa = (int32_t)a;
+            } else if (strcmp(f[0], "line") == 0 && nf == 4) {
+                if (fxtext_parse64(f[1], &a) || fxtext_parse64(f[2], &b))
+                    return perr(p, "object: path=%s: DX and DY must be numbers", text);
+                if (a > 2 * BS_COORD_RAW_MAX || a < -2 * BS_COORD_RAW_MAX || b > 2 * BS_COORD_RAW_MAX ||
+                    b < -2 * BS_COORD_RAW_MAX)
+                    return perr(p, "object: path=%s leaves the world box (|coordinate| <= %d)", text,
+                                SCN_COORD_MAX);
+                if (a == 0 && b == 0) return perr(p, "object: path=%s has zero length", text);
+                if (period(p, f[3], &o.period_ms)) return -1;
+                o.path = SCN_PATH_LINE;
+                o.pa = (int32_t)a;
+                o.pb = (int32_t)b;
+            } else {
+                return perr(p, "object: path=%s: expected circle:R:PERIOD_MS or line:DX:DY:PERIOD_MS", text);
+            }
+        } else {
+            return perr(p, "object: unknown key '%s' (z, yaw, path, spin)", tok[i]);
+        }
+    }
+    /* every point of the path stays in the world box */
+    int64_t lo[2] = {o.x, o.y}, hi[2] = {o.x, o.y};
+    if (o.path == SCN_PATH_CIRCLE) {
+        for (int k = 0; k < 2; k++) {
+            lo[k] -= o.pa;
+            hi[k] += o.pa;
+        }
+    } else if (o.path == SCN_PATH_LINE) {
+        int64_t d[2] = {o.pa, o.pb};
+        for (int k = 0; k < 2; k++) {
+            if (d[k] < 0) lo[k] += d[k];
+            else hi[k] += d[k];
+        }
+    }
+    for (int k = 0; k < 2; k++)
+        if (lo[k] < -BS_COORD_RAW_MAX || hi[k] > BS_COORD_RAW_MAX)
+            return perr(p, "object: its path leaves the world box (|coordinate| <= %d)", SCN_COORD_MAX);
+    if (bs_grow(&s->objects, &s->ocap, s->nobjects + 1, sizeof o)) return perr(p, "out of memory");
+    s->objects[s->nobjects++] = o;
     return 0;
 }
 
@@ -376,7 +640,7 @@ int bs_read_text(const char *path, bs_scene *s, const bspc_options *opt, char *e
     snprintf(s->name, sizeof s->name, "%s", path);
     s->is_text = 1;
     s->player_sector = SCN_NONE;
-    parser p = {path, 0, err, errlen, s, NULL, 0};
+    parser p = {path, 0, err, errlen, s, NULL, 0, 0};
     int rc = 0;
     char *line = buf;
     while (line && rc == 0) {
@@ -401,19 +665,42 @@ int bs_read_text(const char *path, bs_scene *s, const bspc_options *opt, char *e
             line = next;
             continue;
         }
-        if (strcmp(tok[0], "sector") == 0)
+        if (p.in_model) {
+            if (strcmp(tok[0], "part") == 0)
+                rc = do_part(&p, tok, n);
+            else if (strcmp(tok[0], "end") == 0) {
+                char msg[300];
+                if (n != 1)
+                    rc = perr(&p, "end: unexpected '%s'", tok[1]);
+                else if (bs_model_end(s, msg, sizeof msg))
+                    rc = perr(&p, "end: %s", msg);
+                p.in_model = 0;
+            } else
+                rc = perr(&p, "%s: not allowed inside model '%s' (line %d): 'end' missing?", tok[0],
+                          cur_model(&p)->name, cur_model(&p)->src_line);
+        } else if (strcmp(tok[0], "sector") == 0)
             rc = do_sector(&p, tok, n);
         else if (strcmp(tok[0], "wall") == 0)
             rc = do_wall(&p, tok, n);
         else if (strcmp(tok[0], "player") == 0)
             rc = do_player(&p, tok, n);
+        else if (strcmp(tok[0], "model") == 0)
+            rc = do_model(&p, tok, n);
+        else if (strcmp(tok[0], "object") == 0)
+            rc = do_object(&p, tok, n);
+        else if (strcmp(tok[0], "part") == 0 || strcmp(tok[0], "end") == 0)
+            rc = perr(&p, "%s: outside a model (start one with 'model NAME')", tok[0]);
         else
-            rc = perr(&p, "unknown statement '%s' (expected sector, wall or player)", tok[0]);
+            rc = perr(&p, "unknown statement '%s' (expected sector, wall, player, model or object)",
+                      tok[0]);
         line = next;
     }
     free(buf);
     free(p.vhash);
     if (rc) return rc;
+    if (p.in_model)
+        return bs_fail(err, errlen, "%s:%d: model '%s': 'end' missing", path, cur_model(&p)->src_line,
+                       cur_model(&p)->name);
     if (s->nlines == 0) return bs_fail(err, errlen, "%s: no walls", path);
     if (!s->has_player) return bs_fail(err, errlen, "%s: no player start (add 'player X Y ANGLE')", path);
     return check_duplicates(&p);

@@ -76,6 +76,11 @@ void bs_scene_free(bs_scene *s)
     free(s->vy);
     free(s->sectors);
     free(s->lines);
+    free(s->models);
+    free(s->mverts);
+    free(s->faces);
+    free(s->findex);
+    free(s->objects);
     memset(s, 0, sizeof *s);
 }
 

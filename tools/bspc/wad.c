@@ -5,6 +5,10 @@
  * order; only THINGS, LINEDEFS, SIDEDEFS, VERTEXES and SECTORS are read (the
  * shipped nodes are ignored: this compiler builds its own). A BEHAVIOR lump
  * marks a Hexen-format map, which is refused. Every index is validated.
+ *
+ * Things listed in tools/bspc/things.txt (built in as things_txt.h) become
+ * objects on box models, and sectors opened by door specials become doors
+ * (docs/objects.md).
  */
 #include <ctype.h>
 #include <errno.h>
@@ -13,6 +17,7 @@
 #include <string.h>
 
 #include "bspc_int.h"
+#include "things_txt.h" /* bs_things_txt[], bs_things_txt_len: tools/bspc/things.txt */
 
 typedef struct {
     uint32_t pos, size;
@@ -50,6 +55,216 @@ static void name8(char out[9], const uint8_t *p)
     int i;
     for (i = 0; i < 8 && p[i]; i++) out[i] = (char)toupper(p[i]);
     out[i] = 0;
+}
+
+/* ---- things (docs/objects.md) ---- */
+
+typedef struct {
+    uint16_t type;
+    int32_t radius, height; /* whole units */
+    uint8_t colour;
+} thing_kind;
+
+/* Parse the built-in table into kinds[] (at most cap); returns the count, or -1
+ * with a message (a broken table is a build mistake, but it is reported). */
+static int read_thing_table(thing_kind *kinds, int cap, char *err, size_t errlen)
+{
+    int n = 0, lineno = 0;
+    size_t at = 0, len = bs_things_txt_len;
+    while (at < len) {
+        char line[256];
+        size_t k = 0;
+        while (at < len && bs_things_txt[at] != '\n') {
+            if (k < sizeof line - 1) line[k++] = (char)bs_things_txt[at];
+            at++;
+        }
+        at++;
+        line[k] = 0;
+        lineno++;
+        char *hash = strchr(line, '#');
+        if (hash) *hash = 0;
+        char *col[6];
+        int nc = 0;
+        char *save = NULL;
+        for (char *c = strtok_r(line, " \t\r", &save); c && nc < 6; c = strtok_r(NULL, " \t\r", &save))
+            col[nc++] = c;
+        if (nc == 0) continue;
+        long v[3];
+        int bad = nc != 5;
+        for (int j = 0; j < 3 && !bad; j++) {
+            char *end;
+            errno = 0;
+            v[j] = strtol(col[j], &end, 10);
+            bad = *end || errno || v[j] < (j ? 1 : 0) || v[j] > (j == 0 ? 65535 : SCN_MODEL_MAX);
+        }
+        int colour = -1;
+        if (!bad) {
+            if (isdigit((unsigned char)col[3][0])) {
+                char *end;
+                long c = strtol(col[3], &end, 0);
+                colour = (*end || c < 0 || c > 255) ? -1 : (int)c;
+            } else {
+                colour = bs_color_by_name(col[3]);
+            }
+            bad = colour < 0;
+        }
+        if (bad)
+            return bs_fail(err, errlen, "things.txt:%d: expected 'type radius height colour name' "
+                           "(radius 1..%d)", lineno, SCN_MODEL_MAX);
+        if (n == cap) return bs_fail(err, errlen, "things.txt: more than %d thing types", cap);
+        kinds[n++] = (thing_kind){(uint16_t)v[0], (int32_t)v[1], (int32_t)v[2], (uint8_t)colour};
+    }
+    return n;
+}
+
+#define THING_SKILL3 0x0002u  /* present on skill 3 ("hurt me plenty") */
+#define THING_MULTI_ONLY 0x0010u
+
+/* Things of listed types, on skill 3 and in single player, become objects, one
+ * box model per distinct (radius, height, colour), models in order of first use. */
+static int read_things(bs_scene *s, const uint8_t *recs, uint32_t count, const char *display,
+                       const bspc_options *opt, char *err, size_t errlen)
+{
+    enum { MAX_KINDS = 512 };
+    thing_kind *kinds = malloc(sizeof *kinds * MAX_KINDS);
+    uint32_t *model_of = malloc(sizeof *model_of * MAX_KINDS);
+    if (!kinds || !model_of) {
+        free(kinds);
+        free(model_of);
+        return bs_fail(err, errlen, "%s: out of memory", display);
+    }
+    char msg[300];
+    int nk = read_thing_table(kinds, MAX_KINDS, msg, sizeof msg);
+    int rc = 0;
+    if (nk < 0) {
+        rc = bs_fail(err, errlen, "%s: %s", display, msg);
+        goto done;
+    }
+    for (int k = 0; k < nk; k++) model_of[k] = SCN_NONE;
+    uint32_t unknown = 0, skipped = 0;
+    for (uint32_t i = 0; i < count; i++) {
+        const uint8_t *r = recs + 10 * i;
+        int x = rds16(r), y = rds16(r + 2), a = rds16(r + 4);
+        uint16_t type = rd16(r + 6), flags = rd16(r + 8);
+        int k;
+        for (k = 0; k < nk; k++)
+            if (kinds[k].type == type) break;
+        if (k == nk) {
+            if (type != 1 && type != 2 && type != 3 && type != 4 && type != 11 && type != 14) unknown++;
+            continue;
+        }
+        if (!(flags & THING_SKILL3) || (flags & THING_MULTI_ONLY)) continue;
+        if (x == -32768 || y == -32768) {
+            bs_warn(opt, "%s: thing %u: coordinate -32768 out of range, left out", display, i);
+            skipped++;
+            continue;
+        }
+        /* kinds sharing a size and colour share a model */
+        for (int j = 0; j < nk && model_of[k] == SCN_NONE; j++)
+            if (model_of[j] != SCN_NONE && kinds[j].radius == kinds[k].radius &&
+                kinds[j].height == kinds[k].height && kinds[j].colour == kinds[k].colour)
+                model_of[k] = model_of[j];
+        if (model_of[k] == SCN_NONE) {
+            bs_mpart p;
+            memset(&p, 0, sizeof p);
+            p.box = 1;
+            p.sides = 4;
+            p.w = p.d = kinds[k].radius * 2 * 65536;
+            p.h = kinds[k].height * 65536;
+            p.top = p.bottom = p.side = kinds[k].colour;
+            if (bs_model_begin(s, NULL, 0, msg, sizeof msg) || bs_model_add_part(s, &p, msg, sizeof msg) ||
+                bs_model_end(s, msg, sizeof msg)) {
+                rc = bs_fail(err, errlen, "%s: thing type %u: %s", display, type, msg);
+                goto done;
+            }
+            model_of[k] = s->nmodels - 1;
+        }
+        if (s->nobjects >= SCN_MAX_OBJECTS) {
+            rc = bs_fail(err, errlen, "%s: more than %d things become objects", display, SCN_MAX_OBJECTS);
+            goto done;
+        }
+        if (bs_grow(&s->objects, &s->ocap, s->nobjects + 1, sizeof *s->objects)) {
+            rc = bs_fail(err, errlen, "%s: out of memory", display);
+            goto done;
+        }
+        bs_object *o = &s->objects[s->nobjects++];
+        memset(o, 0, sizeof *o);
+        o->model = model_of[k];
+        o->x = x * 65536;
+        o->y = y * 65536;
+        a %= 360;
+        if (a < 0) a += 360;
+        o->yaw = a * 65536;
+        o->path = SCN_PATH_NONE;
+        o->src_line = (int)i;
+    }
+    if (unknown) bs_note(opt, "%s: %u thing(s) of types not in things.txt left out", display, unknown);
+    if (skipped) bs_note(opt, "%s: %u thing(s) out of range left out", display, skipped);
+done:
+    free(kinds);
+    free(model_of);
+    return rc;
+}
+
+/* ---- doors ---- */
+
+static int is_manual_door(unsigned special)
+{
+    static const unsigned specials[] = {1, 26, 27, 28, 31, 32, 33, 34, 117, 118};
+    for (size_t i = 0; i < sizeof specials / sizeof specials[0]; i++)
+        if (special == specials[i]) return 1;
+    return 0;
+}
+
+/* Sectors opened by a door special become doors: the back sector of a manual
+ * door's line, or, for the switched and walked-over doors (63, 90), every
+ * sector with the line's non-zero tag. A door opens to the lowest ceiling of
+ * the sectors across its two-sided lines minus 4 (Doom's
+ * P_FindLowestCeilingSurrounding), never below its closed ceiling. */
+static int find_doors(bs_scene *s, const uint8_t *lines, uint32_t nl, const uint8_t *sides,
+                      const uint8_t *sectors, const char *display, char *err, size_t errlen)
+{
+    uint32_t ns = s->nsectors;
+    uint8_t *door = calloc(ns + 1, 1);
+    int32_t *lowest = malloc(sizeof *lowest * (ns + 1));
+    if (!door || !lowest) {
+        free(door);
+        free(lowest);
+        return bs_fail(err, errlen, "%s: out of memory", display);
+    }
+    for (uint32_t i = 0; i < nl; i++) {
+        const uint8_t *r = lines + 14 * i;
+        unsigned special = rd16(r + 6), tag = rd16(r + 8), back = rd16(r + 12);
+        if (is_manual_door(special)) {
+            /* zero-length lines were skipped before their sectors were checked */
+            if (back != 0xFFFF && rd16(sides + 30 * back + 28) < ns) door[rd16(sides + 30 * back + 28)] = 1;
+        } else if ((special == 63 || special == 90) && tag != 0) {
+            for (uint32_t k = 0; k < ns; k++)
+                if (rd16(sectors + 26 * k + 24) == tag) door[k] = 1;
+        }
+    }
+    for (uint32_t k = 0; k < ns; k++) lowest[k] = INT32_MAX;
+    for (uint32_t i = 0; i < nl; i++) {
+        const uint8_t *r = lines + 14 * i;
+        unsigned front = rd16(r + 10), back = rd16(r + 12);
+        if (back == 0xFFFF) continue;
+        uint32_t a = rd16(sides + 30 * front + 28), b = rd16(sides + 30 * back + 28);
+        if (a >= ns || b >= ns) continue;
+        if (s->sectors[b].ceil_h < lowest[a]) lowest[a] = s->sectors[b].ceil_h;
+        if (s->sectors[a].ceil_h < lowest[b]) lowest[b] = s->sectors[a].ceil_h;
+    }
+    for (uint32_t k = 0; k < ns; k++) {
+        if (!door[k]) continue;
+        bs_sector *c = &s->sectors[k];
+        int32_t open = c->ceil_h;
+        if (lowest[k] != INT32_MAX && lowest[k] - 4 * 65536 > open) open = lowest[k] - 4 * 65536;
+        c->flags |= SCN_SECTOR_DOOR;
+        c->open_h = open;
+        s->ndoors++;
+    }
+    free(door);
+    free(lowest);
+    return 0;
 }
 
 int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_scene *s,
@@ -312,6 +527,9 @@ int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_sc
         bs_fail(err, errlen, "%s: no player start (no thing of type 1)", display);
         goto out;
     }
+    /* every sidedef and sector index was checked by the linedef loop above */
+    if (find_doors(s, ld[L_LINEDEFS], nl, ld[L_SIDEDEFS], ld[L_SECTORS], display, err, errlen)) goto out;
+    if (read_things(s, ld[L_THINGS], cnt[L_THINGS], display, opt, err, errlen)) goto out;
     rc = 0;
 out:
     for (int k = 0; k < L_N; k++) free(ld[k]);

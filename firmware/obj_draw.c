@@ -1,0 +1,375 @@
+/* obj_draw.c - objects in the tree, in view space, on screen, and their 1/z order
+ * against the world (see obj_draw.h for the 1/z format and its ranges).
+ *
+ * Ranges of the geometry. An object's origin lies in the box (|x|, |y| <= 32767
+ * units, |z| <= 16383) and its vertices within 1024 sqrt 2 = 1449 units of it
+ * horizontally and 1024 vertically (the loader's limits), so a vertex is within
+ * |x|, |y| <= 34216 units and |z| <= 17407: an eye offset below 66,983 units
+ * (2^32.03 raw 16.16), a rotated sum bounded by the offset's length (< 2^62.53
+ * with 2.30 sine and cosine), a view coordinate below 2^30.53 raw (18.14), and a
+ * height difference below 33,790 units (2^31.04 raw 16.16). */
+#include "obj_draw.h"
+
+_Static_assert(SCN_MAX_FACE_VERTS + 5 <= CLIP_MAX_VERTS, "a clipped face must fit a clip_poly");
+
+#define NORM_LO ((int64_t)1 << 29)
+#define NORM_HI ((int64_t)1 << 30)
+#define SIDE_EPS ((int64_t)OBJ_TIE_EPS << 30) /* OBJ_TIE_EPS times a normal's length, about */
+#define TIE_FACTOR (320 / OBJ_TIE_EPS)        /* see objd_front */
+#define STACK_MAX (SCN_MAX_DEPTH + 2)
+
+/* ---- exact 128-bit products -------------------------------------------------- */
+
+typedef struct {
+    uint64_t hi, lo; /* two's complement */
+} w128;
+
+static uint64_t uabs(int64_t a)
+{
+    return a < 0 ? (uint64_t)0 - (uint64_t)a : (uint64_t)a;
+}
+
+static w128 w_neg(w128 a)
+{
+    w128 r;
+    r.lo = ~a.lo + 1u;
+    r.hi = ~a.hi + (r.lo == 0);
+    return r;
+}
+
+/* a * b for any int64 a, b (the magnitude is below 2^126), from 32-bit parts:
+ * what a 32-bit core does, and the definition the 128-bit type below must match. */
+static w128 w_mul_parts(int64_t a, int64_t b)
+{
+    uint64_t x = uabs(a), y = uabs(b);
+    uint64_t xl = x & 0xFFFFFFFFu, xh = x >> 32, yl = y & 0xFFFFFFFFu, yh = y >> 32;
+    uint64_t ll = xl * yl, lh = xl * yh, hl = xh * yl, hh = xh * yh;
+    uint64_t mid = (ll >> 32) + (lh & 0xFFFFFFFFu) + (hl & 0xFFFFFFFFu);
+    w128 r;
+    r.lo = (ll & 0xFFFFFFFFu) | (mid << 32);
+    r.hi = hh + (lh >> 32) + (hl >> 32) + (mid >> 32);
+    return ((a < 0) != (b < 0)) ? w_neg(r) : r;
+}
+
+static w128 w_mul(int64_t a, int64_t b)
+{
+#if defined(__SIZEOF_INT128__)
+    /* a 64-bit host multiplies in one instruction; the result is the same */
+    __extension__ typedef __int128 i128;
+    __extension__ typedef unsigned __int128 u128;
+    u128 p = (u128)((i128)a * b);
+    w128 r = {(uint64_t)(p >> 64), (uint64_t)p};
+    return r;
+#else
+    return w_mul_parts(a, b);
+#endif
+}
+
+static w128 w_sub(w128 a, w128 b)
+{
+    w128 r;
+    r.lo = a.lo - b.lo;
+    r.hi = a.hi - b.hi - (a.lo < b.lo);
+    return r;
+}
+
+static int w_sign(w128 a)
+{
+    if (a.hi >> 63) return -1;
+    return (a.hi | a.lo) ? 1 : 0;
+}
+
+static int sign_diff(int64_t a, int64_t b, int64_t c, int64_t d)
+{
+    return w_sign(w_sub(w_mul(a, b), w_mul(c, d)));
+}
+
+int objd_sign_diff(int64_t a, int64_t b, int64_t c, int64_t d)
+{
+    return w_sign(w_sub(w_mul_parts(a, b), w_mul_parts(c, d)));
+}
+
+/* Bits below the leading one, plus one (0 for 0). */
+static int bits(uint64_t v)
+{
+    return v ? 64 - __builtin_clzll(v) : 0;
+}
+
+/* ---- planes ---------------------------------------------------------------------- */
+
+/* Scale (x, y, z) so its largest component lies in [2^29, 2^30). Returns 0 for
+ * the zero vector. */
+static int normalise(int64_t *x, int64_t *y, int64_t *z)
+{
+    uint64_t m = uabs(*x) | uabs(*y) | uabs(*z); /* the same leading bit as the largest */
+    if (m == 0) return 0;
+    int top = 63 - __builtin_clzll(m); /* the largest component's leading bit: wanted at 29 */
+    if (top > 29) {
+        *x = fx_asr64(*x, (unsigned)(top - 29));
+        *y = fx_asr64(*y, (unsigned)(top - 29));
+        *z = fx_asr64(*z, (unsigned)(top - 29));
+    } else if (top < 29) { /* |v| < 2^29: shifting up by at most 29 stays below 2^59 */
+        *x *= (int64_t)1 << (29 - top);
+        *y *= (int64_t)1 << (29 - top);
+        *z *= (int64_t)1 << (29 - top);
+    }
+    return 1;
+}
+
+/* n . p with |n| components < 2^30 and |p| < 2^30.6: below 2^61.4, and so is each
+ * partial sum. */
+static int64_t dot(const objd_plane *pl, int64_t x, int64_t y, int64_t z)
+{
+    return (int64_t)pl->nx * x + (int64_t)pl->ny * y + (int64_t)pl->nz * z;
+}
+
+void objd_plane_flat(const view_xform *v, int32_t h, objd_plane *p)
+{
+    /* view_point's height arithmetic; |y| < 2^29.05, so d < 2^58.05 */
+    int32_t y = (int32_t)fx_asr64((int64_t)h - v->cz, 16 - VIEW_SHIFT);
+    *p = (objd_plane){0, y < 0 ? -(int32_t)NORM_LO : (int32_t)NORM_LO, 0, 0, 0, 0,
+                      (int64_t)(y < 0 ? -y : y) * NORM_LO};
+}
+
+void objd_plane_wall(const view_xform *v, const scn_vertex *a, const scn_vertex *b, objd_plane *p)
+{
+    view_pt pa = view_point(v, a->x, a->y, 0), pb = view_point(v, b->x, b->y, 0);
+    int64_t nx = (int64_t)pb.z - pa.z, ny = 0, nz = (int64_t)pa.x - pb.x; /* across the wall */
+    *p = (objd_plane){0, 0, 0, 0, 0, 0, 0};
+    if (!normalise(&nx, &ny, &nz)) return;
+    int64_t d = nx * pa.x + nz * pa.z; /* < 2^30 * 2^30.5 * 2 */
+    if (d < 0) {
+        nx = -nx;
+        nz = -nz;
+        d = -d;
+    }
+    p->nx = (int32_t)nx;
+    p->nz = (int32_t)nz;
+    p->d = d;
+}
+
+/* 320 d / z at the pixel centre: the numerator M of obj_draw.h, < 2^41. */
+static int64_t numerator(const objd_plane *p, int look, int px, int py)
+{
+    return (int64_t)p->nx * (2 * px + 1 - VIEW_W) + (int64_t)p->ny * (2 * (VIEW_CY + look) - 1 - 2 * py) +
+           (int64_t)p->nz * VIEW_W;
+}
+
+/* Where point (x, y, z) lies against plane p: 1 on the eye's side, -1 beyond, 0
+ * within about OBJ_TIE_EPS of it. */
+static int side(const objd_plane *p, int32_t x, int32_t y, int32_t z)
+{
+    int64_t s = p->d - dot(p, x, y, z);
+    return s > SIDE_EPS ? 1 : (s < -SIDE_EPS ? -1 : 0);
+}
+
+int objd_front(const objd_plane *s, int s_obj, const objd_plane *p, int p_obj, int look, int px, int py)
+{
+    if (p->d <= 0) return 0;
+    if (s->d <= 0) return 1;
+    px = px < 0 ? 0 : (px >= VIEW_W ? VIEW_W - 1 : px);
+    py = py < 0 ? 0 : (py >= VIEW_H ? VIEW_H - 1 : py);
+    int64_t ms = numerator(s, look, px, py), mp = numerator(p, look, px, py);
+    /* 1/z_s - 1/z_p = (ms dp - mp ds) / (320 ds dp); the depths differ by less than
+     * OBJ_TIE_EPS when 320 |ms dp - mp ds| < OBJ_TIE_EPS ms mp (both in front of the eye) */
+    w128 diff = w_sub(w_mul(ms, p->d), w_mul(mp, s->d)); /* < 2^102.5 */
+    int sg = w_sign(diff);
+    if (ms > 0 && mp > 0) {
+        w128 mag = sg < 0 ? w_neg(diff) : diff;
+        /* 20 mag >= 2^(bits(mag) + 3) and ms mp < 2^(bits(ms) + bits(mp)): most pairs
+         * are told apart by their lengths alone */
+        int mb = mag.hi ? 64 + bits(mag.hi) : bits(mag.lo);
+        if (mb + 3 >= bits((uint64_t)ms) + bits((uint64_t)mp)) return sg > 0;
+        /* mag * TIE_FACTOR (< 2^107) by 32-bit parts, against ms mp (< 2^80.2) */
+        uint64_t l0 = (mag.lo & 0xFFFFFFFFu) * TIE_FACTOR, l1 = (mag.lo >> 32) * TIE_FACTOR + (l0 >> 32);
+        w128 scaled = {mag.hi * TIE_FACTOR + (l1 >> 32), (l1 << 32) | (l0 & 0xFFFFFFFFu)};
+        if (w_sign(w_sub(scaled, w_mul(ms, mp))) >= 0) return sg > 0;
+    } else {
+        return sg > 0;
+    }
+    /* a tie: the surfaces abut here */
+    if (s_obj) {
+        int a = side(p, s->cx, s->cy, s->cz); /* s on the eye's side of p: s in front */
+        if (a) return a > 0;
+    }
+    if (p_obj) {
+        int b = side(s, p->cx, p->cy, p->cz); /* p on the eye's side of s: p in front */
+        if (b) return b < 0;
+    }
+    /* in one plane: the one nearing the eye faster along the line, then down it */
+    int g = sign_diff(s->nx, p->d, p->nx, s->d);
+    if (g) return g > 0;
+    return sign_diff(p->ny, s->d, s->ny, p->d) > 0;
+}
+
+/* ---- the object in the tree ------------------------------------------------------ */
+
+int objd_locate(const scene *s, const obj_state *o, const uint32_t *leaf_key, uint32_t *kmin, uint32_t *kmax)
+{
+    const scn_model *m = &s->models[o->model];
+    int64_t x0 = (int64_t)o->x - m->radius, x1 = (int64_t)o->x + m->radius;
+    int64_t y0 = (int64_t)o->y - m->radius, y1 = (int64_t)o->y + m->radius;
+    uint32_t stack[STACK_MAX];
+    uint32_t sp = 0, lo = 0xFFFFFFFFu, hi = 0;
+    int open = 0;
+    if (s->nleaves == 0) return 0;
+    stack[sp++] = s->root;
+    while (sp) {
+        uint32_t n = stack[--sp];
+        if (n & SCN_LEAF_BIT) {
+            uint32_t k = leaf_key[n & ~SCN_LEAF_BIT];
+            if (!k) {
+                open = 1;
+                continue;
+            }
+            if (k < lo) lo = k;
+            if (k > hi) hi = k;
+            continue;
+        }
+        const scn_node *nd = &s->nodes[n];
+        int meet[2];
+        for (int c = 0; c < 2; c++) {
+            const int32_t *bb = nd->bbox[c]; /* top, bottom, left, right */
+            meet[c] = bb[2] <= x1 && bb[3] >= x0 && bb[1] <= y1 && bb[0] >= y0;
+        }
+        if (meet[0] && meet[1]) {
+            /* both boxes: keep the sides of the partition the box reaches. Its
+             * corners' cross products (scene_node_side's arithmetic, whose dropped
+             * bits move a product by less than |dx| + |dy|): offsets below 2^32.03
+             * raw shifted by 3, times a direction below 2^31: < 2^60.03. The
+             * largest and the smallest come from the corners the signs pick. */
+            int64_t slack = (int64_t)uabs(nd->dx) + (int64_t)uabs(nd->dy);
+            int64_t ylo = fx_asr64((nd->dx > 0 ? y0 : y1) - nd->y, 3), yhi = fx_asr64((nd->dx > 0 ? y1 : y0) - nd->y, 3);
+            int64_t xlo = fx_asr64((nd->dy > 0 ? x1 : x0) - nd->x, 3), xhi = fx_asr64((nd->dy > 0 ? x0 : x1) - nd->x, 3);
+            int64_t least = (int64_t)nd->dx * ylo - (int64_t)nd->dy * xlo;
+            int64_t most = (int64_t)nd->dx * yhi - (int64_t)nd->dy * xhi;
+            meet[0] = least <= slack; /* some corner on the front (cross <= 0) */
+            meet[1] = most > -slack;  /* some corner behind */
+        }
+        for (int c = 1; c >= 0; c--)
+            if (meet[c] && sp < STACK_MAX) stack[sp++] = nd->child[c];
+    }
+    if (hi == 0) return 0;
+    *kmin = lo;
+    *kmax = open ? OBJD_KEY_OPEN : hi;
+    return 1;
+}
+
+/* The horizontal offset of the origin from the eye, rotated into view axes (16.16,
+ * int64): z forward, x right. */
+static void origin_view(const obj_state *o, const view_xform *v, int64_t *vx, int64_t *vz)
+{
+    int64_t dx = (int64_t)o->x - v->cx, dy = (int64_t)o->y - v->cy; /* < 2^32 */
+    *vz = fx_asr64(dx * v->cos + dy * v->sin, FX_TRIG_SHIFT);
+    *vx = fx_asr64(dx * v->sin - dy * v->cos, FX_TRIG_SHIFT);
+}
+
+int objd_in_view(const scene *s, const obj_state *o, const view_xform *v)
+{
+    int64_t vx, vz, r = s->models[o->model].radius + FX_ONE; /* a unit for the rounding */
+    origin_view(o, v, &vx, &vz);
+    if (vz + r < 0) return 0;
+    /* left (z + x >= 0) and right (z - x >= 0): the distance from each is the sum
+     * over sqrt 2, so the cylinder is outside when the sum is below -r sqrt 2
+     * (1.4143 > sqrt 2: a little generous) */
+    if ((vz + vx) * 10000 < -r * 14143 || (vz - vx) * 10000 < -r * 14143) return 0;
+    return 1;
+}
+
+int32_t objd_depth(const obj_state *o, const view_xform *v)
+{
+    int64_t vx, vz;
+    origin_view(o, v, &vx, &vz);
+    return (int32_t)fx_asr64(vz, 16 - VIEW_SHIFT);
+}
+
+/* ---- faces -------------------------------------------------------------------------- */
+
+void objd_transform(const scene *s, const obj_state *o, const view_xform *v, view_pt out[SCN_MAX_MODEL_VERTS])
+{
+    const scn_model *m = &s->models[o->model];
+    fx_ang_t a = fx_ang_from_deg(o->yaw_deg);
+    int64_t c = fx_cos(a), sn = fx_sin(a);
+    for (uint32_t i = 0; i < m->num_verts && i < SCN_MAX_MODEL_VERTS; i++) {
+        const scn_mvert *mv = &s->mverts[m->first_vert + i];
+        /* model x forward, y left: yawed, |coordinate| < 2^26 raw times 2^30 */
+        int64_t wx = (int64_t)o->x + fx_asr64(mv->x * c - mv->y * sn, FX_TRIG_SHIFT);
+        int64_t wy = (int64_t)o->y + fx_asr64(mv->x * sn + mv->y * c, FX_TRIG_SHIFT);
+        int64_t dx = wx - v->cx, dy = wy - v->cy;
+        out[i].z = (int32_t)fx_asr64(dx * v->cos + dy * v->sin, 46 - VIEW_SHIFT);
+        out[i].x = (int32_t)fx_asr64(dx * v->sin - dy * v->cos, 46 - VIEW_SHIFT);
+        out[i].y = (int32_t)fx_asr64((int64_t)o->z + mv->z - v->cz, 16 - VIEW_SHIFT);
+    }
+}
+
+static uint64_t isqrt64(uint64_t v)
+{
+    uint64_t r = 0, bit = (uint64_t)1 << 62;
+    while (bit > v) bit >>= 2;
+    while (bit) {
+        if (v >= r + bit) {
+            v -= r + bit;
+            r = (r >> 1) + bit;
+        } else {
+            r >>= 1;
+        }
+        bit >>= 2;
+    }
+    return r;
+}
+
+int objd_face_plane(const scene *s, const scn_model *m, uint32_t f, const view_pt *verts, objd_plane *pl)
+{
+    const scn_face *fc = &s->faces[f];
+    const uint32_t *ix = &s->findex[fc->first_index];
+    int n = fc->num_index;
+    int64_t sx = 0, sy = 0, sz = 0;
+    for (int k = 0; k < n; k++) {
+        const view_pt *p = &verts[ix[k]];
+        sx += p->x;
+        sy += p->y;
+        sz += p->z;
+    }
+    int32_t cx = (int32_t)(sx / n), cy = (int32_t)(sy / n), cz = (int32_t)(sz / n);
+    /* Newell's sum about the centroid: offsets below 2^26.8 raw (a model spans at
+     * most 2 * 1024 sqrt 3 units), products below 2^53.6, 16 terms below 2^57.6.
+     * View space is left-handed (x right, y up, z forward), so for vertices running
+     * counter-clockwise seen from outside the sum points into the part. */
+    int64_t nx = 0, ny = 0, nz = 0;
+    (void)m;
+    for (int k = 0; k < n; k++) {
+        const view_pt *p = &verts[ix[k]], *q = &verts[ix[k + 1 == n ? 0 : k + 1]];
+        int64_t px = (int64_t)p->x - cx, py = (int64_t)p->y - cy, pz = (int64_t)p->z - cz;
+        int64_t qx = (int64_t)q->x - cx, qy = (int64_t)q->y - cy, qz = (int64_t)q->z - cz;
+        nx += (py - qy) * (pz + qz);
+        ny += (pz - qz) * (px + qx);
+        nz += (px - qx) * (py + qy);
+    }
+    if (!normalise(&nx, &ny, &nz)) return 0;
+    *pl = (objd_plane){(int32_t)nx, (int32_t)ny, (int32_t)nz, cx, cy, cz, 0};
+    /* the inward normal at the centroid: positive when the eye is outside. The
+     * normal's length is below 2^30.8, so beyond 2^31 eps no root is needed. */
+    int64_t d = dot(pl, cx, cy, cz);
+    if (d <= 0) return 0;
+    if (d <= ((int64_t)OBJ_BACKFACE_EPS << 31) &&
+        d <= (int64_t)isqrt64((uint64_t)(nx * nx + ny * ny + nz * nz)) * OBJ_BACKFACE_EPS)
+        return 0;
+    pl->d = d;
+    return 1;
+}
+
+int objd_face_screen(const scene *s, const scn_model *m, uint32_t f, const view_pt *verts, const view_xform *v,
+                     screen_pt out[CLIP_MAX_VERTS])
+{
+    const scn_face *fc = &s->faces[f];
+    const uint32_t *ix = &s->findex[fc->first_index];
+    clip_poly p;
+    (void)m;
+    p.n = fc->num_index;
+    /* counter-clockwise seen from outside runs counter-clockwise on screen too (as a
+     * floor does): reversed, it is the clockwise order the fill expects */
+    for (int k = 0; k < p.n; k++) p.v[k] = verts[ix[p.n - 1 - k]];
+    if (!clip_polygon(&p, v, CLIP_ALL)) return 0;
+    clip_project(v, &p, out);
+    return p.n;
+}

@@ -1,0 +1,102 @@
+/* obj_draw.h - moving objects on screen (prefix objd_): where an object is in the
+ * tree, its faces in view space and on screen, and the 1/z planes by which the
+ * span renderer sorts object faces against each other and against the world
+ * (docs/objects.md, "At run time"; Black Book ch. 67's span sorting: abutting
+ * surfaces by the tie rule below, intersecting ones by spans.c finding where
+ * along a line one overtakes the other).
+ *
+ * 1/z. Every plane a surface lies in is kept in view space as n . p = d, with
+ * the normal's largest component in [2^29, 2^30) and d > 0 (the eye, p = 0, is
+ * on the side n . p < d). Through the centre of pixel (px, py) that plane is at
+ *
+ *     1/z = (a px + b py + c) / (320 d)        (z in view units, 18.14 raw)
+ *     a = 2 nx,  b = -2 ny,  c = nx (1 - 320) + ny (199 + 2 look) + 320 nz
+ *
+ * an integer plane over the pixel centres with one integer denominator per
+ * surface. |a|, |b| < 2^31, |c| < 2^40.1, so the numerator M = a px + b py + c
+ * is below 2^41 anywhere on screen, and 0 < d < 2^61.5. Two surfaces are
+ * compared by the exact 128-bit cross products M1 d2 and M2 d1 (< 2^101.5):
+ * monotone in z from the near plane (z = 1/1024 unit, 1/z = 2^-4 per raw
+ * unit) to the far corner of the box (z ~ 92,682 units, 1/z ~ 2^-30.5), with no
+ * rounding at all in the comparison; what is left is the rounding of the
+ * geometry itself (vertices to 1/16384 unit). */
+#ifndef OBJ_DRAW_H
+#define OBJ_DRAW_H
+
+#include <stdint.h>
+#include "clip.h"
+#include "objects.h"
+#include "scene.h"
+#include "view.h"
+
+/* Back-face epsilon, view units (18.14 raw: 16 = 1/1024 map unit, the near
+ * plane's distance): a face whose plane passes within this distance of the eye,
+ * or behind it, is culled. Such a face is seen edge-on: on screen it is a sliver
+ * its neighbours border, and its plane, fitted to vertices rounded to 1/16384
+ * unit, says little about its depth. */
+#define OBJ_BACKFACE_EPS VIEW_ZNEAR
+
+/* Near-match epsilon of the 1/z sort, view units (16 raw = 1/1024 map unit):
+ * two surfaces whose depths at a pixel centre differ by less than this abut
+ * there (an object resting on a floor, against a wall, or on another object).
+ * The geometry's own rounding stays below 1/8192 unit, so abutting surfaces
+ * always tie, and surfaces this close cannot be told apart by depth anyway. */
+#define OBJ_TIE_EPS 16
+
+/* Key range of an object with some of its leaves unvisited (see objd_locate). */
+#define OBJD_KEY_OPEN 0xFFFFFFFEu
+
+typedef struct {
+    int32_t nx, ny, nz; /* normal, largest component in [2^29, 2^30) */
+    int32_t cx, cy, cz; /* object faces: the centroid of the face's vertices */
+    int64_t d;          /* n . p on the plane; > 0, or 0: no usable plane (edge-on through the eye) */
+} objd_plane;
+
+/* The plane of a floor or ceiling at height h (16.16) and of a wall along map
+ * points a -> b, as surfaces.c projects them. */
+void objd_plane_flat(const view_xform *v, int32_t h, objd_plane *p);
+void objd_plane_wall(const view_xform *v, const scn_vertex *a, const scn_vertex *b, objd_plane *p);
+
+/* Which of two surfaces is nearer at the centre of pixel (px, py) (clamped to the
+ * screen): 1 if s is in front of p. s_obj, p_obj: the surface is an object's face
+ * (its plane has a centroid). Depths within OBJ_TIE_EPS tie, and a tie goes to
+ * the side of the planes each surface lies on (a face whose centroid is on the
+ * eye's side of the other's plane is in front: it rests on it or against it);
+ * only faces lying in one plane fall back to Abrash's rule, the larger 1/z
+ * gradient along the scan line (then down it). A plane with d = 0 is in front. */
+int objd_front(const objd_plane *s, int s_obj, const objd_plane *p, int p_obj, int look, int px, int py);
+
+/* Sign (-1, 0, 1) of a b - c d for any int64 values, exactly, by the 32-bit
+ * partial products every 1/z comparison rests on (exported for its test). */
+int objd_sign_diff(int64_t a, int64_t b, int64_t c, int64_t d);
+
+/* The object's box (its model's radius around the origin) walked through the
+ * tree like collision's boxes. leaf_key[leaf] is the key the walk gave a visited
+ * leaf, 0 for one it did not visit. Returns 1 if some leaf the box touches was
+ * visited, with the smallest and largest of their keys; *kmax is OBJD_KEY_OPEN
+ * when the box also touches an unvisited leaf: a part there may lie behind a
+ * wall (one closing columns) that the walk reached after every visited leaf of
+ * the object, so world surfaces beyond kmin are all sorted by 1/z. */
+int objd_locate(const scene *s, const obj_state *o, const uint32_t *leaf_key, uint32_t *kmin, uint32_t *kmax);
+
+/* 0 if the object's bounding cylinder is wholly outside the near, left or right plane. */
+int objd_in_view(const scene *s, const obj_state *o, const view_xform *v);
+
+/* The view depth of the object's origin (view units), for painter's order. */
+int32_t objd_depth(const obj_state *o, const view_xform *v);
+
+/* The model's vertices, yawed and placed at the object's origin, in view space.
+ * Heights go through the same arithmetic as view_point's, so a vertex at a
+ * floor's height lies exactly in that floor's plane. */
+void objd_transform(const scene *s, const obj_state *o, const view_xform *v, view_pt out[SCN_MAX_MODEL_VERTS]);
+
+/* Face f (an index into s->faces) of model m, its vertices transformed: its
+ * plane, if it faces the eye by more than OBJ_BACKFACE_EPS (returns 1), else 0. */
+int objd_face_plane(const scene *s, const scn_model *m, uint32_t f, const view_pt *verts, objd_plane *pl);
+
+/* Face f clipped and projected: its screen vertices, clockwise, into out; returns
+ * their number, or 0 if nothing is left. */
+int objd_face_screen(const scene *s, const scn_model *m, uint32_t f, const view_pt *verts, const view_xform *v,
+                     screen_pt out[CLIP_MAX_VERTS]);
+
+#endif
