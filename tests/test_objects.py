@@ -381,3 +381,21 @@ def test_map01_things(at, angle, tmp_path):
     # the things as the reference reads them are the things the compiler placed
     for o, (model, x, y, z, yaw) in zip(j["objects"], refrender.object_states(MAP01, 0)):
         assert (o["x"], o["y"], o["z"]) == (x, y, z) and _yaw_diff(o["yaw"], yaw) == 0
+
+
+BATTLE = str(ROOT / "tests/scenes/battle.scene")
+
+
+@pytest.mark.parametrize("t", [0, 3000, 8000, 20000, 61000])
+@pytest.mark.parametrize("view", [("0,-900,500", "90", "0"), ("0,-1500", "90", "60"), ("-600,300,700", "-20", "-40")])
+def test_battle_demo(view, t, tmp_path):
+    """The space-battle demo: ships on their paths at time t, all independent of one another."""
+    at, angle, look = view
+    j, c = c_render(tmp_path, BATTLE, "--time", str(t), "--look", look, at=at, angle=angle)
+    assert j["overdraw"] == 1.0 and j["pixels_written"] == 64000
+    assert j["objects_visible"] >= 5
+    ref = reference_for(BATTLE, j)
+    same = float((c == ref).mean())
+    assert same >= 0.995, f"only {same:.4%} of pixels agree with the reference"
+    rows, _ = misplaced_object_pixels(c, ref)
+    assert rows.size == 0, f"{rows.size} object pixels where the reference has a nearer surface"
