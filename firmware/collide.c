@@ -78,22 +78,6 @@ static int sign_diff(int64_t a, int64_t b, int64_t c, int64_t d)
     return (hi | lo) ? 1 : 0;
 }
 
-static uint64_t isqrt64(uint64_t v)
-{
-    uint64_t r = 0, bit = (uint64_t)1 << 62;
-    while (bit > v) bit >>= 2;
-    while (bit) {
-        if (v >= r + bit) {
-            v -= r + bit;
-            r = (r >> 1) + bit;
-        } else {
-            r >>= 1;
-        }
-        bit >>= 2;
-    }
-    return r;
-}
-
 static int64_t min64(int64_t a, int64_t b) { return a < b ? a : b; }
 static int64_t max64(int64_t a, int64_t b) { return a > b ? a : b; }
 static int64_t clamp64(int64_t v, int64_t lo, int64_t hi) { return v < lo ? lo : (v > hi ? hi : v); }
@@ -144,12 +128,12 @@ static int64_t dist_seg(gpt p, gpt a, gpt b)
     int64_t abx = b.x - a.x, aby = b.y - a.y, apx = p.x - a.x, apy = p.y - a.y;
     int64_t t = abx * apx + aby * apy;
     int64_t l2 = abx * abx + aby * aby;
-    if (t <= 0) return (int64_t)isqrt64((uint64_t)(apx * apx + apy * apy));
+    if (t <= 0) return (int64_t)fx_isqrt64((uint64_t)(apx * apx + apy * apy));
     if (t >= l2) {
         int64_t bpx = p.x - b.x, bpy = p.y - b.y;
-        return (int64_t)isqrt64((uint64_t)(bpx * bpx + bpy * bpy));
+        return (int64_t)fx_isqrt64((uint64_t)(bpx * bpx + bpy * bpy));
     }
-    int64_t len = (int64_t)isqrt64((uint64_t)l2); /* >= 1: l2 > t > 0 */
+    int64_t len = (int64_t)fx_isqrt64((uint64_t)l2); /* >= 1: l2 > t > 0 */
     return (int64_t)(uabs64(abx * apy - aby * apx) / (uint64_t)len);
 }
 
@@ -190,7 +174,7 @@ static int unit_vec(int64_t vx, int64_t vy, int32_t *nx, int32_t *ny)
         m >>= 1;
     }
     /* |vx|, |vy| < 2^29: the square sum is below 2^59, its root at least max(|vx|, |vy|) */
-    int64_t len = (int64_t)isqrt64((uint64_t)(vx * vx + vy * vy));
+    int64_t len = (int64_t)fx_isqrt64((uint64_t)(vx * vx + vy * vy));
     *nx = (int32_t)(vx * ((int64_t)1 << UNIT_SHIFT) / len);
     *ny = (int32_t)(vy * ((int64_t)1 << UNIT_SHIFT) / len);
     return 1;
@@ -540,7 +524,7 @@ uint32_t col_move(const scene *s, const world_state *w, const col_body *body, fx
     /* sub-steps of at most min(radius, 16 units): |d| < 2^34 raw, so on the grid
      * the square sum is below 2^61 and n below 2^18; d * n < 2^52 */
     int64_t gx = fx_asr64(dx, G_SHIFT), gy = fx_asr64(dy, G_SHIFT);
-    int64_t len = (int64_t)isqrt64((uint64_t)(gx * gx + gy * gy));
+    int64_t len = (int64_t)fx_isqrt64((uint64_t)(gx * gx + gy * gy));
     int64_t sub = min64(m.rraw, SUB_MAX) >> G_SHIFT;
     int64_t n = (len + sub - 1) / sub;
     if (n == 0 && (dx || dy)) n = 1;

@@ -62,3 +62,19 @@ int32_t fx_cos(fx_ang_t a)
 {
     return fx_sin(a + 0x40000000u);
 }
+
+uint64_t fx_isqrt64(uint64_t v)
+{
+    uint64_t r = 0, bit = (uint64_t)1 << 62;
+    while (bit > v) bit >>= 2;
+    while (bit) {
+        if (v >= r + bit) {
+            v -= r + bit;
+            r = (r >> 1) + bit;
+        } else {
+            r >>= 1;
+        }
+        bit >>= 2;
+    }
+    return r;
+}

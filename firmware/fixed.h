@@ -72,6 +72,9 @@ static inline int64_t fx_mul64(int64_t a, int32_t b, unsigned s)
     return fx_asr64(a * (int64_t)b, s);
 }
 
+/* floor(sqrt(v)) for any 64-bit v (bit-by-bit, no division). */
+uint64_t fx_isqrt64(uint64_t v);
+
 /* Angles. fx_ang_from_deg takes degrees in 16.16 (any value: it wraps). */
 fx_ang_t fx_ang_from_deg(fx_t deg);
 /* sin/cos as 2.30 fixed point (1.0 = 1 << 30), from a quarter-wave table of

@@ -302,22 +302,6 @@ void objd_transform(const scene *s, const obj_state *o, const view_xform *v, vie
     }
 }
 
-static uint64_t isqrt64(uint64_t v)
-{
-    uint64_t r = 0, bit = (uint64_t)1 << 62;
-    while (bit > v) bit >>= 2;
-    while (bit) {
-        if (v >= r + bit) {
-            v -= r + bit;
-            r = (r >> 1) + bit;
-        } else {
-            r >>= 1;
-        }
-        bit >>= 2;
-    }
-    return r;
-}
-
 int objd_face_plane(const scene *s, const scn_model *m, uint32_t f, const view_pt *verts, objd_plane *pl)
 {
     const scn_face *fc = &s->faces[f];
@@ -352,7 +336,7 @@ int objd_face_plane(const scene *s, const scn_model *m, uint32_t f, const view_p
     int64_t d = dot(pl, cx, cy, cz);
     if (d <= 0) return 0;
     if (d <= ((int64_t)OBJ_BACKFACE_EPS << 31) &&
-        d <= (int64_t)isqrt64((uint64_t)(nx * nx + ny * ny + nz * nz)) * OBJ_BACKFACE_EPS)
+        d <= (int64_t)fx_isqrt64((uint64_t)(nx * nx + ny * ny + nz * nz)) * OBJ_BACKFACE_EPS)
         return 0;
     pl->d = d;
     return 1;
