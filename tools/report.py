@@ -94,7 +94,8 @@ def compiled(view, out_dir):
     if src is None:
         return bench.compiled(view["scene"], out_dir)
     out = out_dir / (Path(src).stem + ".bsc")
-    if not out.exists() or out.stat().st_mtime < Path(src).stat().st_mtime:
+    newest = max(Path(src).stat().st_mtime, (BUILD / "bspc").stat().st_mtime)  # a new compiler: a new blob
+    if not out.exists() or out.stat().st_mtime < newest:
         subprocess.run([str(BUILD / "bspc"), str(src), "-o", str(out)], check=True, capture_output=True)
     return out
 
