@@ -36,7 +36,7 @@ static inline int32_t rast_first_sample(int32_t v)
  *                the step (up to 2^-(RAST_STEP_BITS + 1) pixel) accumulates, up
  *                to 200 times that at the bottom of a full-height edge.
  * The default is the exact DDA. 16 bits moved no edge by more than a pixel over
- * the 211 views of make report, for 3.9% fewer instructions per frame (x86-64,
+ * the 211 views of make report, for 3.8% fewer instructions per frame (x86-64,
  * spans) and about 6% fewer on the Cortex-M3, but it decides exact ties (an edge
  * through a pixel centre, common from integer eye positions) off the fill rule:
  * from an eye on a vertex of the map's edge it left single pixels of a ceiling
