@@ -10,9 +10,10 @@
  * 2^27 in magnitude, a difference of two below 2^28, a product of two
  * differences below 2^56 and a cross or dot product below 2^57: all int64. A
  * squared distance compared with r^2 * |ab|^2 (up to 2^114) goes through the
- * exact 128-bit sign_diff(). Nothing here divides by a value that can be 0.
+ * exact 128-bit w128_sign_diff(). Nothing here divides by a value that can be 0.
  */
 #include "collide.h"
+#include "wide128.h"
 
 #define G_SHIFT 4                                        /* grid = 16.16 >> 4: 1/4096 unit */
 #define WORLD_RAW ((int64_t)SCN_COORD_MAX << FX_SHIFT)   /* positions are clamped to +-this */
@@ -34,49 +35,6 @@ typedef struct {
 typedef struct {
     int64_t x0, y0, x1, y1; /* 16.16, inclusive */
 } rbox;
-
-/* ------------------------------------------------------------ exact arithmetic */
-
-typedef struct {
-    uint64_t hi, lo; /* two's complement 128-bit */
-} w128;
-
-static uint64_t uabs64(int64_t a)
-{
-    return a < 0 ? (uint64_t)0 - (uint64_t)a : (uint64_t)a;
-}
-
-static w128 umul64(uint64_t a, uint64_t b)
-{
-    uint64_t al = a & 0xFFFFFFFFu, ah = a >> 32, bl = b & 0xFFFFFFFFu, bh = b >> 32;
-    uint64_t ll = al * bl, lh = al * bh, hl = ah * bl, hh = ah * bh;
-    uint64_t mid = (ll >> 32) + (lh & 0xFFFFFFFFu) + (hl & 0xFFFFFFFFu); /* < 3 * 2^32 */
-    w128 r;
-    r.lo = (ll & 0xFFFFFFFFu) | (mid << 32);
-    r.hi = hh + (lh >> 32) + (hl >> 32) + (mid >> 32);
-    return r;
-}
-
-static w128 smul64(int64_t a, int64_t b)
-{
-    w128 r = umul64(uabs64(a), uabs64(b));
-    if ((a < 0) != (b < 0)) {
-        r.lo = ~r.lo + 1u;
-        r.hi = ~r.hi + (r.lo == 0);
-    }
-    return r;
-}
-
-/* Sign (-1, 0, 1) of a*b - c*d, exact for any int64 operands (each product is
- * below 2^126 in magnitude, their difference below 2^127). */
-static int sign_diff(int64_t a, int64_t b, int64_t c, int64_t d)
-{
-    w128 x = smul64(a, b), y = smul64(c, d);
-    uint64_t lo = x.lo - y.lo;
-    uint64_t hi = x.hi - y.hi - (x.lo < y.lo);
-    if (hi >> 63) return -1;
-    return (hi | lo) ? 1 : 0;
-}
 
 static int64_t min64(int64_t a, int64_t b) { return a < b ? a : b; }
 static int64_t max64(int64_t a, int64_t b) { return a > b ? a : b; }
@@ -118,7 +76,7 @@ static int near_seg(gpt p, gpt a, gpt b, int64_t r, int64_t r2)
         return bpx * bpx + bpy * bpy < r2;
     }
     int64_t c = abx * apy - aby * apx;
-    return sign_diff(c, c, r2, l2) < 0; /* c^2 / l2 < r^2 */
+    return w128_sign_diff(c, c, r2, l2) < 0; /* c^2 / l2 < r^2 */
 }
 
 /* Distance from p to the closed segment ab in grid units, rounded down (for
@@ -134,7 +92,7 @@ static int64_t dist_seg(gpt p, gpt a, gpt b)
         return (int64_t)fx_isqrt64((uint64_t)(bpx * bpx + bpy * bpy));
     }
     int64_t len = (int64_t)fx_isqrt64((uint64_t)l2); /* >= 1: l2 > t > 0 */
-    return (int64_t)(uabs64(abx * apy - aby * apx) / (uint64_t)len);
+    return (int64_t)(w128_uabs(abx * apy - aby * apx) / (uint64_t)len);
 }
 
 /* 1 if the closed segments pq and ab share a point. */
@@ -161,7 +119,7 @@ static int sweep_near(gpt p, gpt q, gpt a, gpt b, int64_t r, int64_t r2)
 /* (vx, vy) scaled to length 2^30 (2.30); 0 for the zero vector. |v| < 2^62. */
 static int unit_vec(int64_t vx, int64_t vy, int32_t *nx, int32_t *ny)
 {
-    uint64_t m = uabs64(vx) > uabs64(vy) ? uabs64(vx) : uabs64(vy);
+    uint64_t m = w128_uabs(vx) > w128_uabs(vy) ? w128_uabs(vx) : w128_uabs(vy);
     if (m == 0) return 0;
     while (m < ((uint64_t)1 << 28)) {
         vx *= 2;
@@ -574,13 +532,13 @@ uint32_t col_move(const scene *s, const world_state *w, const col_body *body, fx
             if (into >= 0) break;
             rx -= fx_asr64(into * nx, UNIT_SHIFT);
             ry -= fx_asr64(into * ny, UNIT_SHIFT);
-            if (uabs64(rx) < MIN_SLIDE && uabs64(ry) < MIN_SLIDE) break;
+            if (w128_uabs(rx) < MIN_SLIDE && w128_uabs(ry) < MIN_SLIDE) break;
             rx += fx_asr64((int64_t)SKIN * nx, UNIT_SHIFT);
             ry += fx_asr64((int64_t)SKIN * ny, UNIT_SHIFT);
         }
         /* a piece that went nowhere (or nearly, twice) will do so again: stop */
         if (px == sx && py == sy) break;
-        if (uabs64(px - sx) < SKIN && uabs64(py - sy) < SKIN) {
+        if (w128_uabs(px - sx) < SKIN && w128_uabs(py - sy) < SKIN) {
             if (++stalls >= 2) break;
         } else {
             stalls = 0;
@@ -611,12 +569,12 @@ typedef struct {
 } sight_ck;
 
 /* Is the height z1 + (z2 - z1) * num / den (0 <= num <= den, den > 0) above hi
- * or below lo? |z1 - hi|, |z2 - z1| < 2^33 and den < 2^59: exact via sign_diff. */
+ * or below lo? |z1 - hi|, |z2 - z1| < 2^33 and den < 2^59: exact via w128_sign_diff. */
 static int z_outside(const sight_ck *c, int64_t num, int64_t den, int64_t lo, int64_t hi)
 {
     int64_t dz = c->z2 - c->z1;
-    if (sign_diff(c->z1 - hi, den, -dz, num) > 0) return 1; /* (z1-hi)*den + dz*num > 0 */
-    return sign_diff(c->z1 - lo, den, -dz, num) < 0;        /* (z1-lo)*den + dz*num < 0 */
+    if (w128_sign_diff(c->z1 - hi, den, -dz, num) > 0) return 1; /* (z1-hi)*den + dz*num > 0 */
+    return w128_sign_diff(c->z1 - lo, den, -dz, num) < 0;        /* (z1-lo)*den + dz*num < 0 */
 }
 
 static int sight_leaf(void *vctx, uint32_t leaf)

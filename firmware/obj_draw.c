@@ -9,6 +9,7 @@
  * with 2.30 sine and cosine), a view coordinate below 2^30.53 raw (18.14), and a
  * height difference below 33,790 units (2^31.04 raw 16.16). */
 #include "obj_draw.h"
+#include "wide128.h"
 
 _Static_assert(SCN_MAX_FACE_VERTS + 5 <= CLIP_MAX_VERTS, "a clipped face must fit a clip_poly");
 
@@ -17,77 +18,6 @@ _Static_assert(SCN_MAX_FACE_VERTS + 5 <= CLIP_MAX_VERTS, "a clipped face must fi
 #define SIDE_EPS ((int64_t)OBJ_TIE_EPS << 30) /* OBJ_TIE_EPS times a normal's length, about */
 #define TIE_FACTOR (320 / OBJ_TIE_EPS)        /* see objd_front */
 #define STACK_MAX (SCN_MAX_DEPTH + 2)
-
-/* ---- exact 128-bit products -------------------------------------------------- */
-
-typedef struct {
-    uint64_t hi, lo; /* two's complement */
-} w128;
-
-static uint64_t uabs(int64_t a)
-{
-    return a < 0 ? (uint64_t)0 - (uint64_t)a : (uint64_t)a;
-}
-
-static w128 w_neg(w128 a)
-{
-    w128 r;
-    r.lo = ~a.lo + 1u;
-    r.hi = ~a.hi + (r.lo == 0);
-    return r;
-}
-
-/* a * b for any int64 a, b (the magnitude is below 2^126), from 32-bit parts:
- * what a 32-bit core does, and the definition the 128-bit type below must match. */
-static w128 w_mul_parts(int64_t a, int64_t b)
-{
-    uint64_t x = uabs(a), y = uabs(b);
-    uint64_t xl = x & 0xFFFFFFFFu, xh = x >> 32, yl = y & 0xFFFFFFFFu, yh = y >> 32;
-    uint64_t ll = xl * yl, lh = xl * yh, hl = xh * yl, hh = xh * yh;
-    uint64_t mid = (ll >> 32) + (lh & 0xFFFFFFFFu) + (hl & 0xFFFFFFFFu);
-    w128 r;
-    r.lo = (ll & 0xFFFFFFFFu) | (mid << 32);
-    r.hi = hh + (lh >> 32) + (hl >> 32) + (mid >> 32);
-    return ((a < 0) != (b < 0)) ? w_neg(r) : r;
-}
-
-static w128 w_mul(int64_t a, int64_t b)
-{
-#if defined(__SIZEOF_INT128__)
-    /* a 64-bit host multiplies in one instruction; the result is the same */
-    __extension__ typedef __int128 i128;
-    __extension__ typedef unsigned __int128 u128;
-    u128 p = (u128)((i128)a * b);
-    w128 r = {(uint64_t)(p >> 64), (uint64_t)p};
-    return r;
-#else
-    return w_mul_parts(a, b);
-#endif
-}
-
-static w128 w_sub(w128 a, w128 b)
-{
-    w128 r;
-    r.lo = a.lo - b.lo;
-    r.hi = a.hi - b.hi - (a.lo < b.lo);
-    return r;
-}
-
-static int w_sign(w128 a)
-{
-    if (a.hi >> 63) return -1;
-    return (a.hi | a.lo) ? 1 : 0;
-}
-
-static int sign_diff(int64_t a, int64_t b, int64_t c, int64_t d)
-{
-    return w_sign(w_sub(w_mul(a, b), w_mul(c, d)));
-}
-
-int objd_sign_diff(int64_t a, int64_t b, int64_t c, int64_t d)
-{
-    return w_sign(w_sub(w_mul_parts(a, b), w_mul_parts(c, d)));
-}
 
 /* Bits below the leading one, plus one (0 for 0). */
 static int bits(uint64_t v)
@@ -101,7 +31,7 @@ static int bits(uint64_t v)
  * the zero vector. */
 static int normalise(int64_t *x, int64_t *y, int64_t *z)
 {
-    uint64_t m = uabs(*x) | uabs(*y) | uabs(*z); /* the same leading bit as the largest */
+    uint64_t m = w128_uabs(*x) | w128_uabs(*y) | w128_uabs(*z); /* the same leading bit as the largest */
     if (m == 0) return 0;
     int top = 63 - __builtin_clzll(m); /* the largest component's leading bit: wanted at 29 */
     if (top > 29) {
@@ -172,10 +102,10 @@ int objd_front(const objd_plane *s, int s_obj, const objd_plane *p, int p_obj, i
     int64_t ms = numerator(s, look, px, py), mp = numerator(p, look, px, py);
     /* 1/z_s - 1/z_p = (ms dp - mp ds) / (320 ds dp); the depths differ by less than
      * OBJ_TIE_EPS when 320 |ms dp - mp ds| < OBJ_TIE_EPS ms mp (both in front of the eye) */
-    w128 diff = w_sub(w_mul(ms, p->d), w_mul(mp, s->d)); /* < 2^102.5 */
-    int sg = w_sign(diff);
+    w128 diff = w128_sub(w128_mul(ms, p->d), w128_mul(mp, s->d)); /* < 2^102.5 */
+    int sg = w128_sign(diff);
     if (ms > 0 && mp > 0) {
-        w128 mag = sg < 0 ? w_neg(diff) : diff;
+        w128 mag = sg < 0 ? w128_neg(diff) : diff;
         /* 20 mag >= 2^(bits(mag) + 3) and ms mp < 2^(bits(ms) + bits(mp)): most pairs
          * are told apart by their lengths alone */
         int mb = mag.hi ? 64 + bits(mag.hi) : bits(mag.lo);
@@ -183,7 +113,7 @@ int objd_front(const objd_plane *s, int s_obj, const objd_plane *p, int p_obj, i
         /* mag * TIE_FACTOR (< 2^107) by 32-bit parts, against ms mp (< 2^80.2) */
         uint64_t l0 = (mag.lo & 0xFFFFFFFFu) * TIE_FACTOR, l1 = (mag.lo >> 32) * TIE_FACTOR + (l0 >> 32);
         w128 scaled = {mag.hi * TIE_FACTOR + (l1 >> 32), (l1 << 32) | (l0 & 0xFFFFFFFFu)};
-        if (w_sign(w_sub(scaled, w_mul(ms, mp))) >= 0) return sg > 0;
+        if (w128_sign(w128_sub(scaled, w128_mul(ms, mp))) >= 0) return sg > 0;
     } else {
         return sg > 0;
     }
@@ -197,9 +127,9 @@ int objd_front(const objd_plane *s, int s_obj, const objd_plane *p, int p_obj, i
         if (b) return b < 0;
     }
     /* in one plane: the one nearing the eye faster along the line, then down it */
-    int g = sign_diff(s->nx, p->d, p->nx, s->d);
+    int g = w128_sign_diff(s->nx, p->d, p->nx, s->d);
     if (g) return g > 0;
-    return sign_diff(p->ny, s->d, s->ny, p->d) > 0;
+    return w128_sign_diff(p->ny, s->d, s->ny, p->d) > 0;
 }
 
 /* ---- the object in the tree ------------------------------------------------------ */
@@ -238,7 +168,7 @@ int objd_locate(const scene *s, const obj_state *o, const uint32_t *leaf_key, ui
              * bits move a product by less than |dx| + |dy|): offsets below 2^32.03
              * raw shifted by 3, times a direction below 2^31: < 2^60.03. The
              * largest and the smallest come from the corners the signs pick. */
-            int64_t slack = (int64_t)uabs(nd->dx) + (int64_t)uabs(nd->dy);
+            int64_t slack = (int64_t)w128_uabs(nd->dx) + (int64_t)w128_uabs(nd->dy);
             int64_t ylo = fx_asr64((nd->dx > 0 ? y0 : y1) - nd->y, 3), yhi = fx_asr64((nd->dx > 0 ? y1 : y0) - nd->y, 3);
             int64_t xlo = fx_asr64((nd->dy > 0 ? x1 : x0) - nd->x, 3), xhi = fx_asr64((nd->dy > 0 ? x0 : x1) - nd->x, 3);
             int64_t least = (int64_t)nd->dx * ylo - (int64_t)nd->dy * xlo;

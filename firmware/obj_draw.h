@@ -66,10 +66,6 @@ void objd_plane_wall(const view_xform *v, const scn_vertex *a, const scn_vertex 
  * gradient along the scan line (then down it). A plane with d = 0 is in front. */
 int objd_front(const objd_plane *s, int s_obj, const objd_plane *p, int p_obj, int look, int px, int py);
 
-/* Sign (-1, 0, 1) of a b - c d for any int64 values, exactly, by the 32-bit
- * partial products every 1/z comparison rests on (exported for its test). */
-int objd_sign_diff(int64_t a, int64_t b, int64_t c, int64_t d);
-
 /* The object's box (its model's radius around the origin) walked through the
  * tree like collision's boxes. leaf_key[leaf] is the key the walk gave a visited
  * leaf, 0 for one it did not visit. Returns 1 if some leaf the box touches was
