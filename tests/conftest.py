@@ -70,6 +70,18 @@ def read_png_indexed(path):
     return width, height, b"".join(rows), palette
 
 
+def write_pwad_map(path, things, linedefs, sidedefs, vertexes, sectors):
+    """Write a PWAD holding one Doom-format map, MAP01, from its lumps' bytes."""
+    lumps = [(b"MAP01", b""), (b"THINGS", things), (b"LINEDEFS", linedefs), (b"SIDEDEFS", sidedefs),
+             (b"VERTEXES", vertexes), (b"SECTORS", sectors)]
+    body, directory, pos = b"", b"", 12
+    for name, data in lumps:
+        directory += struct.pack("<II8s", pos, len(data), name)
+        body += data
+        pos += len(data)
+    Path(path).write_bytes(b"PWAD" + struct.pack("<II", len(lumps), pos) + body + directory)
+
+
 def freedoom(name):
     path = WADDIR / name
     if not path.exists():

@@ -3,7 +3,7 @@ import json
 
 import pytest
 
-from conftest import ROOT, freedoom, program, run
+from conftest import ROOT, freedoom, program, run, write_pwad_map
 
 MAPS = [f"freedoom1.wad:E{e}M{m}" for e in range(1, 5) for m in range(1, 10)] + \
        [f"freedoom2.wad:MAP{m:02d}" for m in range(1, 33)]
@@ -98,14 +98,7 @@ def wad_room(path, x0, y0, x1, y1, floor, ceil):
     sectors = struct.pack("<hh8s8shhh", floor, ceil, b"FLOOR4_8", b"CEIL3_5", 160, 0, 0)
     things = struct.pack("<hhhHH", (x0 + x1) // 2, (y0 + y1) // 2, 0, 1, 7)
     vertexes = b"".join(struct.pack("<hh", x, y) for x, y in verts)
-    lumps = [(b"MAP01", b""), (b"THINGS", things), (b"LINEDEFS", linedefs), (b"SIDEDEFS", sides),
-             (b"VERTEXES", vertexes), (b"SECTORS", sectors)]
-    body, directory, pos = b"", b"", 12
-    for name, data in lumps:
-        directory += struct.pack("<II8s", pos, len(data), name)
-        body += data
-        pos += len(data)
-    path.write_bytes(b"PWAD" + struct.pack("<II", len(lumps), pos) + body + directory)
+    write_pwad_map(path, things, linedefs, sides, vertexes, sectors)
 
 
 @pytest.mark.parametrize("room, message", [

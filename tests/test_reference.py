@@ -13,7 +13,7 @@ import sys
 import numpy as np
 import pytest
 
-from conftest import ROOT, freedoom, program, run
+from conftest import ROOT, freedoom, program, run, write_pwad_map
 
 sys.path.insert(0, str(ROOT / "tools"))
 import accuracy  # noqa: E402
@@ -219,14 +219,7 @@ def make_wad(path, things=None):
         struct.pack("<hh8s8shhh", 32, 96, b"FLOOR4_8", b"CEIL3_5", 160, 0, 0)
     things = struct.pack("<hhhHH", 64, 128, 0, 1, 7) + (things or b"")
     vertexes = b"".join(struct.pack("<hh", x, y) for x, y in verts)
-    lumps = [(b"MAP01", b""), (b"THINGS", things), (b"LINEDEFS", linedefs), (b"SIDEDEFS", sides),
-             (b"VERTEXES", vertexes), (b"SECTORS", sectors)]
-    body, directory, pos = b"", b"", 12
-    for name, data in lumps:
-        directory += struct.pack("<II8s", pos, len(data), name)
-        body += data
-        pos += len(data)
-    path.write_bytes(b"PWAD" + struct.pack("<II", len(lumps), pos) + body + directory)
+    write_pwad_map(path, things, linedefs, sides, vertexes, sectors)
 
 
 def test_hand_made_wad_numbering(tmp_path):
