@@ -844,13 +844,6 @@ def write_ids(path, ids):
     np.ascontiguousarray(ids, dtype="<u4").tofile(path)
 
 
-def read_ids(path):
-    a = np.fromfile(path, dtype="<u4")
-    if a.size != W * H:
-        raise ValueError(f"{path}: {a.size * 4} bytes, expected {W * H * 4} (320x200 uint32)")
-    return a.reshape(H, W).astype(np.uint32)
-
-
 def false_colour(ids):
     """RGB (200, 320, 3) uint8: black for nothing, walls bright, floors dark, ceilings mid;
     the hue is a hash of the id, so neighbouring surfaces differ."""
