@@ -70,6 +70,14 @@ static void bad(fl_decoder *d, fl_reason why)
     emit(d, &ev);
 }
 
+/* A message that passed every check; the first after bad ones is a resync. */
+static void good(fl_decoder *d)
+{
+    d->count.msgs_ok++;
+    if (d->last_bad) d->count.resyncs++;
+    d->last_bad = 0;
+}
+
 static void frame_msg(fl_decoder *d, const fl_msg *m)
 {
     int key = m->type == FL_MSG_KEYFRAME;
@@ -91,9 +99,7 @@ static void frame_msg(fl_decoder *d, const fl_msg *m)
         bad(d, FL_R_PAYLOAD);
         return;
     }
-    d->count.msgs_ok++;
-    if (d->last_bad) d->count.resyncs++;
-    d->last_bad = 0;
+    good(d);
 
     /* frame numbers never seen (lost in damaged messages) */
     if (d->have_seen && (int32_t)(m->frame_no - d->seen_no) > 0) d->count.frames_missed += m->frame_no - d->seen_no - 1;
@@ -165,9 +171,7 @@ static void message(fl_decoder *d, const uint8_t *buf, uint32_t len)
     switch (m.type) {
     case FL_MSG_HELLO:
         if (m.len != HELLO_BYTES) break;
-        d->count.msgs_ok++;
-        if (d->last_bad) d->count.resyncs++;
-        d->last_bad = 0;
+        good(d);
         d->count.hellos++;
         d->hello.version = m.payload[0];
         d->hello.width = (uint16_t)fl_get16(m.payload + 1);
@@ -190,9 +194,7 @@ static void message(fl_decoder *d, const uint8_t *buf, uint32_t len)
         return;
     case FL_MSG_PALETTE:
         if (m.len != FL_PALETTE_BYTES) break;
-        d->count.msgs_ok++;
-        if (d->last_bad) d->count.resyncs++;
-        d->last_bad = 0;
+        good(d);
         d->count.palettes++;
         for (uint32_t i = 0; i < FL_PALETTE_BYTES; i++) d->palette[i] = m.payload[i];
         d->have_palette = 1;
@@ -209,9 +211,7 @@ static void message(fl_decoder *d, const uint8_t *buf, uint32_t len)
     case FL_MSG_ACK:
     case FL_MSG_KEYREQ:
         if (m.len != BACK_BYTES) break;
-        d->count.msgs_ok++;
-        if (d->last_bad) d->count.resyncs++;
-        d->last_bad = 0;
+        good(d);
         event0(&ev, FL_EV_OTHER);
         ev.type = m.type;
         ev.frame_no = m.frame_no;
