@@ -46,8 +46,8 @@ static int cull_box(const int32_t box[4], const view_xform *v, const walk_plane 
 void walk_tree(const scene *s, const view_xform *v, walk_order order, walk_visit visit, void *ctx,
                const occ_columns *occ, walk_stats *st)
 {
-    uint32_t stack[SCN_MAX_DEPTH + 2];
-    uint8_t masks[SCN_MAX_DEPTH + 2];
+    uint32_t stack[CFG_MAX_DEPTH + 2];
+    uint8_t masks[CFG_MAX_DEPTH + 2];
     walk_plane planes[3];
     int sp = 0;
     walk_stats local = {0, 0};
@@ -85,7 +85,7 @@ void walk_tree(const scene *s, const view_xform *v, walk_order order, walk_visit
                 st->boxes_hidden++;
             }
         }
-        if (sp + 2 > SCN_MAX_DEPTH + 2) return; /* unreachable for a validated scene */
+        if (sp + 2 > CFG_MAX_DEPTH + 2) return; /* unreachable for a validated scene */
         if (m2 >= 0) {
             stack[sp] = node->child[second];
             masks[sp++] = (uint8_t)m2;

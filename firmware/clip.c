@@ -10,8 +10,8 @@ int64_t clip_distance(const view_xform *v, view_pt p, unsigned plane)
     case CLIP_NEAR: return (int64_t)p.z - VIEW_ZNEAR;
     case CLIP_LEFT: return (int64_t)p.z + p.x;
     case CLIP_RIGHT: return (int64_t)p.z - p.x;
-    case CLIP_TOP: return (int64_t)(VIEW_CY + v->look) * p.z - (int64_t)VIEW_FOCAL * p.y;
-    default: return (int64_t)(VIEW_CY - v->look) * p.z + (int64_t)VIEW_FOCAL * p.y;
+    case CLIP_TOP: return (int64_t)(VIEW_CY + VIEW_LOOK(v)) * p.z - (int64_t)VIEW_FOCAL * p.y;
+    default: return (int64_t)(VIEW_CY - VIEW_LOOK(v)) * p.z + (int64_t)VIEW_FOCAL * p.y;
     }
 }
 
@@ -45,6 +45,7 @@ static int clip_plane(clip_poly *p, const view_xform *v, unsigned plane)
         inside += d[i] >= 0;
     }
     if (inside == n) return n;
+    p->cut |= plane;
     if (inside == 0) return p->n = 0;
     for (int i = 0; i < n && m < CLIP_MAX_VERTS - 1; i++) {
         int j = (i + 1 == n) ? 0 : i + 1;
@@ -69,6 +70,8 @@ int clip_polygon(clip_poly *p, const view_xform *v, unsigned mask)
 {
     if (p->n > CLIP_MAX_VERTS - 5 || p->n < 0) p->n = 0; /* caller broke the contract: draw nothing */
     for (int i = 0; i < p->n; i++) p->on[i] = 0;
+    p->cut = 0;
+    if (!CFG_YCLIP) mask &= ~(unsigned)(CLIP_TOP | CLIP_BOTTOM);
     for (unsigned plane = 1; plane <= CLIP_BOTTOM && p->n >= 3; plane <<= 1)
         if (mask & plane) clip_plane(p, v, plane);
     return p->n >= 3 ? p->n : 0;

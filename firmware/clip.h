@@ -5,6 +5,7 @@
 #ifndef CLIP_H
 #define CLIP_H
 
+#include "build_config.h"
 #include "scene_format.h"
 #include "view.h"
 
@@ -17,16 +18,19 @@ enum {
     CLIP_ALL = 31u
 };
 
-#define CLIP_MAX_VERTS (SCN_MAX_LEAF_VERTS + 5) /* clipping adds at most one vertex per plane */
+#define CLIP_MAX_VERTS (CFG_POLY_VERTS + 5) /* clipping adds at most one vertex per plane */
 
 typedef struct {
     int n;
     view_pt v[CLIP_MAX_VERTS];
     uint8_t on[CLIP_MAX_VERTS]; /* CLIP_* planes the vertex lies on by construction */
+    unsigned cut;               /* CLIP_* planes that cut it (set by clip_polygon) */
 } clip_poly;
 
 /* Clip p in place against the planes in mask; returns the vertices left (0 if none).
- * The caller fills n and v; on[] is set here. */
+ * A plane with every vertex inside costs one distance per vertex and nothing
+ * more. The caller fills n and v; on[] and cut are set here. A build without
+ * y-clipping (build_config.h) leaves the top and bottom planes out of mask. */
 int clip_polygon(clip_poly *p, const view_xform *v, unsigned mask);
 
 /* Project the clipped polygon to the screen. A vertex made by clipping against a

@@ -24,7 +24,7 @@
 #define SKIN (FX_ONE / 64)                               /* a slide leaves the wall by this */
 #define MIN_SLIDE (FX_ONE / 256)                         /* shorter slides are dropped */
 #define UNIT_SHIFT 30                                    /* unit normals are 2.30 */
-#define STACK_MAX (SCN_MAX_DEPTH + 2)                    /* box walk: one sibling per level + 1 */
+#define STACK_MAX (CFG_MAX_DEPTH + 2)                    /* box walk: one sibling per level + 1 */
 #define CAND_MAX 128                                     /* candidate segs kept per move piece */
 #define HUGE_H ((int64_t)1 << 40)                        /* "no ceiling" (heights are < 2^31) */
 
@@ -191,7 +191,7 @@ static int line_meets(const int32_t bb[4], gpt p, gpt q)
 
 /* Visit every leaf under a node box that overlaps b (and, with line, that the
  * line through line[0], line[1] meets). The explicit stack holds at most one
- * pending sibling per level of the validated tree (depth <= SCN_MAX_DEPTH) plus
+ * pending sibling per level of the validated tree (depth <= CFG_MAX_DEPTH) plus
  * the node in hand. Returns 1 if fn stopped the walk. */
 static int walk_leaves(const scene *s, const rbox *b, const gpt *line, leaf_fn fn, void *ctx)
 {
@@ -306,7 +306,7 @@ typedef struct {
 /* Does a wall block a body standing on floor z? */
 static int wall_blocks(const mover *m, const scn_line *ln, int64_t z)
 {
-    if (ln->sector[1] == SCN_NONE) return 1;
+    if (!CFG_TWO_SIDED || ln->sector[1] == SCN_NONE) return 1;
     const scn_sector *f = &m->s->sectors[ln->sector[0]], *b = &m->s->sectors[ln->sector[1]];
     int64_t fl = max64(f->floor_h, b->floor_h);
     int64_t ce = min64(obj_ceil(m->w, m->s, ln->sector[0]), obj_ceil(m->w, m->s, ln->sector[1]));
@@ -590,7 +590,7 @@ static int sight_leaf(void *vctx, uint32_t leaf)
             continue;
         if (!seg_cross(c->p, c->q, a, b)) continue;
         const scn_line *ln = &s->lines[g->line];
-        if (ln->sector[1] == SCN_NONE) return 1;
+        if (!CFG_TWO_SIDED || ln->sector[1] == SCN_NONE) return 1;
         const scn_sector *f = &s->sectors[ln->sector[0]], *k = &s->sectors[ln->sector[1]];
         int64_t lo = max64(f->floor_h, k->floor_h);
         int64_t hi = min64(obj_ceil(c->w, s, ln->sector[0]), obj_ceil(c->w, s, ln->sector[1]));

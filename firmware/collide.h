@@ -80,7 +80,7 @@ col_body col_player(void);
  * Cost: a box walk of the tree and one pass over the candidate segs per
  * sub-step, about 15 passes when a sub-step is blocked (the cut to 1/4096 and
  * the slide). Stack: under 3 KB on a Cortex-M3 (gcc -fstack-usage: 128
- * candidate seg indices, a tree-walk stack of SCN_MAX_DEPTH + 2 entries). */
+ * candidate seg indices, a tree-walk stack of CFG_MAX_DEPTH + 2 entries). */
 uint32_t col_move(const scene *s, const world_state *w, const col_body *body, fx_t *x, fx_t *y, fx_t *floor_z,
                   int64_t dx, int64_t dy);
 

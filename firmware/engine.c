@@ -49,7 +49,7 @@ int eng_set_work(engine *e, void *mem, uint32_t bytes)
 
 static const world_state *world_of(const engine *e)
 {
-    return e->world.ceil ? &e->world : 0;
+    return (e->world.ceil || e->world.objs) ? &e->world : 0;
 }
 
 void eng_render(engine *e, uint32_t *ids)
@@ -67,7 +67,7 @@ void eng_step(engine *e, uint32_t input, uint32_t dt_ms)
     if (input & HAL_KEY_NEXT_PRESENT) e->present = (hal_present_mode)((e->present + 1) % HAL_PRESENT_COUNT);
     cam_move(&e->cam, &e->sc, world_of(e), input, dt_ms);
     e->t_ms += dt_ms; /* wraps after 49.7 days (a jump along the paths; doors only see dt) */
-    if (e->world.ceil) obj_update(&e->world, &e->sc, e->t_ms, dt_ms, e->cam.view.x, e->cam.view.y);
+    if (world_of(e)) obj_update(&e->world, &e->sc, e->t_ms, dt_ms, e->cam.view.x, e->cam.view.y);
     eng_render(e, 0);
     hal_frame_done();
 }

@@ -8,7 +8,7 @@
  * bound of a line counts as on it, which only ever takes in one leaf more. */
 #include "eye.h"
 
-#define EYE_STACK (SCN_MAX_DEPTH + 2)
+#define EYE_STACK (CFG_MAX_DEPTH + 2)
 
 static int64_t abs64(int64_t v) { return v < 0 ? -v : v; }
 

@@ -17,7 +17,7 @@ _Static_assert(SCN_MAX_FACE_VERTS + 5 <= CLIP_MAX_VERTS, "a clipped face must fi
 #define NORM_HI ((int64_t)1 << 30)
 #define SIDE_EPS ((int64_t)OBJ_TIE_EPS << 30) /* OBJ_TIE_EPS times a normal's length, about */
 #define TIE_FACTOR (320 / OBJ_TIE_EPS)        /* see objd_front */
-#define STACK_MAX (SCN_MAX_DEPTH + 2)
+#define STACK_MAX (CFG_MAX_DEPTH + 2)
 
 /* Bits below the leading one, plus one (0 for 0). */
 static int bits(uint64_t v)
@@ -215,12 +215,12 @@ int32_t objd_depth(const obj_state *o, const view_xform *v)
 
 /* ---- faces -------------------------------------------------------------------------- */
 
-void objd_transform(const scene *s, const obj_state *o, const view_xform *v, view_pt out[SCN_MAX_MODEL_VERTS])
+void objd_transform(const scene *s, const obj_state *o, const view_xform *v, view_pt out[CFG_MODEL_VERTS])
 {
     const scn_model *m = &s->models[o->model];
     fx_ang_t a = fx_ang_from_deg(o->yaw_deg);
     int64_t c = fx_cos(a), sn = fx_sin(a);
-    for (uint32_t i = 0; i < m->num_verts && i < SCN_MAX_MODEL_VERTS; i++) {
+    for (uint32_t i = 0; i < m->num_verts && i < CFG_MODEL_VERTS; i++) {
         const scn_mvert *mv = &s->mverts[m->first_vert + i];
         /* model x forward, y left: yawed, |coordinate| < 2^26 raw times 2^30 */
         int64_t wx = (int64_t)o->x + fx_asr64(mv->x * c - mv->y * sn, FX_TRIG_SHIFT);
@@ -280,6 +280,7 @@ int objd_face_screen(const scene *s, const scn_model *m, uint32_t f, const view_
     clip_poly p;
     (void)m;
     p.n = fc->num_index;
+    if (p.n > CLIP_MAX_VERTS - 5) return 0; /* the loader refuses such a face for this build */
     /* counter-clockwise seen from outside runs counter-clockwise on screen too (as a
      * floor does): reversed, it is the clockwise order the fill expects */
     for (int k = 0; k < p.n; k++) p.v[k] = verts[ix[p.n - 1 - k]];

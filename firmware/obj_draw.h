@@ -84,7 +84,7 @@ int32_t objd_depth(const obj_state *o, const view_xform *v);
 /* The model's vertices, yawed and placed at the object's origin, in view space.
  * Heights go through the same arithmetic as view_point's, so a vertex at a
  * floor's height lies exactly in that floor's plane. */
-void objd_transform(const scene *s, const obj_state *o, const view_xform *v, view_pt out[SCN_MAX_MODEL_VERTS]);
+void objd_transform(const scene *s, const obj_state *o, const view_xform *v, view_pt out[CFG_MODEL_VERTS]);
 
 /* Face f (an index into s->faces) of model m, its vertices transformed: its
  * plane, if it faces the eye by more than OBJ_BACKFACE_EPS (returns 1), else 0. */

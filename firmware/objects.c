@@ -20,9 +20,11 @@ static uint32_t align8(uint64_t n)
 
 uint32_t obj_state_bytes(const scene *s)
 {
-    /* at most 4096 objects and far fewer sectors than 2^26: no overflow */
-    return align8((uint64_t)s->nobjects * sizeof(obj_state)) + align8((uint64_t)s->nsectors * sizeof(fx_t)) +
-           align8((uint64_t)s->nsectors * sizeof(obj_door));
+    /* at most 4096 objects and far fewer sectors than 2^26: no overflow. A build
+     * without objects or without doors keeps no state for them. */
+    return (CFG_OBJECTS ? align8((uint64_t)s->nobjects * sizeof(obj_state)) : 0) +
+           (CFG_DOORS ? align8((uint64_t)s->nsectors * sizeof(fx_t)) + align8((uint64_t)s->nsectors * sizeof(obj_door))
+                      : 0);
 }
 
 static int64_t floor_div(int64_t a, int64_t b)
@@ -72,16 +74,21 @@ int obj_init(world_state *w, const scene *s, void *mem, uint32_t bytes)
 {
     if (!mem || bytes < obj_state_bytes(s)) return -1;
     uint8_t *p = mem;
-    w->objs = (obj_state *)(void *)p;
-    p += align8((uint64_t)s->nobjects * sizeof(obj_state));
-    w->ceil = (fx_t *)(void *)p;
-    p += align8((uint64_t)s->nsectors * sizeof(fx_t));
-    w->doors = (obj_door *)(void *)p;
-    w->n = s->nobjects;
-    for (uint32_t i = 0; i < s->nobjects; i++) place(&w->objs[i], &s->objects[i], 0);
-    for (uint32_t i = 0; i < s->nsectors; i++) {
-        w->ceil[i] = s->sectors[i].ceil_h;
-        w->doors[i] = (obj_door){0, 0, 0};
+    *w = (world_state){0, 0, 0, 0};
+    if (CFG_OBJECTS) {
+        w->objs = (obj_state *)(void *)p;
+        p += align8((uint64_t)s->nobjects * sizeof(obj_state));
+        w->n = s->nobjects;
+        for (uint32_t i = 0; i < s->nobjects; i++) place(&w->objs[i], &s->objects[i], 0);
+    }
+    if (CFG_DOORS) {
+        w->ceil = (fx_t *)(void *)p;
+        p += align8((uint64_t)s->nsectors * sizeof(fx_t));
+        w->doors = (obj_door *)(void *)p;
+        for (uint32_t i = 0; i < s->nsectors; i++) {
+            w->ceil[i] = s->sectors[i].ceil_h;
+            w->doors[i] = (obj_door){0, 0, 0};
+        }
     }
     return 0;
 }
@@ -150,9 +157,9 @@ void obj_update(world_state *w, const scene *s, uint32_t t_ms, uint32_t dt_ms, f
 {
     if (!w) return;
     uint32_t n = w->n < s->nobjects ? w->n : s->nobjects;
-    if (w->objs)
+    if (CFG_OBJECTS && w->objs)
         for (uint32_t i = 0; i < n; i++) place(&w->objs[i], &s->objects[i], t_ms);
-    if (!w->ceil || !w->doors) return;
+    if (!CFG_DOORS || !w->ceil || !w->doors) return;
     /* which doors the player triggers: its sector, and every wall of a door within reach */
     uint32_t under = scene_sector_at(s, px, py);
     int64_t gx = fx_asr64(px, GRID_SHIFT), gy = fx_asr64(py, GRID_SHIFT);

@@ -6,6 +6,7 @@
 #define OBJECTS_H
 
 #include <stdint.h>
+#include "build_config.h"
 #include "fixed.h"
 #include "scene.h"
 
@@ -63,7 +64,7 @@ void obj_update(world_state *w, const scene *s, uint32_t t_ms, uint32_t dt_ms, f
 /* The ceiling of sector i now (the compiled one when w or w->ceil is NULL). */
 static inline fx_t obj_ceil(const world_state *w, const scene *s, uint32_t i)
 {
-    return (w && w->ceil) ? w->ceil[i] : s->sectors[i].ceil_h;
+    return (CFG_DOORS && w && w->ceil) ? w->ceil[i] : s->sectors[i].ceil_h;
 }
 
 #endif

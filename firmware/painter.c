@@ -40,7 +40,7 @@ typedef struct {
 uint32_t painter_work_bytes(const scene *s, const world_state *w)
 {
     /* the leaves' keys, then the order and a merge buffer: 2 * 4096 * 12 bytes at most */
-    uint32_t n = (w && w->objs) ? w->n : 0;
+    uint32_t n = (CFG_OBJECTS && w && w->objs) ? w->n : 0;
     if (!n) return 0;
     return (uint32_t)((uint64_t)s->nleaves * sizeof(uint32_t) + 2u * (uint64_t)n * sizeof(pt_order));
 }
@@ -67,7 +67,7 @@ static int draw_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
 {
     painter *p = ctx;
     surf_leaf(p->sc, p->w, p->v, leaf, clip_mask, &p->sink, 0, p->st);
-    if (p->leaf_key) {
+    if (CFG_OBJECTS && p->leaf_key) {
         uint32_t key = p->leaf_key[leaf];
         for (; p->at < p->nobjs && p->objs[p->at].key == key; p->at++) {
             uint32_t i = p->objs[p->at].index;
@@ -103,7 +103,7 @@ static void draw_object(const scene *sc, uint32_t i, const obj_state *o, const v
                         render_stats *st)
 {
     const scn_model *m = &sc->models[o->model];
-    view_pt verts[SCN_MAX_MODEL_VERTS];
+    view_pt verts[CFG_MODEL_VERTS];
     pt_order faces[SCN_MAX_MODEL_FACES];
     uint32_t nf = 0;
     objd_transform(sc, o, v, verts);
@@ -134,7 +134,7 @@ void painter_render(const scene *sc, const world_state *w, const view_xform *v, 
 {
     painter p = {sc, w, v, t, st, {fill_polygon, 0}, 0, 0, 0, 0, 0};
     walk_stats ws;
-    uint32_t nobj = (w && w->objs) ? w->n : 0;
+    uint32_t nobj = (CFG_OBJECTS && w && w->objs) ? w->n : 0;
     if (nobj && (!work || !work->mem || work->bytes < painter_work_bytes(sc, w))) {
         st->refused = 1; /* no room to order the objects */
         render_clear(t, PAINTER_BACKGROUND);

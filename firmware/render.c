@@ -41,7 +41,9 @@ void render_frame(const scene *s, const world_state *w, const camera *cam, rende
     render_stats *st = stats ? stats : &local;
     view_xform v;
     *st = (render_stats){0};
-    view_setup(&v, cam);
+    camera c = *cam;
+    if (!(s->needs->features & SCN_NEED_LOOK)) c.look = 0; /* the scene keeps its horizon level */
+    view_setup(&v, &c);
     switch (mode) {
     case RENDER_PAINTER:
         painter_render(s, w, &v, t, work, st);

@@ -2,6 +2,7 @@
  * index is checked here, in 64-bit arithmetic so no sum can wrap; the tree walk
  * that proves the node graph is a tree is bounded by the node count. */
 #include "scene.h"
+#include "build_config.h"
 #include "crc32.h"
 #include "fixed.h"
 
@@ -9,6 +10,7 @@ static const uint32_t record_bytes[SCN_SEC_COUNT] = {
     sizeof(scn_vertex), sizeof(scn_sector), sizeof(scn_line), sizeof(scn_seg),
     sizeof(scn_node), sizeof(scn_leaf), sizeof(scn_vertex), 3,
     sizeof(scn_model), sizeof(scn_mvert), sizeof(scn_face), sizeof(uint32_t), sizeof(scn_object),
+    sizeof(scn_needs),
 };
 
 const char *scene_status_text(scene_status st)
@@ -17,6 +19,7 @@ const char *scene_status_text(scene_status st)
         "ok", "truncated", "not 4-byte aligned in memory", "wrong magic (not a compiled scene)",
         "unsupported version", "inconsistent header", "bad CRC-32", "section outside the blob",
         "index out of range", "value outside the proven-safe range", "node graph is not a tree or is too deep",
+        "needs record does not match the scene", "needs more than this build provides",
     };
     return ((unsigned)st < SCENE_ERR_COUNT) ? text[st] : "unknown error";
 }
@@ -25,7 +28,7 @@ const char *scene_section_name(int section)
 {
     static const char *const names[SCN_SEC_COUNT] = {
         "vertices", "sectors", "lines", "segs", "nodes", "leaves", "leaf polygon vertices", "palette",
-        "models", "model vertices", "faces", "face indices", "objects",
+        "models", "model vertices", "faces", "face indices", "objects", "needs",
     };
     return (section >= 0 && section < SCN_SEC_COUNT) ? names[section] : "header";
 }
@@ -38,6 +41,25 @@ static scene_status fail(scene_error *err, scene_status st, int section, uint32_
         err->index = index;
     }
     return st;
+}
+
+static scene_status refuse(scene_error *err, uint32_t item, uint32_t need, uint32_t have)
+{
+    if (err) {
+        err->need = need;
+        err->have = have;
+    }
+    return fail(err, SCENE_ERR_BUILD, SCN_SEC_NEEDS, item);
+}
+
+const char *scene_item_name(uint32_t item)
+{
+    static const char *const names[SCENE_ITEM_COUNT] = {
+        "objects", "doors", "two-sided walls", "height changes", "sky steps", "look up/down", "y-clipping",
+        "edges per frame", "surfaces per frame", "tree depth", "leaf polygon vertices", "model vertices",
+        "face vertices",
+    };
+    return item < SCENE_ITEM_COUNT ? names[item] : "?";
 }
 
 static int coord_ok(int32_t v, int32_t limit_units)
@@ -55,6 +77,8 @@ static scene_status check_sections(scene *s, const uint8_t *base, const scn_head
             return fail(err, SCENE_ERR_SECTION, i, 0);
     }
     if (h->sec[SCN_SEC_PALETTE].count != 256) return fail(err, SCENE_ERR_SECTION, SCN_SEC_PALETTE, 0);
+    if (h->sec[SCN_SEC_NEEDS].count != 1) return fail(err, SCENE_ERR_SECTION, SCN_SEC_NEEDS, 0);
+    s->needs = (const scn_needs *)(base + h->sec[SCN_SEC_NEEDS].offset);
     s->verts = (const scn_vertex *)(base + h->sec[SCN_SEC_VERTICES].offset);
     s->sectors = (const scn_sector *)(base + h->sec[SCN_SEC_SECTORS].offset);
     s->lines = (const scn_line *)(base + h->sec[SCN_SEC_LINES].offset);
@@ -227,13 +251,13 @@ static scene_status check_objects(const scene *s, scene_error *err)
     return SCENE_OK;
 }
 
-/* Walk the whole graph from the root with a stack of SCN_MAX_DEPTH + 1 entries,
+/* Walk the whole graph from the root with a stack of CFG_MAX_DEPTH + 1 entries,
  * counting visits: a tree visits each node at most once, so more visits than
  * nodes means a shared child or a cycle. Bounded by nnodes + 1 pops. */
 static scene_status check_tree(const scene *s, scene_error *err)
 {
-    uint32_t stack[SCN_MAX_DEPTH + 1];
-    uint8_t depth[SCN_MAX_DEPTH + 1];
+    uint32_t stack[CFG_MAX_DEPTH + 1];
+    uint8_t depth[CFG_MAX_DEPTH + 1];
     uint32_t sp = 0, visits = 0, deepest = 0;
     uint32_t root = s->hdr->root;
     if (root & SCN_LEAF_BIT) {
@@ -252,7 +276,7 @@ static scene_status check_tree(const scene *s, scene_error *err)
         for (int c = 0; c < 2; c++) {
             uint32_t ch = s->nodes[n].child[c];
             if (ch & SCN_LEAF_BIT) continue;
-            if (d >= SCN_MAX_DEPTH || sp > SCN_MAX_DEPTH) return fail(err, SCENE_ERR_TREE, SCN_SEC_NODES, n);
+            if (d >= CFG_MAX_DEPTH || sp > CFG_MAX_DEPTH) return fail(err, SCENE_ERR_TREE, SCN_SEC_NODES, n);
             stack[sp] = ch;
             depth[sp++] = (uint8_t)(d + 1);
         }
@@ -261,13 +285,13 @@ static scene_status check_tree(const scene *s, scene_error *err)
     return SCENE_OK;
 }
 
-scene_status scene_load(scene *s, const void *blob, uint32_t len, scene_error *err)
+scene_status scene_parse(scene *s, const void *blob, uint32_t len, scene_error *err)
 {
     const uint8_t *base = (const uint8_t *)blob;
     if (err) {
         err->status = SCENE_OK;
         err->section = -1;
-        err->index = 0;
+        err->index = err->need = err->have = 0;
     }
     if (!blob || len < sizeof(scn_header)) return fail(err, SCENE_ERR_SHORT, -1, 0);
     if (((uintptr_t)blob & 3u) != 0) return fail(err, SCENE_ERR_ALIGN, -1, 0);
@@ -279,6 +303,7 @@ scene_status scene_load(scene *s, const void *blob, uint32_t len, scene_error *e
     if (crc_update(0, base + 16, h->total_bytes - 16) != h->crc32) return fail(err, SCENE_ERR_CRC, -1, 0);
     if (h->flags != 0) return fail(err, SCENE_ERR_HEADER, -1, 0);
     if (h->max_depth > SCN_MAX_DEPTH) return fail(err, SCENE_ERR_TREE, -1, 0);
+    if (h->max_depth > CFG_MAX_DEPTH) return refuse(err, SCENE_ITEM_DEPTH, h->max_depth, CFG_MAX_DEPTH);
     if (h->player_sector != SCN_NONE && h->player_sector >= h->sec[SCN_SEC_SECTORS].count)
         return fail(err, SCENE_ERR_INDEX, -1, 0);
     if (!coord_ok(h->player_x, SCN_COORD_MAX) || !coord_ok(h->player_y, SCN_COORD_MAX))
@@ -314,4 +339,84 @@ uint32_t scene_sector_at(const scene *s, int32_t x, int32_t y)
 {
     if (s->nleaves == 0) return SCN_NONE;
     return s->leaves[scene_leaf_at(s, x, y)].sector;
+}
+
+/* ---- the needs record ------------------------------------------------------ */
+
+uint32_t scene_derived_features(const scene *s)
+{
+    uint32_t f = s->nmodels ? SCN_NEED_OBJECTS : 0;
+    for (uint32_t i = 0; i < s->nsectors; i++) {
+        const scn_sector *a = &s->sectors[i], *b = &s->sectors[0];
+        if (a->flags & SCN_SECTOR_DOOR) f |= SCN_NEED_DOORS;
+        if (a->open_h != a->ceil_h) f |= SCN_NEED_HEIGHTS; /* doors move apart from each other */
+        if (a->floor_h != b->floor_h || a->ceil_h != b->ceil_h || a->open_h != b->open_h) f |= SCN_NEED_HEIGHTS;
+    }
+    for (uint32_t i = 0; i < s->nlines; i++) {
+        const scn_line *l = &s->lines[i];
+        if (l->sector[1] == SCN_NONE) continue;
+        f |= SCN_NEED_TWO_SIDED;
+        if (s->sectors[l->sector[0]].flags & s->sectors[l->sector[1]].flags & SCN_SECTOR_SKY) f |= SCN_NEED_SKY;
+    }
+    return f;
+}
+
+void scene_static_bounds(const scene *s, scn_needs *n)
+{
+    n->leaf_verts = n->model_verts = n->face_verts = n->object_faces = n->object_edges = 0;
+    for (uint32_t i = 0; i < s->nleaves; i++)
+        if (s->leaves[i].num_pverts > n->leaf_verts) n->leaf_verts = s->leaves[i].num_pverts;
+    for (uint32_t i = 0; i < s->nmodels; i++)
+        if (s->models[i].num_verts > n->model_verts) n->model_verts = s->models[i].num_verts;
+    for (uint32_t i = 0; i < s->nfaces; i++)
+        if (s->faces[i].num_index > n->face_verts) n->face_verts = s->faces[i].num_index;
+    for (uint32_t i = 0; i < s->nobjects; i++) { /* validated: at most 4096 x 64 faces of 16 + 5 */
+        const scn_model *m = &s->models[s->objects[i].model];
+        n->object_faces += m->num_faces;
+        for (uint32_t f = 0; f < m->num_faces; f++) n->object_edges += s->faces[m->first_face + f].num_index + 5u;
+    }
+}
+
+/* The record must say what the data shows (features and plain bounds), and its
+ * per-frame bounds may not exceed every polygon at once. Those bounds are the
+ * analysis's and are trusted for sizes only: the renderer never writes past
+ * its pools whatever they say (render_stats.overflow). */
+static scene_status check_needs(const scene *s, scene_error *err)
+{
+    const scn_needs *n = s->needs;
+    scn_needs plain;
+    scene_static_bounds(s, &plain);
+    uint32_t derived = scene_derived_features(s), analysed = SCN_NEED_LOOK | SCN_NEED_YCLIP;
+    uint64_t all_edges = (uint64_t)s->nsegs * 18u, all_surfs = 2u * ((uint64_t)s->nleaves + s->nsegs);
+    for (uint32_t i = 0; i < s->nleaves; i++) all_edges += 2u * ((uint64_t)s->leaves[i].num_pverts + 5u);
+    if ((n->features & ~SCN_NEED_ALL) || (n->features & ~analysed) != derived || n->edges > all_edges ||
+        n->surfaces > all_surfs || n->leaf_verts != plain.leaf_verts || n->model_verts != plain.model_verts ||
+        n->face_verts != plain.face_verts || n->object_faces != plain.object_faces ||
+        n->object_edges != plain.object_edges)
+        return fail(err, SCENE_ERR_NEEDS, SCN_SEC_NEEDS, 0);
+    return SCENE_OK;
+}
+
+/* Does this build (build_config.h) provide all the scene needs? */
+static scene_status check_build(const scene *s, scene_error *err)
+{
+    const scn_needs *n = s->needs;
+    uint32_t missing = n->features & ~(uint32_t)CFG_FEATURES;
+    for (uint32_t bit = 0; missing; bit++)
+        if (missing & (1u << bit)) return refuse(err, bit, 1, 0);
+    if (n->edges > CFG_MAX_EDGES) return refuse(err, SCENE_ITEM_EDGES, n->edges, CFG_MAX_EDGES);
+    if (n->surfaces > CFG_MAX_SURFACES) return refuse(err, SCENE_ITEM_SURFACES, n->surfaces, CFG_MAX_SURFACES);
+    if (n->leaf_verts > CFG_LEAF_VERTS) return refuse(err, SCENE_ITEM_LEAF_VERTS, n->leaf_verts, CFG_LEAF_VERTS);
+    if (n->model_verts > CFG_MODEL_VERTS)
+        return refuse(err, SCENE_ITEM_MODEL_VERTS, n->model_verts, CFG_MODEL_VERTS);
+    if (n->face_verts > CFG_FACE_VERTS) return refuse(err, SCENE_ITEM_FACE_VERTS, n->face_verts, CFG_FACE_VERTS);
+    return SCENE_OK;
+}
+
+scene_status scene_load(scene *s, const void *blob, uint32_t len, scene_error *err)
+{
+    scene_status st = scene_parse(s, blob, len, err);
+    if (st == SCENE_OK) st = check_needs(s, err);
+    if (st == SCENE_OK) st = check_build(s, err);
+    return st;
 }

@@ -22,6 +22,7 @@ typedef struct {
     const scn_face *faces;
     const uint32_t *findex;
     const scn_object *objects;
+    const scn_needs *needs;
     uint32_t nverts, nsectors, nlines, nsegs, nnodes, nleaves, npverts;
     uint32_t nmodels, nmverts, nfaces, nfindex, nobjects;
     uint32_t root;
@@ -39,18 +40,40 @@ typedef enum {
     SCENE_ERR_INDEX,     /* a record refers to something that does not exist */
     SCENE_ERR_RANGE,     /* a coordinate or height outside the proven-safe range */
     SCENE_ERR_TREE,      /* the node graph is not a tree, or is deeper than supported */
+    SCENE_ERR_NEEDS,     /* the needs record does not match the scene */
+    SCENE_ERR_BUILD,     /* the scene needs more than this build provides (need, have) */
     SCENE_ERR_COUNT
 } scene_status;
 
 typedef struct {
     scene_status status;
     int section;     /* SCN_SEC_* of the offending record, or -1 */
-    uint32_t index;  /* its index */
+    uint32_t index;  /* its index; SCENE_ERR_BUILD: the SCENE_ITEM_* that does not fit */
+    uint32_t need, have; /* SCENE_ERR_BUILD: what the scene needs, what the build provides */
 } scene_error;
 
-/* Validate blob[0..len) and fill s. Returns SCENE_OK, or a status with details in err
- * (err may be NULL). s is only usable after SCENE_OK. */
+/* What a build provides, item by item (SCENE_ERR_BUILD's index): the features
+ * SCN_NEED_* by bit number, then the sizes. */
+enum {
+    SCENE_ITEM_EDGES = 7, SCENE_ITEM_SURFACES, SCENE_ITEM_DEPTH, SCENE_ITEM_LEAF_VERTS, SCENE_ITEM_MODEL_VERTS,
+    SCENE_ITEM_FACE_VERTS, SCENE_ITEM_COUNT
+};
+
+/* Validate blob[0..len) and fill s: scene_parse, then the needs record checked
+ * against the scene and against what this build provides (build_config.h).
+ * Returns SCENE_OK, or a status with details in err (err may be NULL). s is
+ * only usable after SCENE_OK. */
 scene_status scene_load(scene *s, const void *blob, uint32_t len, scene_error *err);
+/* Everything but the needs record's contents (for the compiler, which fills it). */
+scene_status scene_parse(scene *s, const void *blob, uint32_t len, scene_error *err);
+
+/* The features the scene's data shows (SCN_NEED_* but LOOK and YCLIP, which are
+ * a declaration and an analysis), and the needs fields that are plain maxima
+ * and sums of its records (leaf, model and face vertices, own objects). */
+uint32_t scene_derived_features(const scene *s);
+void scene_static_bounds(const scene *s, scn_needs *n);
+/* "objects", "edges", ...: a SCENE_ITEM_* or feature bit number, for messages. */
+const char *scene_item_name(uint32_t item);
 
 /* Human-readable names, for messages: status ("bad CRC") and section ("segs"). */
 const char *scene_status_text(scene_status st);

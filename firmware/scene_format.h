@@ -16,7 +16,7 @@
 #include <stdint.h>
 
 #define SCN_MAGIC 0x4E435342u /* bytes "BSCN" */
-#define SCN_VERSION 2u
+#define SCN_VERSION 3u
 #define SCN_NONE 0xFFFFFFFFu     /* "no sector" / "no index" */
 #define SCN_LEAF_BIT 0x80000000u /* child index refers to a leaf */
 
@@ -46,6 +46,7 @@ enum scn_section_id {
     SCN_SEC_FACES,    /* scn_face[]: model faces, model by model */
     SCN_SEC_FINDEX,   /* uint32_t[]: face vertex numbers, relative to the model's first vertex */
     SCN_SEC_OBJECTS,  /* scn_object[]: placed objects */
+    SCN_SEC_NEEDS,    /* scn_needs[1]: what the scene needs (docs/needs.md) */
     SCN_SEC_COUNT
 };
 
@@ -140,5 +141,33 @@ typedef struct {
     uint32_t period_ms; /* one turn or one round trip; > 0 when path != SCN_PATH_NONE */
     int32_t spin;       /* degrees per second, 16.16 */
 } scn_object;
+
+/* What a scene needs of a renderer, written by the compiler's analysis
+ * (tools/bspc/needs.c, docs/needs.md). A build compiled for one scene
+ * (firmware/build_config.h) leaves out every feature whose bit is clear and
+ * sizes its buffers to the bounds; its loader refuses a scene that needs more.
+ * The bounds hold for every camera the renderer accepts (any position in the
+ * coordinate box, any height, any angle and look) and every door state. */
+enum {
+    SCN_NEED_OBJECTS = 1u << 0,   /* models (objects are placed from them) */
+    SCN_NEED_DOORS = 1u << 1,     /* a sector whose ceiling moves */
+    SCN_NEED_TWO_SIDED = 1u << 2, /* a line with a sector on both sides */
+    SCN_NEED_HEIGHTS = 1u << 3,   /* floors or ceilings at more than one height */
+    SCN_NEED_SKY = 1u << 4,       /* two sky ceilings meet at a step (Doom's sky rule) */
+    SCN_NEED_LOOK = 1u << 5,      /* the camera may look up and down */
+    SCN_NEED_YCLIP = 1u << 6,     /* a polygon can cross the top or bottom screen edge */
+    SCN_NEED_ALL = (1u << 7) - 1u
+};
+
+typedef struct {
+    uint32_t features;      /* SCN_NEED_* */
+    uint32_t edges;         /* most world edges on the edge lists in one frame (mode spans) */
+    uint32_t surfaces;      /* most world surfaces in one frame */
+    uint32_t leaf_verts;    /* most vertices of a leaf floor polygon */
+    uint32_t object_faces;  /* faces of the scene's own objects */
+    uint32_t object_edges;  /* their edges after clipping, at most */
+    uint32_t model_verts;   /* most vertices of one model */
+    uint32_t face_verts;    /* most vertices of one model face */
+} scn_needs;
 
 #endif

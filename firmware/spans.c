@@ -72,26 +72,11 @@ typedef struct {
 
 /* ---- memory ------------------------------------------------------------- */
 
-static uint64_t max_edges(const scene *s)
-{
-    /* A polygon with n vertices has at most n + 5 after clipping (one more per
-     * plane), each an edge. Floors and ceilings: two per leaf. Walls: at most two
-     * parts per seg (upper and lower, or the middle), 4 + 5 edges each. */
-    uint64_t e = 0;
-    for (uint32_t i = 0; i < s->nleaves; i++) e += 2u * ((uint64_t)s->leaves[i].num_pverts + 5u);
-    return e + (uint64_t)s->nsegs * 2u * 9u;
-}
-
-static uint64_t max_surfs(const scene *s)
-{
-    return 2u * (uint64_t)s->nleaves + 2u * (uint64_t)s->nsegs;
-}
-
 /* Faces and their clipping-maximal edges of w's objects (0 without objects). */
 static void object_bound(const scene *s, const world_state *w, uint64_t *faces, uint64_t *edges)
 {
     *faces = *edges = 0;
-    if (!w) return;
+    if (!CFG_OBJECTS || !w) return;
     for (uint32_t i = 0; i < w->n; i++) {
         uint32_t mi = w->objs ? w->objs[i].model : (i < s->nobjects ? s->objects[i].model : SCN_NONE);
         if (mi >= s->nmodels) continue; /* nothing to draw */
@@ -115,8 +100,10 @@ static void layout(const scene *s, const world_state *w, span_layout *L)
 {
     uint64_t faces, oedges;
     object_bound(s, w, &faces, &oedges);
-    L->edges = max_edges(s) + oedges;
-    L->surfs = max_surfs(s) + faces;
+    /* the world's part: the most one frame can take for any camera, as the
+     * compiler proved it (docs/needs.md) */
+    L->edges = (uint64_t)s->needs->edges + oedges;
+    L->surfs = (uint64_t)s->needs->surfaces + faces;
     L->planes = faces ? L->surfs : 0;
     L->leaves = faces ? s->nleaves : 0;
     L->total = (uint64_t)align8(sizeof(span_state)) + align8(L->edges * sizeof(sp_edge)) +
@@ -288,7 +275,10 @@ static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, 
         S->st->occluded++;
         return;
     }
-    if (S->nsurfs >= S->max_surfs || S->nedges + (uint32_t)n > S->max_edges) return; /* bound proven: unreachable */
+    if (S->nsurfs >= S->max_surfs || S->nedges + (uint32_t)n > S->max_edges) { /* the proof says: never */
+        S->st->overflow++;
+        return;
+    }
     sp_surf *s = add_surface(S, pts, n, colour, id);
     if (S->leaf_key) { /* objects may meet it: how to find its plane if they do */
         s->plane = -1;
@@ -308,6 +298,15 @@ static int visit_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
 
 /* ---- objects -------------------------------------------------------------- */
 
+/* Is any object in the view frustum? If not, the frame skips the object pass:
+ * no leaf keys during the walk, no locating, no planes. */
+static int any_in_view(const scene *sc, const world_state *w, const view_xform *v)
+{
+    for (uint32_t i = 0; i < w->n; i++)
+        if (w->objs[i].model < sc->nmodels && objd_in_view(sc, &w->objs[i], v)) return 1;
+    return 0;
+}
+
 /* Every object in a visited leaf and in view: its faces that face the eye, clipped
  * and projected, onto the edge lists (no coverage test: they are sorted in the
  * scan, against the world by key range and 1/z). */
@@ -315,7 +314,7 @@ static void add_objects(span_state *S)
 {
     const scene *sc = S->sc;
     const world_state *w = S->w;
-    view_pt verts[SCN_MAX_MODEL_VERTS];
+    view_pt verts[CFG_MODEL_VERTS];
     screen_pt pts[CLIP_MAX_VERTS];
     for (uint32_t i = 0; i < w->n; i++) {
         const obj_state *o = &w->objs[i];
@@ -330,8 +329,10 @@ static void add_objects(span_state *S)
             if (!objd_face_plane(sc, m, f, verts, &pl)) continue;
             int n = objd_face_screen(sc, m, f, verts, S->v, pts);
             if (!n) continue;
-            if (S->nsurfs >= S->max_surfs || S->nedges + (uint32_t)n > S->max_edges || S->nplanes >= S->max_planes)
-                return; /* bound proven: unreachable */
+            if (S->nsurfs >= S->max_surfs || S->nedges + (uint32_t)n > S->max_edges || S->nplanes >= S->max_planes) {
+                S->st->overflow++; /* bounded by the objects' faces: never */
+                return;
+            }
             S->st->object_faces++;
             sp_surf *s = add_surface(S, pts, n, sc->faces[f].colour, RAST_ID(RAST_KIND_OBJECT, i));
             s->key = kmin;
@@ -373,7 +374,7 @@ static int mixed_front(span_state *S, sp_surf *s, sp_surf *p, int x, int y)
         if (p->key < s->key) return 0;
         if (p->key > s->kmax) return 1;
     }
-    return objd_front(plane_of(S, s), s->object, plane_of(S, p), p->object, S->v->look, x, y);
+    return objd_front(plane_of(S, s), s->object, plane_of(S, p), p->object, VIEW_LOOK(S->v), x, y);
 }
 
 static inline __attribute__((always_inline)) int in_front(span_state *S, sp_surf *s, sp_surf *p, int x, int y,
@@ -641,7 +642,8 @@ void spans_render(const scene *sc, const world_state *w, const view_xform *v, co
     mem += align8(L.surfs * sizeof(sp_surf));
     /* objects need the leaves' keys, and planes for their faces and the world
      * surfaces they meet; a frame without them pays nothing for either */
-    S->leaf_key = (L.leaves && w->objs) ? (uint32_t *)(void *)mem : 0;
+    S->leaf_key = (CFG_OBJECTS && L.leaves && w->objs && any_in_view(sc, w, v)) ? (uint32_t *)(void *)mem : 0;
+    st->object_pass = S->leaf_key != 0;
     mem += align8(L.leaves * sizeof(uint32_t));
     S->planes = (objd_plane *)(void *)mem;
     S->max_planes = (uint32_t)L.planes;
@@ -676,8 +678,8 @@ void spans_render(const scene *sc, const world_state *w, const view_xform *v, co
     walk_tree(sc, v, WALK_FRONT_TO_BACK, visit_leaf, S, occ, &ws);
     st->nodes = ws.nodes;
     st->boxes_culled = ws.boxes_culled + ws.boxes_hidden;
-    if (S->leaf_key) add_objects(S);
+    if (CFG_OBJECTS && S->leaf_key) add_objects(S);
     st->edges = S->nedges;
-    scan(S, S->object_faces > 0);
+    scan(S, CFG_OBJECTS && S->object_faces > 0);
     flush_spans(S);
 }

@@ -14,6 +14,7 @@ static void emit(const view_xform *v, clip_poly *p, unsigned mask, const surf_si
         st->clipped_away++;
         return;
     }
+    if (!(p->cut & (CLIP_TOP | CLIP_BOTTOM))) st->yclip_skipped++;
     screen_pt s[CLIP_MAX_VERTS];
     clip_project(v, p, s);
     st->polygons++;
@@ -56,7 +57,7 @@ static void close_columns(occ_columns *occ, int x0, int x1)
  * (ceil: w->ceil, or NULL for the ceilings as compiled). */
 static inline int32_t ceil_now(const scene *sc, const fx_t *ceil, uint32_t i)
 {
-    return ceil ? ceil[i] : sc->sectors[i].ceil_h;
+    return (CFG_DOORS && ceil) ? ceil[i] : sc->sectors[i].ceil_h;
 }
 
 static void seg_parts(const scene *sc, const fx_t *ceil, const view_xform *v, uint32_t gi, unsigned mask,
@@ -83,25 +84,25 @@ static void seg_parts(const scene *sc, const fx_t *ceil, const view_xform *v, ui
     int32_t front_ceil = ceil_now(sc, ceil, front_index);
     uint32_t id = RAST_ID(RAST_KIND_WALL, g->line * 2u + g->side);
     const uint8_t *colour = l->color[g->side];
-    if (back_index == SCN_NONE) {
+    if (!CFG_TWO_SIDED || back_index == SCN_NONE) {
         wall_part(v, a, b, front->floor_h, front_ceil, mask, sink, colour[SCN_PART_MIDDLE], id, gi, st);
         if (occ) close_columns(occ, c0, c1);
         return;
     }
     const scn_sector *back = &sc->sectors[back_index];
     int32_t back_ceil = ceil_now(sc, ceil, back_index);
-    if (back_ceil < front_ceil) {
+    if (CFG_HEIGHTS && back_ceil < front_ceil) {
         int32_t low = back_ceil > front->floor_h ? back_ceil : front->floor_h;
         /* Doom's sky rule: between two sky ceilings there is no upper wall but more
          * sky. The step is drawn as the front sector's sky ceiling, so the view
          * through it has no hole. */
-        if (front->flags & back->flags & SCN_SECTOR_SKY)
+        if (CFG_SKY && (front->flags & back->flags & SCN_SECTOR_SKY))
             wall_part(v, a, b, low, front_ceil, mask, sink, front->ceil_color,
                       RAST_ID(RAST_KIND_CEILING, front_index), gi, st);
         else
             wall_part(v, a, b, low, front_ceil, mask, sink, colour[SCN_PART_UPPER], id, gi, st);
     }
-    if (back->floor_h > front->floor_h) {
+    if (CFG_HEIGHTS && back->floor_h > front->floor_h) {
         int32_t high = back->floor_h < front_ceil ? back->floor_h : front_ceil;
         wall_part(v, a, b, front->floor_h, high, mask, sink, colour[SCN_PART_LOWER], id, gi, st);
     }
@@ -119,7 +120,7 @@ static void plane(const scene *sc, const view_xform *v, const scn_leaf *f, int32
 {
     clip_poly p;
     uint32_t n = f->num_pverts;
-    if (n < 3) return; /* degenerate; the loader refuses more than SCN_MAX_LEAF_VERTS */
+    if (n < 3 || n > CLIP_MAX_VERTS - 5) return; /* degenerate; the loader refuses more than the build's */
     p.n = (int)n;
     for (uint32_t i = 0; i < n; i++) {
         const scn_vertex *q = &sc->pverts[f->first_pvert + (reverse ? n - 1 - i : i)];
@@ -136,11 +137,16 @@ void surf_leaf(const scene *sc, const world_state *w, const view_xform *v, uint3
     st->leaves++;
     if (f->sector != SCN_NONE) {
         const scn_sector *sec = &sc->sectors[f->sector];
+        /* a floor or ceiling seen edge-on or from behind: no plane work at all */
         if (v->cz > sec->floor_h)
             plane(sc, v, f, sec->floor_h, 1, mask, sink, sec->floor_color, RAST_ID(RAST_KIND_FLOOR, f->sector), st);
+        else
+            st->planes_skipped++;
         int32_t top = ceil_now(sc, ceil, f->sector);
         if (v->cz < top)
             plane(sc, v, f, top, 0, mask, sink, sec->ceil_color, RAST_ID(RAST_KIND_CEILING, f->sector), st);
+        else
+            st->planes_skipped++;
     }
     for (uint32_t i = 0; i < f->num_segs; i++) seg_parts(sc, ceil, v, f->first_seg + i, mask, sink, occ, st);
 }

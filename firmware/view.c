@@ -12,7 +12,7 @@ void view_setup(view_xform *v, const camera *cam)
     fx_ang_t a = fx_ang_from_deg(cam->angle_deg);
     v->sin = fx_sin(a);
     v->cos = fx_cos(a);
-    v->look = cam->look < -VIEW_LOOK_MAX ? -VIEW_LOOK_MAX : (cam->look > VIEW_LOOK_MAX ? VIEW_LOOK_MAX : cam->look);
+    v->look = !CFG_LOOK ? 0 : cam->look < -VIEW_LOOK_MAX ? -VIEW_LOOK_MAX : (cam->look > VIEW_LOOK_MAX ? VIEW_LOOK_MAX : cam->look);
 }
 
 static int32_t clamp32(int64_t v, int32_t hi)
@@ -25,6 +25,6 @@ screen_pt view_project(const view_xform *v, view_pt p)
     int32_t z = p.z < VIEW_ZNEAR ? VIEW_ZNEAR : p.z;
     screen_pt s;
     s.x = view_subpixel(clamp32(((int64_t)VIEW_CX << 16) + view_persp(p.x, z), VIEW_W_FX));
-    s.y = view_subpixel(clamp32(((int64_t)(VIEW_CY + v->look) << 16) - view_persp(p.y, z), VIEW_H_FX));
+    s.y = view_subpixel(clamp32(((int64_t)(VIEW_CY + VIEW_LOOK(v)) << 16) - view_persp(p.y, z), VIEW_H_FX));
     return s;
 }

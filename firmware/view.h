@@ -39,6 +39,7 @@
 #define VIEW_VIEW_H
 
 #include <stdint.h>
+#include "build_config.h"
 #include "fixed.h"
 
 #ifndef VIEW_SHIFT
@@ -92,6 +93,9 @@ typedef struct {
 typedef struct {
     int32_t x, y;        /* screen, 16.16 */
 } screen_pt;
+
+/* The vertical shear in use: always 0 in a build without look up/down. */
+#define VIEW_LOOK(v) (CFG_LOOK ? (v)->look : 0)
 
 /* Set up the transform for a camera (clamps the eye into the world box and look). */
 void view_setup(view_xform *v, const camera *cam);

@@ -363,6 +363,21 @@ done:
 
 /* The door options, after --time: each must name a door and a ceiling between its closed
  * and open heights, so the renderer sees only states a door can be in. */
+/* Options that ask for more than the scene (its declaration) or this build
+ * (build_config.h) provides. */
+static int refuse_beyond_scene(const options *o, const scene *s)
+{
+    const char *why = 0;
+    if (o->cam.look && !(s->needs->features & SCN_NEED_LOOK))
+        why = "--look: the scene keeps its horizon level (it says 'look off')";
+    else if (o->objects && !CFG_OBJECTS)
+        why = "--objects: this build leaves out objects (it was built for a scene without them)";
+    else if (o->ndoors && !CFG_DOORS)
+        why = "--door: this build leaves out doors (it was built for a scene without them)";
+    if (why) fprintf(stderr, "render: %s: %s\n", o->scene, why);
+    return why != 0;
+}
+
 static int apply_doors(const options *o, const scene *s, world_state *w)
 {
     for (int i = 0; i < o->ndoors; i++) {
@@ -430,6 +445,10 @@ static void print_json(const options *o, const engine *e, uint32_t crc)
            "\"polygons\": %u, \"occluded\": %u, \"edges\": %u, \"spans\": %u, \"work_bytes\": %u, \"frames\": %ld, ",
            st->nodes, st->boxes_culled, st->leaves, st->segs, st->culled, st->polygons, st->occluded, st->edges,
            st->spans, e->work.bytes, o->repeat);
+    printf("\"object_pass\": %u, \"overflow\": %u, \"yclip_skipped\": %u, \"planes_skipped\": %u, "
+           "\"features\": %u, \"build_features\": %u, ",
+           st->object_pass, st->overflow, st->yclip_skipped, st->planes_skipped, e->sc.needs->features,
+           (unsigned)CFG_FEATURES);
     printf("\"objects_visible\": %u, \"object_faces\": %u, \"objects\": [", st->objects_visible, st->object_faces);
     const world_state *w = &e->world;
     for (uint32_t i = 0; i < w->n; i++) {
@@ -478,8 +497,12 @@ int main(int argc, char **argv)
     scene_error se;
     hal_null_reset();
     if (len > UINT32_MAX || eng_init(&e, blob, (uint32_t)len, &se) != SCENE_OK) {
-        scene_file_describe_error(o.scene, se.status, se.section, se.index, err, sizeof err);
+        scene_file_describe_error(o.scene, &se, err, sizeof err);
         fprintf(stderr, "render: %s\n", err);
+        free(blob);
+        return 1;
+    }
+    if (refuse_beyond_scene(&o, &e.sc)) {
         free(blob);
         return 1;
     }

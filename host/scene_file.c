@@ -68,11 +68,18 @@ int scene_file_load(const char *spec, const bspc_options *opt, uint8_t **blob, s
     return bspc_compile(spec, opt, blob, len, NULL, err, errlen);
 }
 
-void scene_file_describe_error(const char *spec, int status, int section, uint32_t index, char *err, size_t errlen)
+void scene_file_describe_error(const char *spec, const scene_error *se, char *err, size_t errlen)
 {
-    if (section >= 0)
-        snprintf(err, errlen, "%s: compiled scene rejected: %s in %s record %u", spec,
-                 scene_status_text((scene_status)status), scene_section_name(section), index);
+    const char *st = scene_status_text(se->status);
+    if (se->status == SCENE_ERR_BUILD && se->index < SCENE_ITEM_EDGES)
+        snprintf(err, errlen, "%s: the scene needs %s, which this build leaves out (it was built for another "
+                 "scene; see docs/needs.md)", spec, scene_item_name(se->index));
+    else if (se->status == SCENE_ERR_BUILD)
+        snprintf(err, errlen, "%s: the scene needs %u %s, this build provides %u (it was built for another "
+                 "scene; see docs/needs.md)", spec, se->need, scene_item_name(se->index), se->have);
+    else if (se->section >= 0)
+        snprintf(err, errlen, "%s: compiled scene rejected: %s in %s record %u", spec, st,
+                 scene_section_name(se->section), se->index);
     else
-        snprintf(err, errlen, "%s: compiled scene rejected: %s", spec, scene_status_text((scene_status)status));
+        snprintf(err, errlen, "%s: compiled scene rejected: %s", spec, st);
 }

@@ -13,6 +13,6 @@
 int scene_file_load(const char *spec, const bspc_options *opt, uint8_t **blob, size_t *len, char *err, size_t errlen);
 
 /* The loader's verdict on a blob as one line ("FILE: bad CRC-32"), for messages. */
-void scene_file_describe_error(const char *spec, int status, int section, uint32_t index, char *err, size_t errlen);
+void scene_file_describe_error(const char *spec, const scene_error *se, char *err, size_t errlen);
 
 #endif

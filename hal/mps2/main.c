@@ -103,6 +103,11 @@ int main(void)
 
     scene_error se;
     scene_status st = eng_init(&e, fw_scene, fw_scene_len, &se);
+    if (st == SCENE_ERR_BUILD) {
+        log_printf("firmware: the built-in scene %s needs %u %s, this build provides %u; refusing to run\n",
+                   fw_scene_name, (unsigned)se.need, scene_item_name(se.index), (unsigned)se.have);
+        return FW_EXIT_SCENE;
+    }
     if (st != SCENE_OK) {
         if (se.section >= 0)
             log_printf("firmware: the built-in scene %s is invalid: %s (%s record %u); refusing to run\n",

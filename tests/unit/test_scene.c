@@ -385,9 +385,15 @@ static void test_object_count_limit(void **state)
     uint8_t *big = malloc(len + sizeof(scn_object));
     memcpy(big, b, len);
     scn_header *h = (scn_header *)(void *)big;
-    assert_int_equal(h->sec[SCN_SEC_OBJECTS].offset + h->sec[SCN_SEC_OBJECTS].count * sizeof(scn_object), len);
-    memcpy(big + len, big + len - sizeof(scn_object), sizeof(scn_object));
+    /* the objects end where the needs record (the last section) starts: a copy of
+     * the last object goes in between */
+    size_t oend = h->sec[SCN_SEC_OBJECTS].offset + h->sec[SCN_SEC_OBJECTS].count * sizeof(scn_object);
+    assert_int_equal(h->sec[SCN_SEC_NEEDS].offset, oend);
+    assert_int_equal(oend + sizeof(scn_needs), len);
+    memcpy(big + oend + sizeof(scn_object), b + oend, sizeof(scn_needs));
+    memcpy(big + oend, b + oend - sizeof(scn_object), sizeof(scn_object));
     h->sec[SCN_SEC_OBJECTS].count++;
+    h->sec[SCN_SEC_NEEDS].offset += sizeof(scn_object);
     h->total_bytes += sizeof(scn_object);
     fix_crc(big, len + sizeof(scn_object));
     assert_int_equal(load_copy(big, len + sizeof(scn_object), &err), SCENE_ERR_RANGE);

@@ -99,8 +99,9 @@ int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *l
     for (uint32_t i = 0; i < t->nleaves; i++) npv += t->leaves[i].poly.n;
     uint32_t counts[SCN_SEC_COUNT] = {t->nverts, s->nsectors, s->nlines, t->nsegs,
                                       t->nnodes, t->nleaves,  npv,       256,
-                                      s->nmodels, s->nmverts, s->nfaces, s->nfindex, s->nobjects};
-    static const uint32_t recsz[SCN_SEC_COUNT] = {8, 12 + 4, 24, 16, 56, 20, 8, 3, 28, 12, 8, 4, 40};
+                                      s->nmodels, s->nmverts, s->nfaces, s->nfindex, s->nobjects, 1};
+    static const uint32_t recsz[SCN_SEC_COUNT] = {8, 12 + 4, 24, 16, 56, 20, 8, 3, 28, 12, 8, 4, 40,
+                                                  sizeof(scn_needs)};
     uint32_t off[SCN_SEC_COUNT];
     uint64_t at = sizeof(scn_header);
     for (int k = 0; k < SCN_SEC_COUNT; k++) {
@@ -253,6 +254,8 @@ int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *l
         wi32(&w, o->spin);
     }
 
+    /* the needs record (SCN_SEC_NEEDS) stays zero here: bspc.c fills it in from
+     * the analysis of this very blob and recomputes the CRC */
     uint32_t crc = crc_update(0, p + 16, (size_t)at - 16);
     w.at = 12;
     w32(&w, crc);

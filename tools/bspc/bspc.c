@@ -6,7 +6,9 @@
 #include <string.h>
 
 #include "bspc_int.h"
+#include "crc32.h"
 #include "geom.h"
+#include "scene.h"
 
 bspc_options bspc_defaults(void)
 {
@@ -81,6 +83,23 @@ static void place_objects(bs_scene *s, const bs_tree *t, const bspc_options *opt
     }
     if (dropped) bs_note(opt, "%s: %u thing(s) inside no sector left out", s->name, dropped);
     s->nobjects = kept;
+}
+
+/* Analyse the blob just written (as the renderer will read it) and write what
+ * it needs into its needs record; the CRC covers the record. */
+static int fill_needs(const bs_scene *s, uint8_t *blob, size_t len, needs_report *r, char *err, size_t errlen)
+{
+    scene sc;
+    scene_error se;
+    if (scene_parse(&sc, blob, (uint32_t)len, &se) != SCENE_OK)
+        return bs_fail(err, errlen, "%s: internal error: the compiled scene does not parse (%s, %s record %u)",
+                       s->name, scene_status_text(se.status), scene_section_name(se.section), se.index);
+    if (needs_analyse(&sc, !s->no_look, r)) return bs_fail(err, errlen, "%s: out of memory", s->name);
+    const scn_header *h = (const scn_header *)(const void *)blob;
+    memcpy(blob + h->sec[SCN_SEC_NEEDS].offset, &r->needs, sizeof r->needs);
+    uint32_t crc = crc_update(0, blob + 16, len - 16);
+    memcpy(blob + 12, &crc, 4);
+    return 0;
 }
 
 int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, size_t *len,
@@ -178,6 +197,8 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
     }
     place_objects(&s, &t, &opt);
     if (bs_write_blob(&s, &t, blob, len, err, errlen)) goto out;
+    needs_report needs;
+    if (fill_needs(&s, *blob, *len, &needs, err, errlen)) goto out;
     double t1 = bs_now_ms();
     bs_note(&opt, "%s: times: tree %.2f ms, T-junctions %.2f ms, blob %.2f ms", s.name, t_tree - t0,
             t_tj - t_tree, t1 - t_tj);
@@ -202,6 +223,7 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
         stats->models = s.nmodels;
         stats->objects = s.nobjects;
         stats->doors = s.ndoors;
+        stats->needs = needs;
     }
     rc = 0;
 out:

@@ -7,6 +7,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "needs.h"
+
 typedef enum { BSPC_SPLIT_FEWEST, BSPC_SPLIT_BALANCED, BSPC_SPLIT_MIXED } bspc_split;
 
 typedef struct {
@@ -23,6 +25,7 @@ typedef struct {
     double mean_depth;    /* mean over leaves */
     double build_ms;      /* wall-clock milliseconds for the tree build and blob write */
     uint32_t models, objects, doors; /* docs/objects.md */
+    needs_report needs;              /* what the scene needs (docs/needs.md), as written in the blob */
 } bspc_stats;
 
 /* Default options. */

@@ -120,6 +120,7 @@ typedef struct {
     bs_line *lines;
     uint32_t nlines, lcap;
     int has_player;
+    int no_look;                    /* text: 'look off': the camera keeps its horizon level */
     int32_t player_x, player_y, player_angle; /* 16.16; angle in degrees */
     int player_line;
     uint32_t player_sector;         /* filled by bs_scene_check / bspc.c */

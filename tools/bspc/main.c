@@ -1,5 +1,5 @@
 /* main.c - build/bspc, the BSP compiler's command line:
- *   bspc INPUT [-o OUT] [--split fewest|balanced|mixed] [--stats] [-v]
+ *   bspc INPUT [-o OUT] [--split fewest|balanced|mixed] [--stats] [--needs] [--config FILE.h] [-v]
  * INPUT is a text scene (docs/scene-format.md) or file.wad:MAP01 / file.wad:E1M1. */
 #include <errno.h>
 #include <stdio.h>
@@ -7,10 +7,12 @@
 #include <string.h>
 
 #include "bspc.h"
+#include "scene.h"
 
 static void usage(FILE *f)
 {
-    fputs("usage: bspc INPUT [-o OUT] [--split fewest|balanced|mixed] [--stats] [-v]\n"
+    fputs("usage: bspc INPUT [-o OUT] [--split fewest|balanced|mixed] [--stats] [--needs]\n"
+          "            [--config FILE.h] [-v]\n"
           "\n"
           "Compiles a scene into a BSP blob (firmware/scene_format.h).\n"
           "  INPUT            a text scene (docs/scene-format.md), or a Doom-format map as\n"
@@ -21,6 +23,11 @@ static void usage(FILE *f)
           "  --split S        partition choice: fewest (fewest splits), balanced (best\n"
           "                   balance) or mixed (weighted, the default)\n"
           "  --stats          print one JSON object of build figures on stdout\n"
+          "  --needs          print what the scene needs: features, and the most work one\n"
+          "                   frame can take for any camera (docs/needs.md)\n"
+          "  --config FILE.h  write the C header of a build for this scene alone\n"
+          "                   (firmware/build_config.h); INPUT may then also be a compiled\n"
+          "                   scene (.bsc), whose needs record is used as it is\n"
           "  -v               progress and warnings on stderr\n"
           "  --help           this text\n",
           f);
@@ -46,10 +53,64 @@ static void default_out(const char *in, char *out, size_t n)
         snprintf(out, n, "%s.bsc", tmp);
 }
 
+static int write_config(const char *path, const char *name, const scene *sc)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) {
+        fprintf(stderr, "bspc: %s: cannot write: %s\n", path, strerror(errno));
+        return 1;
+    }
+    needs_write_config(f, name, sc, sc->needs);
+    if (fclose(f)) {
+        fprintf(stderr, "bspc: %s: write failed\n", path);
+        remove(path);
+        return 1;
+    }
+    return 0;
+}
+
+static int is_compiled(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    uint8_t m[4] = {0};
+    if (!f) return 0;
+    size_t n = fread(m, 1, 4, f);
+    fclose(f);
+    return n == 4 && ((uint32_t)m[0] | (uint32_t)m[1] << 8 | (uint32_t)m[2] << 16 | (uint32_t)m[3] << 24) == SCN_MAGIC;
+}
+
+/* --config for a scene compiled before: its own needs record, once it loads. */
+static int config_from_compiled(const char *in, const char *config)
+{
+    FILE *f = fopen(in, "rb");
+    if (!f) {
+        fprintf(stderr, "bspc: %s: cannot read: %s\n", in, strerror(errno));
+        return 1;
+    }
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    uint32_t *blob = malloc(n > 0 ? (size_t)n + 4 : 4);
+    size_t got = blob && n > 0 ? fread(blob, 1, (size_t)n, f) : 0;
+    fclose(f);
+    scene sc;
+    scene_error se;
+    if (!blob || n <= 0 || got != (size_t)n || scene_load(&sc, blob, (uint32_t)n, &se) != SCENE_OK) {
+        fprintf(stderr, "bspc: %s: not a compiled scene this version loads%s%s\n", in, blob && got == (size_t)n ? ": " : "",
+                blob && got == (size_t)n ? scene_status_text(se.status) : "");
+        free(blob);
+        return 1;
+    }
+    int rc = write_config(config, in, &sc);
+    free(blob);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     const char *in = NULL, *outp = NULL;
-    int want_stats = 0;
+    int want_stats = 0, want_needs = 0;
+    const char *config = NULL;
     bspc_options opt = bspc_defaults();
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -60,6 +121,14 @@ int main(int argc, char **argv)
             opt.verbose = 1;
         } else if (strcmp(a, "--stats") == 0) {
             want_stats = 1;
+        } else if (strcmp(a, "--needs") == 0) {
+            want_needs = 1;
+        } else if (strcmp(a, "--config") == 0) {
+            if (++i >= argc) {
+                fprintf(stderr, "bspc: --config needs a file name\n");
+                return 2;
+            }
+            config = argv[i];
         } else if (strcmp(a, "-o") == 0) {
             if (++i >= argc) {
                 fprintf(stderr, "bspc: -o needs a file name\n");
@@ -96,6 +165,7 @@ int main(int argc, char **argv)
         usage(stderr);
         return 2;
     }
+    if (config && is_compiled(in)) return config_from_compiled(in, config);
     char outbuf[1100];
     if (!outp) {
         default_out(in, outbuf, sizeof outbuf);
@@ -109,6 +179,20 @@ int main(int argc, char **argv)
     if (bspc_compile(in, &opt, &blob, &len, &st, err, sizeof err)) {
         fprintf(stderr, "bspc: %s\n", err);
         return 1;
+    }
+    if (want_needs || config) {
+        scene sc;
+        scene_error se;
+        if (scene_load(&sc, blob, (uint32_t)len, &se) != SCENE_OK) { /* cannot happen: bspc wrote it */
+            fprintf(stderr, "bspc: %s: the compiled scene does not load: %s\n", in, scene_status_text(se.status));
+            free(blob);
+            return 1;
+        }
+        if (want_needs) needs_print(stdout, in, &sc, &st.needs);
+        if (config && write_config(config, in, &sc)) {
+            free(blob);
+            return 1;
+        }
     }
     FILE *f = fopen(outp, "wb");
     if (!f) {
@@ -128,8 +212,10 @@ int main(int argc, char **argv)
     if (want_stats)
         printf("{\"input_walls\": %u, \"segs\": %u, \"splits\": %u, \"leaves\": %u, \"nodes\": %u, "
                "\"vertices\": %u, \"max_depth\": %u, \"mean_depth\": %.3f, \"build_ms\": %.3f, "
-               "\"models\": %u, \"objects\": %u}\n",
+               "\"models\": %u, \"objects\": %u, \"features\": %u, \"max_edges\": %u, \"max_surfaces\": %u, "
+               "\"all_edges\": %u, \"all_surfaces\": %u}\n",
                st.input_walls, st.segs, st.splits, st.leaves, st.nodes, st.vertices, st.max_depth,
-               st.mean_depth, st.build_ms, st.models, st.objects);
+               st.mean_depth, st.build_ms, st.models, st.objects, st.needs.needs.features, st.needs.needs.edges,
+               st.needs.needs.surfaces, st.needs.all_edges, st.needs.all_surfaces);
     return 0;
 }

@@ -7,6 +7,7 @@
  *   player X Y ANGLE
  *   model NAME / part box|prism KEY=VALUE... / end
  *   object MODEL X Y [z=Z] [yaw=DEG] [path=...] [spin=DEG_PER_S]
+ *   look on|off   (off: the camera never looks up or down; docs/needs.md)
  * (models and objects: docs/objects.md; sectors also take door=H).
  * Numbers are decimal (fractions allowed) and become 16.16, rounded to nearest.
  * Every error names the file, the line and the problem.
@@ -460,6 +461,14 @@ static int period(parser *p, const char *t, uint32_t *out)
     return 0;
 }
 
+static int do_look(parser *p, char **tok, int n)
+{
+    if (n != 2 || (strcmp(tok[1], "on") != 0 && strcmp(tok[1], "off") != 0))
+        return perr(p, "look: expected 'look on' or 'look off'");
+    p->s->no_look = strcmp(tok[1], "off") == 0;
+    return 0;
+}
+
 static int do_object(parser *p, char **tok, int n)
 {
     bs_scene *s = p->s;
@@ -688,10 +697,12 @@ int bs_read_text(const char *path, bs_scene *s, const bspc_options *opt, char *e
             rc = do_model(&p, tok, n);
         else if (strcmp(tok[0], "object") == 0)
             rc = do_object(&p, tok, n);
+        else if (strcmp(tok[0], "look") == 0)
+            rc = do_look(&p, tok, n);
         else if (strcmp(tok[0], "part") == 0 || strcmp(tok[0], "end") == 0)
             rc = perr(&p, "%s: outside a model (start one with 'model NAME')", tok[0]);
         else
-            rc = perr(&p, "unknown statement '%s' (expected sector, wall, player, model or object)",
+            rc = perr(&p, "unknown statement '%s' (expected sector, wall, player, model, object or look)",
                       tok[0]);
         line = next;
     }
