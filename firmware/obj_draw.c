@@ -11,7 +11,7 @@
 #include "obj_draw.h"
 #include "wide128.h"
 
-_Static_assert(SCN_MAX_FACE_VERTS + 5 <= CLIP_MAX_VERTS, "a clipped face must fit a clip_poly");
+_Static_assert(!CFG_OBJECTS || CFG_FACE_VERTS + 5 <= CLIP_MAX_VERTS, "a clipped face must fit a clip_poly");
 
 #define NORM_LO ((int64_t)1 << 29)
 #define NORM_HI ((int64_t)1 << 30)

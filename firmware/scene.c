@@ -251,13 +251,13 @@ static scene_status check_objects(const scene *s, scene_error *err)
     return SCENE_OK;
 }
 
-/* Walk the whole graph from the root with a stack of CFG_MAX_DEPTH + 1 entries,
+/* Walk the whole graph from the root with a stack of SCN_MAX_DEPTH + 1 entries,
  * counting visits: a tree visits each node at most once, so more visits than
  * nodes means a shared child or a cycle. Bounded by nnodes + 1 pops. */
 static scene_status check_tree(const scene *s, scene_error *err)
 {
-    uint32_t stack[CFG_MAX_DEPTH + 1];
-    uint8_t depth[CFG_MAX_DEPTH + 1];
+    uint32_t stack[SCN_MAX_DEPTH + 1];
+    uint8_t depth[SCN_MAX_DEPTH + 1];
     uint32_t sp = 0, visits = 0, deepest = 0;
     uint32_t root = s->hdr->root;
     if (root & SCN_LEAF_BIT) {
@@ -276,7 +276,7 @@ static scene_status check_tree(const scene *s, scene_error *err)
         for (int c = 0; c < 2; c++) {
             uint32_t ch = s->nodes[n].child[c];
             if (ch & SCN_LEAF_BIT) continue;
-            if (d >= CFG_MAX_DEPTH || sp > CFG_MAX_DEPTH) return fail(err, SCENE_ERR_TREE, SCN_SEC_NODES, n);
+            if (d >= SCN_MAX_DEPTH || sp > SCN_MAX_DEPTH) return fail(err, SCENE_ERR_TREE, SCN_SEC_NODES, n);
             stack[sp] = ch;
             depth[sp++] = (uint8_t)(d + 1);
         }
@@ -303,7 +303,6 @@ scene_status scene_parse(scene *s, const void *blob, uint32_t len, scene_error *
     if (crc_update(0, base + 16, h->total_bytes - 16) != h->crc32) return fail(err, SCENE_ERR_CRC, -1, 0);
     if (h->flags != 0) return fail(err, SCENE_ERR_HEADER, -1, 0);
     if (h->max_depth > SCN_MAX_DEPTH) return fail(err, SCENE_ERR_TREE, -1, 0);
-    if (h->max_depth > CFG_MAX_DEPTH) return refuse(err, SCENE_ITEM_DEPTH, h->max_depth, CFG_MAX_DEPTH);
     if (h->player_sector != SCN_NONE && h->player_sector >= h->sec[SCN_SEC_SECTORS].count)
         return fail(err, SCENE_ERR_INDEX, -1, 0);
     if (!coord_ok(h->player_x, SCN_COORD_MAX) || !coord_ok(h->player_y, SCN_COORD_MAX))
@@ -404,6 +403,8 @@ static scene_status check_build(const scene *s, scene_error *err)
     uint32_t missing = n->features & ~(uint32_t)CFG_FEATURES;
     for (uint32_t bit = 0; missing; bit++)
         if (missing & (1u << bit)) return refuse(err, bit, 1, 0);
+    if (s->hdr->max_depth > CFG_MAX_DEPTH)
+        return refuse(err, SCENE_ITEM_DEPTH, s->hdr->max_depth, CFG_MAX_DEPTH);
     if (n->edges > CFG_MAX_EDGES) return refuse(err, SCENE_ITEM_EDGES, n->edges, CFG_MAX_EDGES);
     if (n->surfaces > CFG_MAX_SURFACES) return refuse(err, SCENE_ITEM_SURFACES, n->surfaces, CFG_MAX_SURFACES);
     if (n->leaf_verts > CFG_LEAF_VERTS) return refuse(err, SCENE_ITEM_LEAF_VERTS, n->leaf_verts, CFG_LEAF_VERTS);

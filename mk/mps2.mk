@@ -1,12 +1,16 @@
 # mps2.mk - the Cortex-M3 firmware on QEMU's mps2-an385 board (hal/mps2), the
 # instruction-counting QEMU plugin (tools/qemu_plugin), and how to run them.
 #
-#   make firmware [SCENE=...] [CAMPATH=default|map01] [WORK_BYTES=N] [STREAM=framelink|raw] [ARM_OUT=DIR]
+#   make firmware [SCENE=...] [FULL=1] [CAMPATH=default|map01] [WORK_BYTES=N] [STREAM=framelink|raw] [ARM_OUT=DIR]
 #       -> $(ARM_OUT)/firmware.elf (default build/arm/firmware.elf): the scene
 #          (text scene, WAD map "file.wad:MAP01" or a compiled .bsc, default
 #          tests/scenes/default.scene) compiled by build/bspc and built in, the
 #          work area sized from it by build/render (or WORK_BYTES), and a camera
 #          path (default: map01 for a MAP01 scene, else default).
+#          The renderer is built for that scene (docs/needs.md): only the
+#          features it needs, fixed buffers sized to its proven bounds
+#          ($(ARM_OUT)/scene_config.h, written by bspc --config). FULL=1 builds
+#          every feature in, as for any scene.
 #   make run-firmware [UART=FILE|stdio] [RUN_ARGS="--frames 10 ..."]
 #       runs it in qemu-system-arm; the UART (the frame stream) goes to
 #       build/arm/uart.bin (or stdout with UART=stdio), the firmware's messages
@@ -45,8 +49,12 @@ ARM_CFLAGS := -std=c11 -O2 -g -mcpu=cortex-m3 -mthumb -mfloat-abi=soft -ffreesta
               -fno-strict-aliasing -fno-tree-loop-distribute-patterns -ffunction-sections -fdata-sections \
               $(WARN) -Ifirmware -Ihal -Ihal/mps2 -Ihal/serial
 ARM_SRC  := $(FW_SRC) $(HAL_SRC) $(MPS2_SRC) $(MPS2_LINK_SRC)
-# Objects that do not depend on the scene; ARM_OBJ may be shared by several ARM_OUTs.
+# Objects of a FULL=1 build do not depend on the scene: its ARM_OBJ may be
+# shared by several ARM_OUTs. A build for one scene compiles them for it.
+FULL     ?=
 ARM_OBJ  ?= $(ARM_OUT)/obj
+ARM_SCENE_DEF := $(if $(FULL),,-DSCENE_CONFIG='"$(abspath $(ARM_OUT)/scene_config.h)"')
+ARM_CONFIG_DEP := $(if $(FULL),,$(ARM_OUT)/scene_config.h)
 ARM_OBJS := $(patsubst %.c,$(ARM_OBJ)/%.o,$(ARM_SRC)) $(ARM_OUT)/fw_scene.o
 # The soft-float helpers (as in tools/check_nofloat.sh) that may not be linked in.
 ARM_FLOAT_HELPERS := '^__aeabi_([fd]|[a-z]*2[fd]$$)|^__(add|sub|mul|div|neg|fix|fixuns|float|floatun|extend|trunc|cmp|eq|ne|lt|le|gt|ge|unord|pow|powi)[sdtx]f[0-9]?$$'
@@ -64,15 +72,21 @@ FORCE:
 
 firmware: $(ARM_OUT)/firmware.elf
 
-$(ARM_OBJ)/%.o: %.c $(GEN)/fx_tables.c
+$(ARM_OBJ)/%.o: %.c $(GEN)/fx_tables.c $(ARM_CONFIG_DEP)
 	@mkdir -p $(@D)
-	$(ARMCC) $(ARM_CFLAGS) -MMD -MP -c $< -o $@
+	$(ARMCC) $(ARM_CFLAGS) $(ARM_SCENE_DEF) -MMD -MP -c $< -o $@
+
+# What the scene needs, as a C header (rewritten only when it changes).
+$(ARM_OUT)/scene_config.h: $(ARM_OUT)/scene.bsc $(BUILD)/bspc
+	$(BUILD)/bspc $< --config $@.tmp
+	@cmp -s $@.tmp $@ || mv $@.tmp $@
+	@rm -f $@.tmp
 
 # What the built-in part depends on; rewritten only when it changes.
 $(ARM_OUT)/config: FORCE
 	@mkdir -p $(@D)
-	@echo 'SCENE=$(SCENE) CAMPATH=$(CAMPATH) WORK_BYTES=$(WORK_BYTES) STREAM=$(STREAM)' | cmp -s - $@ || \
-	  echo 'SCENE=$(SCENE) CAMPATH=$(CAMPATH) WORK_BYTES=$(WORK_BYTES) STREAM=$(STREAM)' > $@
+	@echo 'SCENE=$(SCENE) CAMPATH=$(CAMPATH) WORK_BYTES=$(WORK_BYTES) STREAM=$(STREAM) FULL=$(FULL)' | cmp -s - $@ || \
+	  echo 'SCENE=$(SCENE) CAMPATH=$(CAMPATH) WORK_BYTES=$(WORK_BYTES) STREAM=$(STREAM) FULL=$(FULL)' > $@
 
 $(ARM_OUT)/scene.bsc: $(ARM_OUT)/config $(BUILD)/bspc $(wildcard $(firstword $(subst :, ,$(SCENE))))
 	@mkdir -p $(@D)
@@ -81,25 +95,40 @@ $(ARM_OUT)/scene.bsc: $(ARM_OUT)/config $(BUILD)/bspc $(wildcard $(firstword $(s
 	  *) $(BUILD)/bspc '$(SCENE)' -o $@ ;; \
 	esac
 
-# The work area: what build/render says the scene needs (mode spans), unless
-# WORK_BYTES is given. A scene build/render cannot load gets none: the firmware
-# then refuses it at start with the loader's message.
-$(ARM_OUT)/work_bytes: $(ARM_OUT)/scene.bsc $(BUILD)/render
-	@if [ -n '$(WORK_BYTES)' ]; then echo '$(WORK_BYTES)' > $@; \
-	elif n=$$($(BUILD)/render $< 2>/dev/null | sed -n 's/.*"work_bytes": \([0-9]*\).*/\1/p') && [ -n "$$n" ]; then \
-	  echo "$$n" > $@; \
-	else echo "mps2: build/render cannot load $(SCENE): no work area built in (the firmware will refuse the scene)"; \
-	  echo 0 > $@; fi
-
-$(ARM_OUT)/gen/fw_scene.c: $(ARM_OUT)/scene.bsc $(ARM_OUT)/work_bytes $(BUILD)/bin2c
-	@mkdir -p $(@D)
-	@n=$$(cat $(ARM_OUT)/work_bytes); name=$$(printf '%s' '$(SCENE)' | sed 's/[\\"]/\\&/g'); \
+# The built-in part: the scene, its name, the camera path and a work area of
+# $(2) bytes, as C ($(1) the output file).
+define fw_scene_c
+	@mkdir -p $(dir $(1))
+	@n=$(2); name=$$(printf '%s' '$(SCENE)' | sed 's/[\\"]/\\&/g'); \
 	{ $(BUILD)/bin2c fw_scene $< && \
 	  echo "const char fw_scene_name[] = \"$$name\";" && \
 	  echo "const char fw_campath_name[] = \"$(CAMPATH)\";" && \
 	  echo "/* the work area: $$n bytes at 0x21020000 in PSRAM (hal/mps2/mps2.ld) */" && \
 	  echo "_Alignas(8) uint8_t fw_work[$$n > 0 ? $$n : 1] __attribute__((section(\".work\")));" && \
-	  echo "const uint32_t fw_work_bytes = $${n}u;"; } > $@.tmp && mv $@.tmp $@
+	  echo "const uint32_t fw_work_bytes = $${n}u;"; } > $(1).tmp && mv $(1).tmp $(1)
+endef
+
+# The work area: exactly what this firmware needs for its scene (32-bit
+# layouts, this build's features), as the firmware itself works it out: a
+# sizing image with no work area is run once under QEMU and says how much it
+# needs. WORK_BYTES= overrides. A scene the firmware refuses gets none: the
+# firmware then refuses it at start with the loader's message.
+$(ARM_OUT)/gen/fw_sizer.c: $(ARM_OUT)/scene.bsc $(BUILD)/bin2c
+	$(call fw_scene_c,$@,0)
+$(ARM_OUT)/fw_sizer.o: $(ARM_OUT)/gen/fw_sizer.c
+	$(ARMCC) $(ARM_CFLAGS) -c $< -o $@
+$(ARM_OUT)/sizer.elf: $(filter-out $(ARM_OUT)/fw_scene.o,$(ARM_OBJS)) $(ARM_OUT)/fw_sizer.o hal/mps2/mps2.ld
+	$(ARMCC) $(ARM_CFLAGS) -T hal/mps2/mps2.ld -Wl,--gc-sections $(filter %.o,$^) -lgcc -o $@
+$(ARM_OUT)/work_bytes: $(ARM_OUT)/sizer.elf $(ARM_OUT)/config
+	@if [ -n '$(WORK_BYTES)' ]; then echo '$(WORK_BYTES)' > $@; \
+	elif n=$$(timeout 60 $(QEMU_ARM) -M mps2-an385 -nographic -monitor none -semihosting-config enable=on,target=native \
+	          -kernel $< -serial null 2>&1 | sed -n 's/.* needs \([0-9]*\) bytes of work memory.*/\1/p') && [ -n "$$n" ]; then \
+	  echo "$$n" > $@; \
+	else echo "mps2: the firmware refuses $(SCENE): no work area built in (it will say why at start)"; \
+	  echo 0 > $@; fi
+
+$(ARM_OUT)/gen/fw_scene.c: $(ARM_OUT)/scene.bsc $(ARM_OUT)/work_bytes $(BUILD)/bin2c
+	$(call fw_scene_c,$@,$$(cat $(ARM_OUT)/work_bytes))
 
 $(ARM_OUT)/fw_scene.o: $(ARM_OUT)/gen/fw_scene.c
 	@mkdir -p $(@D)
@@ -113,7 +142,7 @@ $(ARM_OUT)/firmware.elf: $(ARM_OBJS) hal/mps2/mps2.ld $(ARM_OUT)/config
 	  echo "$$helpers" | sed 's/^/    /'; rm -f $@.tmp; exit 1; fi
 	@mv $@.tmp $@
 	@$(ARMSIZE) $@ | sed 's/^/mps2: /'
-	@echo "mps2: $@: scene $(SCENE), camera path $(CAMPATH), work area $$(cat $(ARM_OUT)/work_bytes) bytes, stream $(STREAM)"
+	@echo "mps2: $@: scene $(SCENE), camera path $(CAMPATH), work area $$(cat $(ARM_OUT)/work_bytes) bytes, stream $(STREAM), $(if $(FULL),every feature,built for the scene)"
 
 # ---- running it -----------------------------------------------------------------
 # -nographic would put the UART and QEMU's monitor together on stdio, where a

@@ -42,7 +42,10 @@ def render(scene, *extra, at=None, angle=None, sanitized=True, check=True):
     cam = (["--at", at] if at is not None else []) + (["--angle", angle] if angle is not None else [])
     proc = run([program("render", sanitized), scene, *cam, *extra], check=check)
     assert proc.stdout.count("\n") == 1, proc.stdout
-    return json.loads(proc.stdout)
+    out = json.loads(proc.stdout)
+    # the scene's proven per-frame bounds (docs/needs.md) sized the pools: none may run full
+    assert out.get("overflow", 0) == 0, (scene, cam, extra)
+    return out
 
 
 def read_png_indexed(path):
