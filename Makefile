@@ -93,9 +93,12 @@ help:
 	@echo "make run        walk the built-in scene in a window (headless: fly-through PNGs)"
 	@echo "make test       deps, build, unit tests and pytest, with ASan and UBSan"
 	@echo "make bench      instructions per frame (callgrind), overdraw, VRAM writes, bus cycles on 20 views;"
-	@echo "                Cortex-M3 instructions per frame (bench-m3); link faults (bench-faults)"
+	@echo "                Cortex-M3 instructions per frame (bench-m3); link faults (bench-faults);"
+	@echo "                firmware flash and RAM, full against built for one scene (bench-size)"
+	@echo "make scene-host SCENE=...  build/scene/NAME/render, emu built for one scene (docs/needs.md)"
 	@echo "make bench-link the frame link's bytes per frame and encoder cost"
-	@echo "make firmware   build/arm/firmware.elf for QEMU mps2-an385 (SCENE=, CAMPATH=); make run-firmware"
+	@echo "make firmware   build/arm/firmware.elf for QEMU mps2-an385, built for its scene (SCENE=, FULL=1,"
+	@echo "                CAMPATH=); make run-firmware"
 	@echo "make flash      IMAGE=x.dfu DEVICE=VID:PID (or LOOPBACK=1): USB DFU download"
 	@echo "make bench-bsp  bspc over all 68 Freedoom maps per strategy, beside zdbsp and glbsp"
 	@echo "make report     error against the reference vs instructions per frame, per render mode and"
@@ -131,11 +134,17 @@ bench-bsp: deps $(BUILD)/bspc
 bench: deps $(BUILD)/bspc $(BUILD)/render
 	$(PY) tools/bench.py
 
-bench: bench-faults
+bench: bench-faults bench-size
 bench-faults: deps firmware
 	$(PY) tools/bench_faults.py
 
+# flash and RAM of the firmware, full build against builds for one scene (docs/needs.md)
+bench-size: deps $(BUILD)/bspc $(BUILD)/render
+	$(PY) tools/size_table.py
+
+.PHONY: bench-size
+
 clean:
-	rm -rf $(BUILD)/obj $(BUILD)/san $(BUILD)/gen $(PROGRAMS) $(BUILD)/*.bsc $(BUILD)/gen_tables $(BUILD)/bin2c
+	rm -rf $(BUILD)/obj $(BUILD)/san $(BUILD)/gen $(BUILD)/scene $(BUILD)/size $(PROGRAMS) $(BUILD)/*.bsc $(BUILD)/gen_tables $(BUILD)/bin2c
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

@@ -75,8 +75,8 @@ void scene_file_describe_error(const char *spec, const scene_error *se, char *er
         snprintf(err, errlen, "%s: the scene needs %s, which this build leaves out (it was built for another "
                  "scene; see docs/needs.md)", spec, scene_item_name(se->index));
     else if (se->status == SCENE_ERR_BUILD)
-        snprintf(err, errlen, "%s: the scene needs %u %s, this build provides %u (it was built for another "
-                 "scene; see docs/needs.md)", spec, se->need, scene_item_name(se->index), se->have);
+        snprintf(err, errlen, "%s: the scene needs %s %u; this build provides %u (it was built for another "
+                 "scene; see docs/needs.md)", spec, scene_item_name(se->index), se->need, se->have);
     else if (se->section >= 0)
         snprintf(err, errlen, "%s: compiled scene rejected: %s in %s record %u", spec, st,
                  scene_section_name(se->section), se->index);

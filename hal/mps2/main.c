@@ -104,8 +104,12 @@ int main(void)
     scene_error se;
     scene_status st = eng_init(&e, fw_scene, fw_scene_len, &se);
     if (st == SCENE_ERR_BUILD) {
-        log_printf("firmware: the built-in scene %s needs %u %s, this build provides %u; refusing to run\n",
-                   fw_scene_name, (unsigned)se.need, scene_item_name(se.index), (unsigned)se.have);
+        if (se.index < SCENE_ITEM_EDGES)
+            log_printf("firmware: the built-in scene %s needs %s, which this build leaves out; refusing to run\n",
+                       fw_scene_name, scene_item_name(se.index));
+        else
+            log_printf("firmware: the built-in scene %s needs %s %u; this build provides %u; refusing to run\n",
+                       fw_scene_name, scene_item_name(se.index), (unsigned)se.need, (unsigned)se.have);
         return FW_EXIT_SCENE;
     }
     if (st != SCENE_OK) {
