@@ -76,9 +76,12 @@ $(ARM_OBJ)/%.o: %.c $(GEN)/fx_tables.c $(ARM_CONFIG_DEP)
 	@mkdir -p $(@D)
 	$(ARMCC) $(ARM_CFLAGS) $(ARM_SCENE_DEF) -MMD -MP -c $< -o $@
 
-# What the scene needs, as a C header (rewritten only when it changes).
+# What the scene needs, as a C header (rewritten only when it changes). A scene
+# that does not load gets every feature: the firmware then refuses it at start
+# with the loader's message.
 $(ARM_OUT)/scene_config.h: $(ARM_OUT)/scene.bsc $(BUILD)/bspc
-	$(BUILD)/bspc $< --config $@.tmp
+	@$(BUILD)/bspc $< --config $@.tmp || { echo "mps2: built with every feature (the firmware will refuse the scene)"; \
+	  echo '/* the scene does not load: every feature (build_config.h) */' > $@.tmp; }
 	@cmp -s $@.tmp $@ || mv $@.tmp $@
 	@rm -f $@.tmp
 

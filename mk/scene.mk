@@ -35,7 +35,9 @@ $(SCENE_OUT)/scene.bsc $(SCENE_OUT)/scene_config.h: $(SCENE_OUT)/scene $(BUILD)/
 	  *.bsc) cp '$(SCENE)' $(SCENE_OUT)/scene.bsc ;; \
 	  *) $(BUILD)/bspc '$(SCENE)' -o $(SCENE_OUT)/scene.bsc ;; \
 	esac
-	$(BUILD)/bspc $(SCENE_OUT)/scene.bsc --config $(SCENE_OUT)/scene_config.h.tmp
+	@$(BUILD)/bspc $(SCENE_OUT)/scene.bsc --config $(SCENE_OUT)/scene_config.h.tmp || \
+	  { echo "scene-host: built with every feature (the programs will refuse the scene)"; \
+	    echo '/* the scene does not load: every feature (build_config.h) */' > $(SCENE_OUT)/scene_config.h.tmp; }
 	@cmp -s $(SCENE_OUT)/scene_config.h.tmp $(SCENE_OUT)/scene_config.h || \
 	  mv $(SCENE_OUT)/scene_config.h.tmp $(SCENE_OUT)/scene_config.h
 	@rm -f $(SCENE_OUT)/scene_config.h.tmp
