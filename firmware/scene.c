@@ -372,8 +372,22 @@ void scene_static_bounds(const scene *s, scn_needs *n)
     for (uint32_t i = 0; i < s->nobjects; i++) { /* validated: at most 4096 x 64 faces of 16 + 5 */
         const scn_model *m = &s->models[s->objects[i].model];
         n->object_faces += m->num_faces;
-        for (uint32_t f = 0; f < m->num_faces; f++) n->object_edges += s->faces[m->first_face + f].num_index + 5u;
+        n->object_edges += scene_model_edges(s, m);
     }
+}
+
+uint32_t scene_model_edges(const scene *s, const scn_model *m)
+{
+    uint32_t e = 0; /* validated: at most 64 faces of 16 + 5 */
+    for (uint32_t f = 0; f < m->num_faces; f++) e += s->faces[m->first_face + f].num_index + 5u;
+    return e;
+}
+
+void scene_all_polygons(const scene *s, uint64_t *edges, uint64_t *surfaces)
+{
+    *edges = (uint64_t)s->nsegs * 2u * (4u + 5u);
+    for (uint32_t i = 0; i < s->nleaves; i++) *edges += 2u * ((uint64_t)s->leaves[i].num_pverts + 5u);
+    *surfaces = 2u * ((uint64_t)s->nleaves + s->nsegs);
 }
 
 /* The record must say what the data shows (features and plain bounds), and its
@@ -386,8 +400,8 @@ static scene_status check_needs(const scene *s, scene_error *err)
     scn_needs plain;
     scene_static_bounds(s, &plain);
     uint32_t derived = scene_derived_features(s), analysed = SCN_NEED_LOOK | SCN_NEED_YCLIP;
-    uint64_t all_edges = (uint64_t)s->nsegs * 18u, all_surfs = 2u * ((uint64_t)s->nleaves + s->nsegs);
-    for (uint32_t i = 0; i < s->nleaves; i++) all_edges += 2u * ((uint64_t)s->leaves[i].num_pverts + 5u);
+    uint64_t all_edges, all_surfs;
+    scene_all_polygons(s, &all_edges, &all_surfs);
     if ((n->features & ~SCN_NEED_ALL) || (n->features & ~analysed) != derived || n->edges > all_edges ||
         n->surfaces > all_surfs || n->leaf_verts != plain.leaf_verts || n->model_verts != plain.model_verts ||
         n->face_verts != plain.face_verts || n->object_faces != plain.object_faces ||

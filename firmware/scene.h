@@ -72,6 +72,13 @@ scene_status scene_parse(scene *s, const void *blob, uint32_t len, scene_error *
  * and sums of its records (leaf, model and face vertices, own objects). */
 uint32_t scene_derived_features(const scene *s);
 void scene_static_bounds(const scene *s, scn_needs *n);
+/* Edges of model m's faces after clipping, at most (each face n + 5: one more
+ * vertex per clipping plane). */
+uint32_t scene_model_edges(const scene *s, const scn_model *m);
+/* Every world polygon at once, the bound without the analysis: edges after
+ * clipping (floors and ceilings n + 5, two wall parts of 4 + 5 per seg) and
+ * surfaces. A needs record may never claim more. */
+void scene_all_polygons(const scene *s, uint64_t *edges, uint64_t *surfaces);
 /* "objects", "edges", ...: a SCENE_ITEM_* or feature bit number, for messages. */
 const char *scene_item_name(uint32_t item);
 

@@ -80,9 +80,8 @@ static void object_bound(const scene *s, const world_state *w, uint64_t *faces, 
     for (uint32_t i = 0; i < w->n; i++) {
         uint32_t mi = w->objs ? w->objs[i].model : (i < s->nobjects ? s->objects[i].model : SCN_NONE);
         if (mi >= s->nmodels) continue; /* nothing to draw */
-        const scn_model *m = &s->models[mi];
-        *faces += m->num_faces;
-        for (uint32_t f = 0; f < m->num_faces; f++) *edges += (uint64_t)s->faces[m->first_face + f].num_index + 5u;
+        *faces += s->models[mi].num_faces;
+        *edges += scene_model_edges(s, &s->models[mi]);
     }
 }
 

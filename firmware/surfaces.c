@@ -150,11 +150,3 @@ void surf_leaf(const scene *sc, const world_state *w, const view_xform *v, uint3
     }
     for (uint32_t i = 0; i < f->num_segs; i++) seg_parts(sc, ceil, v, f->first_seg + i, mask, sink, occ, st);
 }
-
-uint32_t surf_max_polygon_verts(const scene *s)
-{
-    uint32_t most = 4;
-    for (uint32_t i = 0; i < s->nleaves; i++)
-        if (s->leaves[i].num_pverts > most) most = s->leaves[i].num_pverts;
-    return most + 5;
-}

@@ -30,8 +30,4 @@ typedef struct {
 void surf_leaf(const scene *s, const world_state *w, const view_xform *v, uint32_t leaf, unsigned clip_mask,
                const surf_sink *sink, occ_columns *occ, render_stats *st);
 
-/* The most screen vertices surf_leaf can hand a sink for this scene (bounds the
- * edge pool of the span renderer). */
-uint32_t surf_max_polygon_verts(const scene *s);
-
 #endif

@@ -230,10 +230,8 @@ int needs_analyse(const scene *s, int look, needs_report *r)
     if (look) n->features |= SCN_NEED_LOOK;
     scene_static_bounds(s, n);
     /* every polygon at once: the bound a renderer must use without this analysis */
-    uint64_t all_e = 0, all_s = 0;
-    for (uint32_t i = 0; i < s->nleaves; i++) all_e += 2u * ((uint64_t)s->leaves[i].num_pverts + CLIP_EXTRA);
-    all_e += (uint64_t)s->nsegs * 2u * WALL_EDGES;
-    all_s = 2u * (uint64_t)s->nleaves + 2u * (uint64_t)s->nsegs;
+    uint64_t all_e, all_s;
+    scene_all_polygons(s, &all_e, &all_s);
     r->all_edges = all_e > UINT32_MAX ? UINT32_MAX : (uint32_t)all_e;
     r->all_surfaces = all_s > UINT32_MAX ? UINT32_MAX : (uint32_t)all_s;
 
