@@ -2,19 +2,20 @@
  * C header for a build compiled for one scene (firmware/build_config.h). */
 #include "needs.h"
 
+/* Why a feature is needed or not, by SCN_NEED_* bit number (its name is
+ * scene_item_name's, as in the loader's messages). */
 static const struct {
-    uint32_t bit;
-    const char *name, *yes, *no;
+    const char *yes, *no;
 } feature_text[] = {
-    {SCN_NEED_OBJECTS, "objects", "the scene has models", "no models"},
-    {SCN_NEED_DOORS, "doors", "a sector's ceiling moves", "every ceiling stays put"},
-    {SCN_NEED_TWO_SIDED, "two-sided walls", "a line has a sector on both sides", "every line is one-sided"},
-    {SCN_NEED_HEIGHTS, "height changes", "floors or ceilings differ", "one floor height, one ceiling height"},
-    {SCN_NEED_SKY, "sky steps", "two sky ceilings meet across a line", "no two sky ceilings meet"},
-    {SCN_NEED_LOOK, "look up/down", "the scene allows it", "the scene says 'look off'"},
-    {SCN_NEED_YCLIP, "y-clipping", "a polygon seen from just beside it crosses the screen's top or bottom",
-     "nothing to draw"},
+    {"the scene has models", "no models"},
+    {"a sector's ceiling moves", "every ceiling stays put"},
+    {"a line has a sector on both sides", "every line is one-sided"},
+    {"floors or ceilings differ", "one floor height, one ceiling height"},
+    {"two sky ceilings meet across a line", "no two sky ceilings meet"},
+    {"the scene allows it", "the scene says 'look off'"},
+    {"a polygon seen from just beside it crosses the screen's top or bottom", "nothing to draw"},
 };
+_Static_assert(SCN_NEED_ALL == (1u << (sizeof feature_text / sizeof feature_text[0])) - 1u, "one text per feature");
 #define NFEATURES (sizeof feature_text / sizeof feature_text[0])
 
 void needs_print(FILE *f, const char *name, const scene *s, const needs_report *r)
@@ -22,9 +23,9 @@ void needs_print(FILE *f, const char *name, const scene *s, const needs_report *
     const scn_needs *n = &r->needs;
     fprintf(f, "%s: what the scene needs (docs/needs.md)\n", name);
     for (unsigned i = 0; i < NFEATURES; i++) {
-        int on = (n->features & feature_text[i].bit) != 0;
-        fprintf(f, "  %-16s %-4s %s\n", feature_text[i].name, on ? "yes" : "no", on ? feature_text[i].yes
-                                                                                  : feature_text[i].no);
+        int on = (n->features & (1u << i)) != 0;
+        fprintf(f, "  %-16s %-4s %s\n", scene_item_name(i), on ? "yes" : "no", on ? feature_text[i].yes
+                                                                              : feature_text[i].no);
     }
     fprintf(f, "  per frame, for any camera and door state (every polygon at once: %u edges, %u surfaces):\n",
             r->all_edges, r->all_surfaces);
@@ -51,7 +52,7 @@ void needs_write_config(FILE *f, const char *name, const scene *s, const scn_nee
                " * from the needs of %s (docs/needs.md). */\n", name);
     fprintf(f, "#define CFG_FEATURES 0x%02xu /*", n->features);
     for (unsigned i = 0; i < NFEATURES; i++)
-        if (n->features & feature_text[i].bit) fprintf(f, " %s;", feature_text[i].name);
+        if (n->features & (1u << i)) fprintf(f, " %s;", scene_item_name(i));
     fprintf(f, " */\n");
     fprintf(f, "#define CFG_MAX_EDGES %uu\n", n->edges);
     fprintf(f, "#define CFG_MAX_SURFACES %uu\n", n->surfaces);
