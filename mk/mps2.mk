@@ -76,14 +76,9 @@ $(ARM_OBJ)/%.o: %.c $(GEN)/fx_tables.c $(ARM_CONFIG_DEP)
 	@mkdir -p $(@D)
 	$(ARMCC) $(ARM_CFLAGS) $(ARM_SCENE_DEF) -MMD -MP -c $< -o $@
 
-# What the scene needs, as a C header (rewritten only when it changes). A scene
-# that does not load gets every feature: the firmware then refuses it at start
-# with the loader's message.
+# What the scene needs, as a C header (mk/scene.mk's recipe).
 $(ARM_OUT)/scene_config.h: $(ARM_OUT)/scene.bsc $(BUILD)/bspc
-	@$(BUILD)/bspc $< --config $@.tmp || { echo "mps2: built with every feature (the firmware will refuse the scene)"; \
-	  echo '/* the scene does not load: every feature (build_config.h) */' > $@.tmp; }
-	@cmp -s $@.tmp $@ || mv $@.tmp $@
-	@rm -f $@.tmp
+	$(call scene_config_recipe,$<,$@,mps2)
 
 # What the built-in part depends on; rewritten only when it changes.
 $(ARM_OUT)/config: FORCE
@@ -92,11 +87,7 @@ $(ARM_OUT)/config: FORCE
 	  echo 'SCENE=$(SCENE) CAMPATH=$(CAMPATH) WORK_BYTES=$(WORK_BYTES) STREAM=$(STREAM) FULL=$(FULL)' > $@
 
 $(ARM_OUT)/scene.bsc: $(ARM_OUT)/config $(BUILD)/bspc $(wildcard $(firstword $(subst :, ,$(SCENE))))
-	@mkdir -p $(@D)
-	@case '$(SCENE)' in \
-	  *.bsc) echo "mps2: $(SCENE) is compiled already: built in as it is"; cp '$(SCENE)' $@ ;; \
-	  *) $(BUILD)/bspc '$(SCENE)' -o $@ ;; \
-	esac
+	$(call scene_bsc_recipe,$@,mps2)
 
 # The built-in part: the scene, its name, the camera path and a work area of
 # $(2) bytes, as C ($(1) the output file).

@@ -30,17 +30,29 @@ $(SCENE_OUT)/scene: SCENE_FORCE
 	@mkdir -p $(@D)
 	@echo '$(SCENE)' | cmp -s - $@ || echo '$(SCENE)' > $@
 
-$(SCENE_OUT)/scene.bsc $(SCENE_OUT)/scene_config.h: $(SCENE_OUT)/scene $(BUILD)/bspc $(wildcard $(firstword $(subst :, ,$(SCENE))))
+# Recipes shared with mk/mps2.mk. $(1) the compiled scene to write: SCENE
+# compiled by build/bspc, or copied when it is compiled already; $(2) who says so.
+define scene_bsc_recipe
+	@mkdir -p $(dir $(1))
 	@case '$(SCENE)' in \
-	  *.bsc) cp '$(SCENE)' $(SCENE_OUT)/scene.bsc ;; \
-	  *) $(BUILD)/bspc '$(SCENE)' -o $(SCENE_OUT)/scene.bsc ;; \
+	  *.bsc) echo "$(2): $(SCENE) is compiled already: used as it is"; cp '$(SCENE)' $(1) ;; \
+	  *) $(BUILD)/bspc '$(SCENE)' -o $(1) ;; \
 	esac
-	@$(BUILD)/bspc $(SCENE_OUT)/scene.bsc --config $(SCENE_OUT)/scene_config.h.tmp || \
-	  { echo "scene-host: built with every feature (the programs will refuse the scene)"; \
-	    echo '/* the scene does not load: every feature (build_config.h) */' > $(SCENE_OUT)/scene_config.h.tmp; }
-	@cmp -s $(SCENE_OUT)/scene_config.h.tmp $(SCENE_OUT)/scene_config.h || \
-	  mv $(SCENE_OUT)/scene_config.h.tmp $(SCENE_OUT)/scene_config.h
-	@rm -f $(SCENE_OUT)/scene_config.h.tmp
+endef
+# $(1) the compiled scene, $(2) the header to write (only when it changes), $(3)
+# who says so. A scene that does not load gets every feature, so the build
+# refuses it at start with the loader's message.
+define scene_config_recipe
+	@$(BUILD)/bspc $(1) --config $(2).tmp || { echo "$(3): built with every feature (it will refuse the scene)"; \
+	  echo '/* the scene does not load: every feature (build_config.h) */' > $(2).tmp; }
+	@cmp -s $(2).tmp $(2) || mv $(2).tmp $(2)
+	@rm -f $(2).tmp
+endef
+
+$(SCENE_OUT)/scene.bsc: $(SCENE_OUT)/scene $(BUILD)/bspc $(wildcard $(firstword $(subst :, ,$(SCENE))))
+	$(call scene_bsc_recipe,$@,scene-host)
+$(SCENE_OUT)/scene_config.h: $(SCENE_OUT)/scene.bsc $(BUILD)/bspc
+	$(call scene_config_recipe,$<,$@,scene-host)
 
 SCENE_DEF = -DSCENE_CONFIG='"$(abspath $(SCENE_OUT)/scene_config.h)"'
 
