@@ -32,7 +32,7 @@ FLOATFREE := firmware/% hal/fb.c hal/perf.c hal/ram_target.c hal/null/% hal/seri
 # sources to LINK_SRC (the frame link, linked into host programs and unit tests),
 # UNIT_EXTRA (more sources for the unit tests) and EXTRA_NOFLOAT_SRC.
 LINK_SRC   := $(wildcard hal/serial/*.c)
-UNIT_EXTRA :=
+UNIT_EXTRA := tests/unit/scene_fixture.c
 EXTRA_NOFLOAT_SRC :=
 -include $(sort $(wildcard mk/*.mk))
 

@@ -39,6 +39,7 @@
 #include "crc32.h"
 #include "scene.h"
 #include "scene_format.h"
+#include "scene_fixture.h"
 
 __extension__ typedef __int128 i128;
 
@@ -496,21 +497,10 @@ static void check_blob(const uint8_t *b, size_t len)
 
 /* ------------------------------------------------------------ helpers */
 
-static char *write_temp(const char *text)
-{
-    char *path = strdup("/tmp/test_bsp_XXXXXX");
-    int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    size_t n = strlen(text);
-    assert_int_equal(write(fd, text, n), (ssize_t)n);
-    close(fd);
-    return path;
-}
-
 static int compile_text(const char *text, bspc_split split, uint8_t **blob, size_t *len,
                         bspc_stats *st, char *err, size_t errlen, char **pathout)
 {
-    char *path = write_temp(text);
+    char *path = fixture_write_temp(text);
     bspc_options o = bspc_defaults();
     o.split = split;
     int rc = bspc_compile(path, &o, blob, len, st, err, errlen);

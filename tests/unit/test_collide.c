@@ -25,6 +25,7 @@
 #include "collide.h"
 #include "hal.h"
 #include "scene.h"
+#include "scene_fixture.h"
 
 __extension__ typedef __int128 i128;
 
@@ -53,14 +54,7 @@ static void load_spec(loaded *l, const char *spec)
 
 static void load_text(loaded *l, const char *text)
 {
-    char path[] = "/tmp/test_collide_XXXXXX";
-    int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    size_t n = strlen(text);
-    assert_int_equal(write(fd, text, n), (ssize_t)n);
-    close(fd);
-    load_spec(l, path);
-    unlink(path);
+    fixture_load_text(text, &l->blob, &l->s);
 }
 
 static void unload(loaded *l) { free(l->blob); }

@@ -31,6 +31,7 @@
 #include "objects.h"
 #include "render.h"
 #include "scene.h"
+#include "scene_fixture.h"
 
 #define U(v) ((fx_t)((v) * 65536.0)) /* map units to 16.16 (test values are exact) */
 #define PI 3.14159265358979323846
@@ -45,21 +46,7 @@ typedef struct {
 
 static void load_text(loaded *l, const char *text)
 {
-    char path[] = "/tmp/test_objects_XXXXXX";
-    int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    size_t n = strlen(text);
-    assert_int_equal(write(fd, text, n), (ssize_t)n);
-    close(fd);
-    char err[512];
-    size_t len = 0;
-    bspc_options o = bspc_defaults();
-    int rc = bspc_compile(path, &o, &l->blob, &len, NULL, err, sizeof err);
-    unlink(path);
-    if (rc) fprintf(stderr, "%s\n", err);
-    assert_int_equal(rc, 0);
-    l->len = (uint32_t)len;
-    assert_int_equal(scene_load(&l->s, l->blob, (uint32_t)len, NULL), SCENE_OK);
+    l->len = fixture_load_text(text, &l->blob, &l->s);
 }
 
 static void unload(loaded *l) { free(l->blob); }

@@ -22,6 +22,7 @@
 #include "hal_null.h"
 #include "render.h"
 #include "scene.h"
+#include "scene_fixture.h"
 
 #define U(v) ((fx_t)((int64_t)(v) * 65536))
 
@@ -63,20 +64,7 @@ static world W;
 static int setup(void **state)
 {
     (void)state;
-    char path[] = "/tmp/test_ranges_XXXXXX.scene";
-    int fd = mkstemps(path, 6);
-    assert_true(fd >= 0);
-    size_t n = strlen(SCENE_TEXT);
-    assert_int_equal(write(fd, SCENE_TEXT, n), (ssize_t)n);
-    close(fd);
-    char err[512];
-    size_t len = 0;
-    bspc_options o = bspc_defaults();
-    int rc = bspc_compile(path, &o, &W.blob, &len, NULL, err, sizeof err);
-    unlink(path);
-    if (rc) fprintf(stderr, "%s\n", err);
-    assert_int_equal(rc, 0);
-    assert_int_equal(scene_load(&W.s, W.blob, (uint32_t)len, NULL), SCENE_OK);
+    fixture_load_text(SCENE_TEXT, &W.blob, &W.s);
     W.work.bytes = render_work_bytes(&W.s, NULL);
     W.work.mem = malloc(W.work.bytes);
     assert_non_null(W.work.mem);

@@ -21,6 +21,7 @@
 #include "engine.h"
 #include "hal_null.h"
 #include "scene.h"
+#include "scene_fixture.h"
 
 static uint8_t *blob;
 static size_t blob_len;
@@ -53,18 +54,8 @@ static const char OBJECTS_SCENE[] =
 
 static int compile_text(const char *text, uint8_t **out, size_t *len)
 {
-    char path[] = "/tmp/test_scene_XXXXXX";
-    int fd = mkstemp(path);
-    if (fd < 0) return -1;
-    size_t n = strlen(text);
-    int ok = write(fd, text, n) == (ssize_t)n;
-    close(fd);
     char err[256];
-    bspc_options opt = bspc_defaults();
-    int rc = ok ? bspc_compile(path, &opt, out, len, NULL, err, sizeof err) : -1;
-    if (rc) fprintf(stderr, "%s\n", err);
-    unlink(path);
-    return rc;
+    return fixture_compile_text(text, NULL, out, len, NULL, err, sizeof err);
 }
 
 static int setup(void **state)
