@@ -11,12 +11,16 @@ import select
 import shutil
 import struct
 import subprocess
+import sys
 import zlib
 
 import pytest
 
 from conftest import BUILD, ROOT
 from linkrig import Firmware
+
+sys.path.insert(0, str(ROOT / "tools"))
+from armelf import symbol  # noqa: E402
 
 QEMU = shutil.which("qemu-system-arm")
 TIMEOUT = 60
@@ -77,15 +81,6 @@ def fx_text(raw):
     if not frac:
         return f"{sign}{whole}"
     return f"{sign}{whole}." + f"{frac * 152587890625:016d}".rstrip("0")
-
-
-def symbol(elf, name):
-    out = subprocess.run(["arm-none-eabi-nm", str(elf)], capture_output=True, text=True, check=True).stdout
-    for line in out.splitlines():
-        parts = line.split()
-        if len(parts) == 3 and parts[2] == name:
-            return int(parts[0], 16)
-    raise AssertionError(f"{name} not in {elf}")
 
 
 @pytest.fixture(scope="module")

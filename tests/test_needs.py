@@ -11,11 +11,16 @@
 """
 import json
 import random
+import struct
 import subprocess
+import sys
 
 import pytest
 
-from conftest import BUILD, ROOT, WADDIR, program, run
+from conftest import ROOT, WADDIR, program, run
+
+sys.path.insert(0, str(ROOT / "tools"))
+import armelf  # noqa: E402
 
 BENCH = json.loads((ROOT / "tests" / "bench_views.json").read_text())["views"]
 EXTREME = sorted((ROOT / "tests" / "scenes" / "extreme").glob("*.json"))
@@ -118,7 +123,6 @@ def test_bounds_hold_for_any_camera(tmp_path, spec):
 
 def bounds_box(bsc):
     """x0, x1, y0, y1 of a compiled scene's vertices, in units (read from the blob's vertex section)."""
-    import struct
     data = bsc.read_bytes()
     off, count = struct.unpack_from("<II", data, 44)
     xs, ys = [], []
@@ -204,8 +208,6 @@ def test_scene_build_is_smaller(tmp_path):
         out = "build/" + ("arm-needs-full" if full else "arm-needs-scene")
         subprocess.run(["make", "-s", "--no-print-directory", "-j4", "firmware", f"ARM_OUT={out}",
                         f"FULL={full}"], cwd=ROOT, check=True, capture_output=True, timeout=900)
-        text = subprocess.run(["arm-none-eabi-size", "-A", ROOT / out / "firmware.elf"], capture_output=True, text=True,
-                              check=True).stdout
-        sec = {l.split()[0]: int(l.split()[1]) for l in text.splitlines() if l.startswith(".")}
+        sec = armelf.sections(ROOT / out / "firmware.elf")
         sizes[bool(full)] = sec[".text"] + sec.get(".rodata", 0)
     assert sizes[False] < sizes[True], sizes

@@ -32,6 +32,8 @@ import sys
 import zlib
 from pathlib import Path
 
+import armelf
+
 ROOT = Path(__file__).resolve().parent.parent
 BUILD = ROOT / "build"
 FRAME = 64000
@@ -76,8 +78,7 @@ def m3_counts(frames_raw, n, fltool):
         (bench / "frames.raw").write_bytes(frames_raw[start * FRAME:(start + count) * FRAME])
         sh(["make", "-s", "--no-print-directory", "build/flbench/m3.elf"], cwd=ROOT)
         elf = bench / "m3.elf"
-        syms = sh(["arm-none-eabi-nm", elf]).stdout.split("\n")
-        addr = {l.split()[2]: "0x" + l.split()[0] for l in syms if len(l.split()) == 3}
+        addr = {name: f"{a:#x}" for name, (a, _) in armelf.symbols(elf).items()}
         out = bench / "insns.txt"
         proc = subprocess.run(["qemu-system-arm", "-M", "mps2-an385", "-nographic", "-monitor", "none", "-serial",
                                "null", "-semihosting-config", "enable=on,target=native", "-kernel", str(elf), "-plugin",

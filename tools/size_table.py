@@ -19,6 +19,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import armelf
+
 ROOT = Path(__file__).resolve().parent.parent
 WADDIR = Path(os.environ.get("DOOMWADDIR", "/usr/share/games/doom"))
 FEATURES = ["objects", "doors", "two-sided walls", "height changes", "sky steps", "look up/down", "y-clipping"]
@@ -51,30 +53,16 @@ def make(*args):
         sys.exit(f"size_table: make {' '.join(args)} failed:\n{proc.stdout}{proc.stderr}")
 
 
-def sections(elf):
-    out = subprocess.run(["arm-none-eabi-size", "-A", str(elf)], capture_output=True, text=True, check=True).stdout
-    return {l.split()[0]: int(l.split()[1]) for l in out.splitlines() if l.startswith(".")}
-
-
-def symbol_size(elf, name):
-    out = subprocess.run(["arm-none-eabi-nm", "-S", str(elf)], capture_output=True, text=True, check=True).stdout
-    for line in out.splitlines():
-        parts = line.split()
-        if len(parts) == 4 and parts[3] == name:
-            return int(parts[1], 16)
-    return 0
-
-
 def measure(spec, full):
     name = spec.split("/")[-1].replace(".", "_").replace(":", "-")
     out = f"build/size/{name}-{'full' if full else 'scene'}"
     make("firmware", f"SCENE={spec}", f"ARM_OUT={out}", f"FULL={'1' if full else ''}")
     elf = ROOT / out / "firmware.elf"
-    sec = sections(elf)
+    sec = armelf.sections(elf)
+    blob = armelf.symbols(elf).get("fw_scene", (0, 0))[1]
     flash = sec.get(".text", 0) + sec.get(".ARM.exidx", 0) + sec.get(".data", 0)
     ram = sec.get(".data", 0) + sec.get(".bss", 0) + sec.get(".work", 0)
-    return {"flash": flash, "ram": ram, "work": sec.get(".work", 0), "blob": symbol_size(elf, "fw_scene"),
-            "code": flash - symbol_size(elf, "fw_scene")}
+    return {"flash": flash, "ram": ram, "work": sec.get(".work", 0), "blob": blob, "code": flash - blob}
 
 
 def needs(spec):

@@ -24,6 +24,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent.parent
 BUILD = ROOT / "build"
+sys.path.insert(0, str(ROOT / "tools"))
+import armelf  # noqa: E402
 CLOCKS = (48_000_000, 133_000_000)
 
 
@@ -34,12 +36,10 @@ def make(*args):
 
 
 def symbol(elf, name):
-    out = subprocess.run(["arm-none-eabi-nm", str(elf)], capture_output=True, text=True, check=True).stdout
-    for line in out.splitlines():
-        parts = line.split()
-        if len(parts) == 3 and parts[2] == name:
-            return int(parts[0], 16)
-    sys.exit(f"bench_m3: {name} not in {elf}")
+    try:
+        return armelf.symbol(elf, name)
+    except LookupError as e:
+        sys.exit(f"bench_m3: {e}")
 
 
 def count(elf, args, out):
