@@ -96,6 +96,8 @@ help:
 	@echo "                Cortex-M3 instructions per frame (bench-m3); link faults (bench-faults);"
 	@echo "                firmware flash and RAM, full against built for one scene (bench-size)"
 	@echo "make scene-host SCENE=...  build/scene/NAME/render, emu built for one scene (docs/needs.md)"
+	@echo "make fuzz       each libFuzzer harness (tests/fuzz) for FUZZ_TIME seconds (default 60), FUZZ=names;"
+	@echo "                make fuzz-smoke (part of make test): seeds and kept crashes once, 3 s each"
 	@echo "make bench-link the frame link's bytes per frame and encoder cost"
 	@echo "make firmware   build/arm/firmware.elf for QEMU mps2-an385, built for its scene (SCENE=, FULL=1,"
 	@echo "                CAMPATH=); make run-firmware"
@@ -125,7 +127,7 @@ pytest: $(PROGRAMS) $(SAN_PROGS)
 	$(PY) -m pytest -q tests
 
 test: deps
-	@$(MAKE) --no-print-directory all unit
+	@$(MAKE) --no-print-directory all unit fuzz-smoke
 	@$(MAKE) --no-print-directory pytest
 
 bench-bsp: deps $(BUILD)/bspc
@@ -145,6 +147,6 @@ bench-size: deps $(BUILD)/bspc $(BUILD)/render
 .PHONY: bench-size
 
 clean:
-	rm -rf $(BUILD)/obj $(BUILD)/san $(BUILD)/gen $(BUILD)/scene $(BUILD)/size $(PROGRAMS) $(BUILD)/*.bsc $(BUILD)/gen_tables $(BUILD)/bin2c
+	rm -rf $(BUILD)/obj $(BUILD)/san $(BUILD)/gen $(BUILD)/scene $(BUILD)/size $(PROGRAMS) $(BUILD)/*.bsc $(BUILD)/gen_tables $(BUILD)/bin2c $(BUILD)/fuzz/obj $(BUILD)/fuzz/fuzz_*
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

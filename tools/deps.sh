@@ -17,6 +17,7 @@ PACKAGES=(
   freedoom                    # real maps: freedoom1.wad, freedoom2.wad
   zdbsp glbsp                 # other BSP compilers, for make bench-bsp
   valgrind                    # instruction counts
+  clang libclang-rt-14-dev    # libFuzzer harnesses with ASan and UBSan (make fuzz, tests/fuzz)
   xvfb xauth                  # a display for SDL tests on headless machines
   python3 python3-venv        # tests and tools
 )
