@@ -48,7 +48,7 @@ $(1)/obj/$(GEN)/%.o: $(GEN)/%.c
 	@mkdir -p $$(@D)
 	$$(CC) $$(BASE) $(2) $$(FW_FLAGS) -c $$< -o $$@
 
-$(1)/bspc: $(call objs,$(1)/obj,tools/bspc/main.c $(BSPC_LIB) firmware/crc32.c firmware/scene.c)
+$(1)/bspc: $(call objs,$(1)/obj,tools/bspc/main.c $(BSPC_LIB) host/scene_file.c firmware/crc32.c firmware/scene.c)
 	$$(CC) $(2) $$^ -o $$@ -lm
 $(1)/render: $(call objs,$(1)/obj,host/render.c $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC))
 	$$(CC) $(2) $$^ -o $$@ -lm

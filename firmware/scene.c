@@ -298,7 +298,9 @@ scene_status scene_parse(scene *s, const void *blob, uint32_t len, scene_error *
     const scn_header *h = (const scn_header *)blob;
     if (h->magic != SCN_MAGIC) return fail(err, SCENE_ERR_MAGIC, -1, 0);
     if (h->version != SCN_VERSION) return fail(err, SCENE_ERR_VERSION, -1, 0);
-    if (h->header_bytes != sizeof(scn_header) || (h->total_bytes & 3u)) return fail(err, SCENE_ERR_HEADER, -1, 0);
+    /* total_bytes below the header would make the CRC's length below wrap */
+    if (h->header_bytes != sizeof(scn_header) || (h->total_bytes & 3u) || h->total_bytes < sizeof(scn_header))
+        return fail(err, SCENE_ERR_HEADER, -1, 0);
     if (h->total_bytes > len) return fail(err, SCENE_ERR_SHORT, -1, 0);
     if (crc_update(0, base + 16, h->total_bytes - 16) != h->crc32) return fail(err, SCENE_ERR_CRC, -1, 0);
     if (h->flags != 0) return fail(err, SCENE_ERR_HEADER, -1, 0);

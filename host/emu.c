@@ -128,7 +128,7 @@ int main(int argc, char **argv)
     static engine e;
     scene_error se;
     if (len > UINT32_MAX || eng_init(&e, data, (uint32_t)len, &se) != SCENE_OK) {
-        scene_file_describe_error(spec ? spec : "built-in scene", &se, err, sizeof err);
+        scene_file_describe_error(spec ? spec : "built-in scene", data, len, &se, err, sizeof err);
         fprintf(stderr, "emu: %s\n", err);
         free(blob);
         return 1;

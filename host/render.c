@@ -497,7 +497,7 @@ int main(int argc, char **argv)
     scene_error se;
     hal_null_reset();
     if (len > UINT32_MAX || eng_init(&e, blob, (uint32_t)len, &se) != SCENE_OK) {
-        scene_file_describe_error(o.scene, &se, err, sizeof err);
+        scene_file_describe_error(o.scene, blob, len, &se, err, sizeof err);
         fprintf(stderr, "render: %s\n", err);
         free(blob);
         return 1;

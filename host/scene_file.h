@@ -12,7 +12,10 @@
  * message naming the file and the problem in err. */
 int scene_file_load(const char *spec, const bspc_options *opt, uint8_t **blob, size_t *len, char *err, size_t errlen);
 
-/* The loader's verdict on a blob as one line ("FILE: bad CRC-32"), for messages. */
-void scene_file_describe_error(const char *spec, const scene_error *se, char *err, size_t errlen);
+/* The loader's verdict on blob[0..len) as one line naming the file, the item
+ * (a header field, a section, a record and its index) and the problem
+ * ("FILE: compiled scene rejected: segs record 3: index out of range"). */
+void scene_file_describe_error(const char *spec, const uint8_t *blob, size_t len, const scene_error *se, char *err,
+                               size_t errlen);
 
 #endif

@@ -21,6 +21,7 @@
  *       Encodes the frames R times (for callgrind: instructions per frame are
  *       the difference between two R's) without writing anything.
  */
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -133,9 +134,12 @@ static int cmd_walk(int argc, char **argv)
         return 1;
     }
     static engine e;
+    scene_error se;
     hal_null_reset();
-    if (eng_init(&e, blob, (uint32_t)len, NULL) != SCENE_OK) {
-        fprintf(stderr, "fltool: %s: bad scene\n", spec);
+    if (eng_init(&e, blob, (uint32_t)len, &se) != SCENE_OK) {
+        scene_file_describe_error(spec, blob, len, &se, err, sizeof err);
+        fprintf(stderr, "fltool: %s\n", err);
+        free(blob);
         return 1;
     }
     uint32_t need = eng_work_bytes(&e);
@@ -266,7 +270,7 @@ static int cmd_encode(int argc, char **argv, int bench)
     size_t len;
     uint8_t *raw = read_file(in, &len);
     if (!raw) {
-        fprintf(stderr, "fltool: %s: cannot read\n", in);
+        fprintf(stderr, "fltool: %s: cannot read: %s\n", in, strerror(errno));
         return 1;
     }
     long nframes = (long)(len / FL_FRAME_BYTES);
@@ -408,7 +412,7 @@ static int cmd_decode(int argc, char **argv)
     size_t len;
     uint8_t *data = read_file(in, &len);
     if (!data) {
-        fprintf(stderr, "fltool: %s: cannot read\n", in);
+        fprintf(stderr, "fltool: %s: cannot read: %s\n", in, strerror(errno));
         return 1;
     }
     static fl_decoder dec;
@@ -449,7 +453,7 @@ static int cmd_digest(int argc, char **argv)
     size_t len;
     uint8_t *raw = read_file(argv[0], &len);
     if (!raw) {
-        fprintf(stderr, "fltool: %s: cannot read\n", argv[0]);
+        fprintf(stderr, "fltool: %s: cannot read: %s\n", argv[0], strerror(errno));
         return 1;
     }
     size_t n = len / FL_FRAME_BYTES;

@@ -195,6 +195,10 @@ static int check_image(const char *path, const uint8_t *data, size_t len, int ha
                 img->id_product, vid, pid);
     else if (e == DFU_IMAGE_TOO_SHORT)
         fprintf(stderr, " (%zu bytes)", len);
+    else if (e == DFU_IMAGE_BAD_LENGTH) /* the field as found, so the message names the value */
+        fprintf(stderr, " (bLength %u, file %zu bytes)", img->suffix_len, len);
+    else if (e == DFU_IMAGE_BAD_VERSION)
+        fprintf(stderr, " (bcdDFU %04x)", img->bcd_dfu);
     fprintf(stderr, "; nothing was sent to the device\n");
     return -1;
 }

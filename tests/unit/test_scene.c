@@ -134,6 +134,13 @@ static void test_header_damage(void **state)
          * (load_copy has then rendered a frame from them under ASan) */
         if (i < 20) assert_int_not_equal(st, SCENE_OK);
     }
+    /* total_bytes below the header (0, 4, 8, 12 pass the multiple-of-4 test): refused
+     * before the CRC, whose length total_bytes - 16 would wrap */
+    for (uint32_t total = 0; total < sizeof(scn_header); total += 4) {
+        memcpy(b, blob, blob_len);
+        memcpy(b + 8, &total, 4);
+        assert_int_equal(load_copy(b, blob_len, &err), SCENE_ERR_HEADER);
+    }
     /* a bad CRC */
     memcpy(b, blob, blob_len);
     b[blob_len - 1] ^= 1;

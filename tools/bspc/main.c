@@ -8,6 +8,7 @@
 
 #include "bspc.h"
 #include "scene.h"
+#include "scene_file.h"
 
 static void usage(FILE *f)
 {
@@ -79,25 +80,23 @@ static int is_compiled(const char *path)
     return n == 4 && ((uint32_t)m[0] | (uint32_t)m[1] << 8 | (uint32_t)m[2] << 16 | (uint32_t)m[3] << 24) == SCN_MAGIC;
 }
 
-/* --config for a scene compiled before: its own needs record, once it loads. */
+/* --config for a scene compiled before: its own needs record, once it loads. It is
+ * read and judged as build/render does, so both refuse it with the same words. */
 static int config_from_compiled(const char *in, const char *config)
 {
-    FILE *f = fopen(in, "rb");
-    if (!f) {
-        fprintf(stderr, "bspc: %s: cannot read: %s\n", in, strerror(errno));
+    uint8_t *blob;
+    size_t n;
+    char err[512];
+    bspc_options opt = bspc_defaults();
+    if (scene_file_load(in, &opt, &blob, &n, err, sizeof err) != 0) {
+        fprintf(stderr, "bspc: %s\n", err);
         return 1;
     }
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    uint32_t *blob = malloc(n > 0 ? (size_t)n + 4 : 4);
-    size_t got = blob && n > 0 ? fread(blob, 1, (size_t)n, f) : 0;
-    fclose(f);
     scene sc;
     scene_error se;
-    if (!blob || n <= 0 || got != (size_t)n || scene_load(&sc, blob, (uint32_t)n, &se) != SCENE_OK) {
-        fprintf(stderr, "bspc: %s: not a compiled scene this version loads%s%s\n", in, blob && got == (size_t)n ? ": " : "",
-                blob && got == (size_t)n ? scene_status_text(se.status) : "");
+    if (scene_load(&sc, blob, (uint32_t)n, &se) != SCENE_OK) { /* scene_file_load reads at most 256 MiB */
+        scene_file_describe_error(in, blob, n, &se, err, sizeof err);
+        fprintf(stderr, "bspc: %s\n", err);
         free(blob);
         return 1;
     }

@@ -33,6 +33,7 @@ typedef struct {
     uint32_t *vhash; /* vertex index + 1 */
     uint32_t hcap;
     int in_model;    /* between 'model' and 'end' */
+    const char *stmt; /* the statement being read, for messages of helpers shared by several */
 } parser;
 
 static int perr(parser *p, const char *fmt, ...)
@@ -66,14 +67,14 @@ static int parse_color(parser *p, const char *key, const char *val, uint8_t *out
     long v;
     if (isdigit((unsigned char)val[0])) {
         if (parse_int(val, 0, 255, &v))
-            return perr(p, "%s=%s: a colour is a palette index 0..255 or NAME[:SHADE]", key, val);
+            return perr(p, "%s: %s=%s: a colour is a palette index 0..255 or NAME[:SHADE]", p->stmt, key, val);
         *out = (uint8_t)v;
         return 0;
     }
     int c = bs_color_by_name(val);
     if (c < 0)
-        return perr(p, "%s=%s: unknown colour (a palette index 0..255, or a ramp name such as "
-                       "red or red:12, shade 0..15)", key, val);
+        return perr(p, "%s: %s=%s: unknown colour (a palette index 0..255, or a ramp name such as "
+                       "red or red:12, shade 0..15)", p->stmt, key, val);
     *out = (uint8_t)c;
     return 0;
 }
@@ -603,8 +604,8 @@ static int check_duplicates(parser *p)
                 i1 = t;
             }
             p->line = s->lines[i1].src_line;
-            rc = perr(p, "wall: duplicates the wall on line %d (same two points)",
-                      s->lines[i0].src_line);
+            rc = perr(p, "wall: duplicates the wall on line %d (same two points%s)", s->lines[i0].src_line,
+                      s->lines[i0].v1 == s->lines[i1].v1 ? "" : ", reversed");
             break;
         }
     }
@@ -642,14 +643,20 @@ int bs_read_text(const char *path, bs_scene *s, const bspc_options *opt, char *e
     }
     buf[len] = 0;
     if (strlen(buf) != len) {
+        /* binary: say what it is not, and what it is when it is a compiled scene */
+        int compiled = len >= 4 && memcmp(buf, "BSCN", 4) == 0;
         free(buf);
-        return bs_fail(err, errlen, "%s: not a text scene (contains NUL bytes)", path);
+        if (compiled)
+            return bs_fail(err, errlen, "%s: a compiled scene, not a source to compile (bspc --config reads "
+                           "one; build/render draws it)", path);
+        return bs_fail(err, errlen, "%s: not a scene: not text (contains NUL bytes), and its magic is not "
+                       "\"BSCN\" (a compiled scene's)", path);
     }
 
     snprintf(s->name, sizeof s->name, "%s", path);
     s->is_text = 1;
     s->player_sector = SCN_NONE;
-    parser p = {path, 0, err, errlen, s, NULL, 0, 0};
+    parser p = {path, 0, err, errlen, s, NULL, 0, 0, ""};
     int rc = 0;
     char *line = buf;
     while (line && rc == 0) {
@@ -674,6 +681,7 @@ int bs_read_text(const char *path, bs_scene *s, const bspc_options *opt, char *e
             line = next;
             continue;
         }
+        p.stmt = tok[0];
         if (p.in_model) {
             if (strcmp(tok[0], "part") == 0)
                 rc = do_part(&p, tok, n);
@@ -712,7 +720,9 @@ int bs_read_text(const char *path, bs_scene *s, const bspc_options *opt, char *e
     if (p.in_model)
         return bs_fail(err, errlen, "%s:%d: model '%s': 'end' missing", path, cur_model(&p)->src_line,
                        cur_model(&p)->name);
-    if (s->nlines == 0) return bs_fail(err, errlen, "%s: no walls", path);
-    if (!s->has_player) return bs_fail(err, errlen, "%s: no player start (add 'player X Y ANGLE')", path);
+    /* what is missing is missing at the end of the file: its last line */
+    if (s->nlines == 0) return bs_fail(err, errlen, "%s:%d: end of file: no walls", path, p.line);
+    if (!s->has_player)
+        return bs_fail(err, errlen, "%s:%d: end of file: no player start (add 'player X Y ANGLE')", path, p.line);
     return check_duplicates(&p);
 }

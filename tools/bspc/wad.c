@@ -283,9 +283,17 @@ int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_sc
     uint8_t hdr[12];
     long flen = -1;
     if (fseek(f, 0, SEEK_END) == 0) flen = ftell(f);
-    if (flen < 12 || read_at(f, 0, 12, hdr) ||
-        (memcmp(hdr, "IWAD", 4) != 0 && memcmp(hdr, "PWAD", 4) != 0)) {
-        bs_fail(err, errlen, "%s: %s is not a WAD file (no IWAD/PWAD magic)", display, wadpath);
+    if (flen < 12 || read_at(f, 0, 12, hdr)) {
+        bs_fail(err, errlen, "%s: %s is not a WAD file (%ld bytes, shorter than the 12-byte header)", display,
+                wadpath, flen < 0 ? 0L : flen);
+        goto out;
+    }
+    if (memcmp(hdr, "IWAD", 4) != 0 && memcmp(hdr, "PWAD", 4) != 0) {
+        char magic[5];
+        for (int i = 0; i < 4; i++) magic[i] = isprint(hdr[i]) ? (char)hdr[i] : '?';
+        magic[4] = 0;
+        bs_fail(err, errlen, "%s: %s is not a WAD file (header magic '%s', not IWAD or PWAD)", display, wadpath,
+                magic);
         goto out;
     }
     size_t len = (size_t)flen;
