@@ -29,7 +29,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     memcpy(blob, data + 1 + FUZZ_VIEW_BYTES, len);
     if (len >= sizeof(scn_header)) {
         if (flags & 2) put32(blob + offsetof(scn_header, total_bytes), (uint32_t)len);
-        if (flags & 1) put32(blob + offsetof(scn_header, crc32), crc_update(0, blob + 16, len - 16));
+        /* over the length the header declares, as the loader reads it, when that lies in the blob */
+        uint32_t total = (uint32_t)blob[8] | (uint32_t)blob[9] << 8 | (uint32_t)blob[10] << 16 |
+                         (uint32_t)blob[11] << 24;
+        if (total < 16 || total > len) total = (uint32_t)len;
+        if (flags & 1) put32(blob + offsetof(scn_header, crc32), crc_update(0, blob + 16, total - 16));
     }
     fuzz_draw(blob, len, NULL, 0);
     fuzz_draw(blob, len, &view, 0);

@@ -118,6 +118,7 @@ static int split_set(builder *B, work *w, bs_part c, work *front, work *back, ch
             } else if (x == g.x2 && y == g.y2) {
                 to = (a > 0) ? front : back;
             } else {
+                if (bs_seg_budget_check(t, B->s->name, 1, g.line, err, errlen)) return -1;
                 uint32_t v = bs_vertex(t, x, y);
                 if (v == SCN_NONE) return bs_fail(err, errlen, "%s: out of memory", B->s->name);
                 if (bs_grow(&t->segs, &t->segcap, t->nsegs + 1, sizeof(bs_seg)))
@@ -429,4 +430,14 @@ out:
     free(stack);
     bs_chooser_free(B.chooser);
     return rc;
+}
+
+int bs_seg_budget_check(const bs_tree *t, const char *name, uint32_t more, uint32_t line, char *err, size_t errlen)
+{
+    uint64_t budget = BS_SEG_BUDGET(t);
+    if ((uint64_t)t->nsegs + more <= budget) return 0;
+    return bs_fail(err, errlen,
+                   "%s: linedef %u: the walls are cut into more than %llu pieces (16 per wall side + 65,536): "
+                   "walls that cross each other?",
+                   name, line, (unsigned long long)budget);
 }

@@ -162,7 +162,7 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
     double t0 = bs_now_ms();
     if (bs_build(&s, &opt, &t, err, errlen)) goto out;
     double t_tree = bs_now_ms();
-    if (bs_tjunc_segs(&t, err, errlen) || bs_tjunc_polys(&t, err, errlen)) goto out;
+    if (bs_tjunc_segs(&t, s.name, err, errlen) || bs_tjunc_polys(&t, err, errlen)) goto out;
     double t_tj = bs_now_ms();
 
     uint64_t dsum = 0;

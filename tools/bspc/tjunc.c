@@ -76,12 +76,20 @@ static void grid_free(grid *g)
 typedef struct {
     int32_t x, y;
     bs_i128 along; /* (P - A) . (B - A) */
+    uint32_t seq;  /* order found: equal distances keep it */
 } hit;
 
 typedef struct {
     hit *h;
     uint32_t n, cap;
 } hits;
+
+static int hit_cmp(const void *a, const void *b)
+{
+    const hit *p = a, *q = b;
+    if (p->along != q->along) return p->along > q->along ? 1 : -1;
+    return (p->seq > q->seq) - (p->seq < q->seq);
+}
 
 /* points of the grid strictly inside segment A-B (within BS_TJ_TOL of it), sorted from A */
 static int find_on_segment(const grid *g, const int32_t *px, const int32_t *py, int32_t ax,
@@ -130,20 +138,14 @@ static int find_on_segment(const grid *g, const int32_t *px, const int32_t *py, 
                 bs_i128 along = (bs_i128)(qx - ax) * dx + (bs_i128)(qy - ay) * dy;
                 if (along <= 0 || along >= len2) continue;
                 if (bs_grow(&out->h, &out->cap, out->n + 1, sizeof(hit))) return -1;
-                out->h[out->n++] = (hit){(int32_t)qx, (int32_t)qy, along};
+                out->h[out->n] = (hit){(int32_t)qx, (int32_t)qy, along, out->n};
+                out->n++;
             }
         }
     }
-    /* sort by distance from A (insertion sort: few hits) and drop repeats */
-    for (uint32_t i = 1; i < out->n; i++) {
-        hit v = out->h[i];
-        uint32_t j = i;
-        while (j > 0 && out->h[j - 1].along > v.along) {
-            out->h[j] = out->h[j - 1];
-            j--;
-        }
-        out->h[j] = v;
-    }
+    /* sort by distance from A and drop repeats: a damaged map can put thousands
+     * of points on one seg, so no quadratic sort */
+    if (out->n > 1) qsort(out->h, out->n, sizeof *out->h, hit_cmp);
     uint32_t k = 0;
     for (uint32_t i = 0; i < out->n; i++) {
         if (k > 0 && out->h[k - 1].x == out->h[i].x && out->h[k - 1].y == out->h[i].y) continue;
@@ -153,7 +155,7 @@ static int find_on_segment(const grid *g, const int32_t *px, const int32_t *py, 
     return 0;
 }
 
-int bs_tjunc_segs(bs_tree *t, char *err, size_t errlen)
+int bs_tjunc_segs(bs_tree *t, const char *name, char *err, size_t errlen)
 {
     /* the point set: every vertex some seg uses */
     uint8_t *used = calloc(t->nverts + 1, 1);
@@ -182,6 +184,7 @@ int bs_tjunc_segs(bs_tree *t, char *err, size_t errlen)
             bs_seg g0 = t->segs[si];
             if (find_on_segment(&g, px, py, g0.x1, g0.y1, g0.x2, g0.y2, &H)) goto out;
             if (H.n == 0) continue;
+            if (bs_seg_budget_check(t, name, H.n, g0.line, err, errlen)) goto out;
             /* pieces: v1 -> h0 -> h1 ... -> v2; the first piece keeps index si */
             if (bs_grow(&t->segs, &t->segcap, t->nsegs + H.n, sizeof(bs_seg))) goto out;
             if (bs_grow(&L->segs, &L->cap, L->nsegs + H.n, sizeof(uint32_t))) goto out;
