@@ -10,7 +10,8 @@ project's scenes, compiled scenes, single-map WADs cut from Freedoom, frame-link
 images), the crashes kept as regressions (tests/fuzz/regress/NAME/) and the corpus it grew on
 earlier runs (build/fuzz/corpus/NAME). A crash leaves its input in build/fuzz/crashes/NAME/ and
 makes the run fail; once fixed, the input belongs in tests/fuzz/regress/NAME/. The figures
-(executions, executions per second, coverage, corpus) go to build/fuzz/report.md."""
+of the last run of each harness (executions, executions per second, coverage, corpus; from its
+log, build/fuzz/NAME.log) go to build/fuzz/report.md."""
 import argparse
 import concurrent.futures
 import os
@@ -20,7 +21,6 @@ import struct
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -148,16 +148,29 @@ def make_seeds(name):
 
 STAT = re.compile(r"stat::(\w+):\s*(\d+)")
 COV = re.compile(r"cov: (\d+) ft: (\d+) corp: (\d+)/")
+DONE = re.compile(r"Done (\d+) runs in (\d+) second")
+CRASH = re.compile(r"^(==\d+==ERROR|SUMMARY: |.*Test unit written to)", re.M)
 
 
-def run_harness(name, seconds, corpus):
-    """One libFuzzer run; returns its figures and whether it ended without a crash."""
+def figures(name, log):
+    """A run's figures, from libFuzzer's own log of it."""
+    text = log.read_text(errors="replace")
+    stats = {k: int(v) for k, v in STAT.findall(text)}
+    cov, done = COV.findall(text), DONE.findall(text)
+    return dict(name=name, log=log, execs=stats.get("number_of_executed_units", 0),
+                per_sec=stats.get("average_exec_per_sec", 0), rss=stats.get("peak_rss_mb", 0),
+                seconds=int(done[-1][1]) if done else 0, cov=int(cov[-1][0]) if cov else 0,
+                ft=int(cov[-1][1]) if cov else 0, corpus=int(cov[-1][2]) if cov else 0,
+                crashed=bool(CRASH.search(text)) or not done)
+
+
+def run_harness(name, seconds, corpus, log):
+    """One libFuzzer run (its output in log); returns its figures, crashed if it did not end cleanly."""
     seeds = make_seeds(name)
     regress = ROOT / "tests/fuzz/regress" / name
     crashes = FUZZ / "crashes" / name
     crashes.mkdir(parents=True, exist_ok=True)
     corpus.mkdir(parents=True, exist_ok=True)
-    log = FUZZ / f"{name}.log"
     cmd = [str(FUZZ / f"fuzz_{name}"), f"-max_total_time={seconds}", "-timeout=25", "-rss_limit_mb=2560",
            "-print_final_stats=1", f"-artifact_prefix={crashes}/", str(corpus), str(seeds)]
     if MAX_LEN[name]:
@@ -165,18 +178,12 @@ def run_harness(name, seconds, corpus):
     if regress.is_dir():
         cmd.append(str(regress))
     with tempfile.TemporaryDirectory() as tmp:
-        start = time.monotonic()
         with open(log, "w") as f:
             rc = subprocess.run(cmd, cwd=ROOT, stdout=f, stderr=subprocess.STDOUT,
                                 env=dict(os.environ, TMPDIR=tmp)).returncode
-        wall = time.monotonic() - start
-    text = log.read_text(errors="replace")
-    stats = {k: int(v) for k, v in STAT.findall(text)}
-    cov = COV.findall(text)
-    return dict(name=name, rc=rc, wall=wall, execs=stats.get("number_of_executed_units", 0),
-                per_sec=stats.get("average_exec_per_sec", 0), rss=stats.get("peak_rss_mb", 0),
-                cov=int(cov[-1][0]) if cov else 0, ft=int(cov[-1][1]) if cov else 0,
-                corpus=int(cov[-1][2]) if cov else 0, log=log, seeds=len(list(seeds.iterdir())))
+    r = figures(name, log)
+    r["crashed"] = r["crashed"] or rc != 0
+    return r
 
 
 def replay(name):
@@ -190,12 +197,16 @@ def replay(name):
     return r.returncode == 0
 
 
-def report(rows, seconds):
-    lines = [f"| harness | seconds | executions | per second | coverage (edges) | features | corpus | crashes |",
-             "|---|---|---|---|---|---|---|---|"]
-    for r in rows:
-        lines.append(f"| {r['name']} | {r['wall']:.0f} | {r['execs']:,} | {r['per_sec']:,} | {r['cov']:,} | "
-                     f"{r['ft']:,} | {r['corpus']:,} | {0 if r['rc'] == 0 else 'yes: ' + str(r['log'])} |")
+def report():
+    """The table of the last full run of every harness (build/fuzz/NAME.log)."""
+    lines = ["| harness | seconds | executions | per second | coverage (edges) | features | corpus | peak RSS MB | crash |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for name in NAMES:
+        log = FUZZ / f"{name}.log"
+        if log.exists():
+            r = figures(name, log)
+            lines.append(f"| {name} | {r['seconds']} | {r['execs']:,} | {r['per_sec']:,} | {r['cov']:,} | "
+                         f"{r['ft']:,} | {r['corpus']:,} | {r['rss']:,} | {'yes: ' + str(log) if r['crashed'] else 'none'} |")
     return "\n".join(lines) + "\n"
 
 
@@ -221,28 +232,30 @@ def main():
         for n in failed:
             print(f"fuzz-smoke: {n}: a seed or kept regression fails (above)", file=sys.stderr)
         with tempfile.TemporaryDirectory() as tmp:
-            rows = [run_harness(n, 3, Path(tmp) / n) for n in names if n not in failed]
+            rows = [run_harness(n, 3, Path(tmp) / n, Path(tmp) / f"{n}.log") for n in names if n not in failed]
+            for r in rows:
+                if r["crashed"]:
+                    sys.stderr.write(r["log"].read_text(errors="replace")[-4000:])
         for r in rows:
-            ok = r["rc"] == 0
-            print(f"fuzz-smoke: {r['name']}: {r['execs']:,} executions, {'ok' if ok else 'CRASH, see ' + str(r['log'])}")
+            ok = not r["crashed"]
+            print(f"fuzz-smoke: {r['name']}: {r['execs']:,} executions, {'ok' if ok else 'CRASH (above)'}")
             if not ok:
                 failed.append(r["name"])
         return 1 if failed else 0
 
     print(f"fuzz: {len(names)} harnesses, {a.time} s each, {a.jobs} at once", flush=True)
     with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, a.jobs)) as pool:
-        futures = {pool.submit(run_harness, n, a.time, FUZZ / "corpus" / n): n for n in names}
+        futures = {pool.submit(run_harness, n, a.time, FUZZ / "corpus" / n, FUZZ / f"{n}.log"): n for n in names}
         rows = []
         for f in concurrent.futures.as_completed(futures):
             r = f.result()
             rows.append(r)
-            print(f"fuzz: {r['name']}: {r['execs']:,} executions in {r['wall']:.0f} s, coverage {r['cov']:,}, "
-                  f"{'no crash' if r['rc'] == 0 else 'CRASH: see ' + str(r['log'])}", flush=True)
-    rows.sort(key=lambda r: NAMES.index(r["name"]))
-    table = report(rows, a.time)
+            print(f"fuzz: {r['name']}: {r['execs']:,} executions in {r['seconds']} s, coverage {r['cov']:,}, "
+                  f"{'CRASH: see ' + str(r['log']) if r['crashed'] else 'no crash'}", flush=True)
+    table = report()
     (FUZZ / "report.md").write_text(table)
     print(table)
-    return 0 if all(r["rc"] == 0 for r in rows) else 1
+    return 1 if any(r["crashed"] for r in rows) else 0
 
 
 if __name__ == "__main__":

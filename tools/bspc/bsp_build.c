@@ -437,7 +437,7 @@ int bs_seg_budget_check(const bs_tree *t, const char *name, uint32_t more, uint3
     uint64_t budget = BS_SEG_BUDGET(t);
     if ((uint64_t)t->nsegs + more <= budget) return 0;
     return bs_fail(err, errlen,
-                   "%s: linedef %u: the walls are cut into more than %llu pieces (16 per wall side + 65,536): "
+                   "%s: linedef %u: the walls are cut into more than %llu pieces (2 per wall side + 4,096): "
                    "walls that cross each other?",
                    name, line, (unsigned long long)budget);
 }
