@@ -227,6 +227,11 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
     }
     rc = 0;
 out:
+    if (rc) { /* a refusal hands back no blob (one may have been written before the failing step) */
+        free(*blob);
+        *blob = NULL;
+        *len = 0;
+    }
     bs_tree_free(&t);
     bs_scene_free(&s);
     return rc;

@@ -520,19 +520,18 @@ static int do_object(parser *p, char **tok, int n)
             if (strcmp(f[0], "circle") == 0 && nf == 3) {
                 if (fxtext_parse64(f[1], &a))
                     return perr(p, "object: path=%s: radius '%s' is not a number", text, f[1]);
-                if (a <= 0 || a > 2 * BS_COORD_RAW_MAX)
-                    return perr(p, "object: path=%s: radius out of range (0 < R <= %d)", text,
-                                2 * SCN_COORD_MAX);
+                /* no larger circle fits in the world box, and the radius is stored in 32 bits */
+                if (a <= 0 || a > BS_COORD_RAW_MAX)
+                    return perr(p, "object: path=%s: radius out of range (0 < R <= %d)", text, SCN_COORD_MAX);
                 if (period(p, f[2], &o.period_ms)) return -1;
                 o.path = SCN_PATH_CIRCLE;
                 o.pa = (int32_t)a;
             } else if (strcmp(f[0], "line") == 0 && nf == 4) {
                 if (fxtext_parse64(f[1], &a) || fxtext_parse64(f[2], &b))
                     return perr(p, "object: path=%s: DX and DY must be numbers", text);
-                if (a > 2 * BS_COORD_RAW_MAX || a < -2 * BS_COORD_RAW_MAX || b > 2 * BS_COORD_RAW_MAX ||
-                    b < -2 * BS_COORD_RAW_MAX)
-                    return perr(p, "object: path=%s leaves the world box (|coordinate| <= %d)", text,
-                                SCN_COORD_MAX);
+                /* stored in 32 bits: a longer step would wrap before the box check below */
+                if (a > BS_COORD_RAW_MAX || a < -BS_COORD_RAW_MAX || b > BS_COORD_RAW_MAX || b < -BS_COORD_RAW_MAX)
+                    return perr(p, "object: path=%s: DX and DY out of range (|D| <= %d)", text, SCN_COORD_MAX);
                 if (a == 0 && b == 0) return perr(p, "object: path=%s has zero length", text);
                 if (period(p, f[3], &o.period_ms)) return -1;
                 o.path = SCN_PATH_LINE;
