@@ -21,7 +21,7 @@ FUZZ_DIR   := $(BUILD)/fuzz
 FUZZ_SAN   := -fsanitize=address,undefined -fno-sanitize-recover=all
 FUZZ_CFLAGS = -std=c11 -g -O1 -fno-omit-frame-pointer -fno-strict-aliasing $(WARN) $(INC) -D_DEFAULT_SOURCE \
               -Ihost/flash -Ifirmware/dfu -Itests/fuzz $(FUZZ_SAN)
-FUZZ_NAMES := text wad scene render
+FUZZ_NAMES := text wad scene render link dfu
 FUZZ_TIME  ?= 60
 FUZZ_JOBS  ?= 2
 

@@ -26,7 +26,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 BUILD = ROOT / "build"
 FUZZ = BUILD / "fuzz"
-NAMES = ["text", "wad", "scene", "render"]
+NAMES = ["text", "wad", "scene", "render", "link", "dfu"]
 # Longest input each harness is given (None: libFuzzer's own choice from the seeds).
 MAX_LEN = {"text": 16384, "wad": 196608, "scene": 65536, "render": 16409, "link": None, "dfu": None}
 WADDIR = Path(os.environ.get("DOOMWADDIR", "/usr/share/games/doom"))
