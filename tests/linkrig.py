@@ -115,12 +115,23 @@ class Firmware:
 class FaultyRelay:
     """Relays bytes from `upstream` (a TCP address the firmware serves) to whoever connects to
     self.port, damaging the firmware->receiver direction at a rate per byte: bit flips, dropped
-    bytes and truncated messages (a run of bytes up to the next message delimiter lost), in
-    equal shares. The receiver->firmware direction (acks, keyframe requests) passes intact."""
+    bytes and truncated messages, in equal shares. A truncation loses the bytes from the chosen
+    one up to the next message delimiter (kept); chosen on a delimiter, it keeps it and loses the
+    whole next message. The receiver->firmware direction (acks, keyframe requests) passes intact.
+
+    self.damage lists every damage event as (offset, kind), kind "flip", "drop" or "truncate", offset
+    in the stream the receiver gets: how many bytes it had got before the damage (so the index of a
+    flipped byte, or of the byte that follows the dropped byte or truncated run). self.sent counts the
+    bytes relayed to the receiver, self.back those relayed from it to the firmware. They grow while
+    the relay runs; read them after join()."""
 
     def __init__(self, upstream_port, rate, seed=1):
         self.rate, self.rng = rate, random.Random(seed)
         self.flips = self.drops = self.truncations = 0
+        self.damage = []
+        self.sent = 0
+        self.back = 0
+        self._skipping = False
         self.listener = socket.socket()
         self.listener.bind(("127.0.0.1", 0))
         self.listener.listen(1)
@@ -129,29 +140,39 @@ class FaultyRelay:
         self.thread = threading.Thread(target=self._run, daemon=True)
         self.thread.start()
 
+    @property
+    def events(self):
+        return self.flips + self.drops + self.truncations
+
+    def join(self, timeout=10):
+        self.thread.join(timeout)
+
     def _damage(self, data):
         out = bytearray()
-        skipping = False
         for b in data:
-            if skipping:
+            if self._skipping:
                 if b == 0:
-                    skipping = False
+                    self._skipping = False
                     out.append(b)
                 continue
             if self.rng.random() < self.rate:
                 kind = self.rng.randrange(3)
                 if kind == 0:
+                    self.damage.append((self.sent + len(out), "flip"))
                     out.append(b ^ (1 << self.rng.randrange(8)))
                     self.flips += 1
                 elif kind == 1:
+                    self.damage.append((self.sent + len(out), "drop"))
                     self.drops += 1
                 else:
                     self.truncations += 1
-                    skipping = b != 0
-                    if not skipping:
+                    self._skipping = True
+                    if b == 0:
                         out.append(b)
+                    self.damage.append((self.sent + len(out), "truncate"))
                 continue
             out.append(b)
+        self.sent += len(out)
         return bytes(out)
 
     def _run(self):
@@ -169,8 +190,61 @@ class FaultyRelay:
                         down.sendall(self._damage(data))
                     else:
                         up.sendall(data)
+                        self.back += len(data)
         except OSError:
             return
         finally:
             up.close()
             down.close()
+
+
+LINK_BYTES_PER_S = 11520  # 115,200 baud, 8N1: 10 bits a byte
+
+
+def firmware_link(log):
+    """What the firmware says it sent and heard, from its log (hal/mps2/stream_fl.c's closing
+    "link:" line): frames_sent, acks_heard, keyreqs_heard, ack_timeouts; None if it said nothing."""
+    m = re.search(r"link: (\d+) frames .*?; (\d+) acks, (\d+) keyframe requests, (\d+) timeouts", log)
+    if not m:
+        return None
+    return dict(zip(["frames_sent", "acks_heard", "keyreqs_heard", "ack_timeouts"], map(int, m.groups())))
+
+
+def outages(damage, accepted, frames_sent):
+    """The receiver's outages, measured from where the relay damaged the stream and where the
+    receiver accepted frames (both as byte offsets in the stream the receiver got).
+
+    damage: offsets of the damage events (FaultyRelay.damage's first fields). accepted: (offset
+    just past the accepted frame's message, frame number) for each accepted frame, in stream order
+    (tools/capture.py's frames.jsonl: stream_end, frame). An outage starts at the first damage
+    event after the last accepted frame and ends at the next accepted frame; every damage event in
+    between belongs to it. Returns one dict per outage: start and end (offsets; end None if no frame
+    was accepted after it: open at the end of the run), bytes (end - start: what the receiver
+    consumed from the first damaged byte until it showed an intact frame again; None if open),
+    ms (those bytes' time on a 115,200 8N1 link), events (damage events in it), frames_lost (frame
+    numbers between the last frame accepted before it and the next one accepted; for an open
+    outage, up to the last frame sent)."""
+    damage = sorted(damage)
+    acc = sorted(accepted)
+    out = []
+    i = j = 0
+    prev_no = -1
+    while i < len(damage):
+        d = damage[i]
+        while j < len(acc) and acc[j][0] <= d:
+            prev_no = acc[j][1]
+            j += 1
+        end = acc[j][0] if j < len(acc) else None
+        k = i
+        while k < len(damage) and (end is None or damage[k] < end):
+            k += 1
+        if end is None:
+            lost = frames_sent - 1 - prev_no
+            out.append({"start": d, "end": None, "bytes": None, "ms": None, "events": k - i, "frames_lost": lost})
+        else:
+            lost = acc[j][1] - prev_no - 1
+            n = end - d
+            out.append({"start": d, "end": end, "bytes": n, "ms": n * 1000 / LINK_BYTES_PER_S, "events": k - i,
+                        "frames_lost": lost})
+        i = k
+    return out

@@ -14,7 +14,9 @@ it). Writes, in DIR:
                       the camera exactly as the firmware used it (x, y, z and angle as exact
                       decimals of their 16.16 values, look in pixels; raw 16.16 integers too),
                       the render and present modes, and `render_args`: the arguments that make
-                      build/render reproduce the frame bit for bit
+                      build/render reproduce the frame bit for bit, and `stream_end`: the bytes
+                      received from the start of the stream up to and including the delimiter
+                      that ended the frame's message (where it was accepted)
     summary.json      the decoder's counters
 
 Exits 0 when N frames were captured, 1 when the stream ended or went quiet first.
@@ -82,6 +84,20 @@ def write_png(path, pixels, palette, width=framelink.W, height=framelink.H):
     Path(path).write_bytes(data)
 
 
+def feed_at(dec, data):
+    """Feed `data` to the decoder; yield (event, offset) for each event, offset the stream's byte
+    count just past the delimiter that completed the event's message (events happen only at
+    delimiters, so the data is fed a segment at a time)."""
+    start = 0
+    while start < len(data):
+        z = data.find(b"\0", start)
+        end = len(data) if z < 0 else z + 1
+        evs = dec.feed(data[start:end])
+        for ev in evs:
+            yield ev, dec.counters["bytes"]
+        start = end
+
+
 def capture(port, frames, out, png=True, timeout=10.0, log=sys.stderr):
     """Capture `frames` frames from an open pyserial port into `out`; returns the counters."""
     out = Path(out)
@@ -104,11 +120,12 @@ def capture(port, frames, out, png=True, timeout=10.0, log=sys.stderr):
                     break
                 continue
             last = time.monotonic()
-            for ev in dec.feed(data):
+            for ev, at in feed_at(dec, data):
                 if ev["event"] == "palette":
                     palette = ev["palette"]
                 elif ev["event"] == "frame" and got < frames:
                     rec = frame_record(ev)
+                    rec["stream_end"] = at
                     if png:
                         write_png(out / f"frame_{ev['frame']:05d}.png", ev["pixels"], palette)
                     jl.write(json.dumps(rec) + "\n")

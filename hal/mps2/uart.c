@@ -83,6 +83,10 @@ uint32_t uart_rx_overruns(void)
 
 void uart0_rx_irq(void)
 {
+    /* Acknowledge before draining: a byte that lands after the drain then raises
+     * the interrupt again. Acknowledged after, it would sit in the data register
+     * with no interrupt pending, and the UART delivers nothing more. */
+    UART_INTSTATUS = INT_RX | INT_RX_OVERRUN;
     if (UART_STATE & STATE_RX_OVERRUN) {
         rx_dropped++;
         UART_STATE = STATE_RX_OVERRUN;
@@ -97,5 +101,4 @@ void uart0_rx_irq(void)
             rx_dropped++;
         }
     }
-    UART_INTSTATUS = INT_RX | INT_RX_OVERRUN;
 }
