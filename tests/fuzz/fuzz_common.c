@@ -12,24 +12,21 @@
  * (the largest Freedoom map needs about 9 MB); a harness does not allocate it. */
 #define FUZZ_WORK_MAX (64u << 20)
 
-static uint32_t le32(const uint8_t *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-
 fuzz_view fuzz_view_from(const uint8_t *data)
 {
     fuzz_view v;
-    v.x = (int32_t)le32(data);
-    v.y = (int32_t)le32(data + 4);
-    v.z = (int32_t)le32(data + 8);
-    v.angle = (int32_t)le32(data + 12);
-    v.look = (int32_t)le32(data + 16);
-    v.t_ms = le32(data + 20);
+    v.x = (int32_t)rd32(data);
+    v.y = (int32_t)rd32(data + 4);
+    v.z = (int32_t)rd32(data + 8);
+    v.angle = (int32_t)rd32(data + 12);
+    v.look = (int32_t)rd32(data + 16);
+    v.t_ms = rd32(data + 20);
     return v;
 }
 
-const char *fuzz_temp_file(const uint8_t *data, size_t size, const char *suffix)
+/* data as this process's temporary file ending in suffix; its path (static storage),
+ * or NULL if it could not be written. */
+static const char *temp_file(const uint8_t *data, size_t size, const char *suffix)
 {
     static char path[256];
     const char *dir = getenv("TMPDIR");
@@ -57,6 +54,16 @@ int fuzz_compile(const char *spec, const char *file, uint8_t **blob, size_t *len
     return -1;
 }
 
+int fuzz_compile_input(const uint8_t *data, size_t size, const char *suffix, const char *map, uint8_t **blob,
+                       size_t *len)
+{
+    const char *path = temp_file(data, size, suffix);
+    if (!path) return -1;
+    char spec[300];
+    snprintf(spec, sizeof spec, "%s%s%s", path, map ? ":" : "", map ? map : "");
+    return fuzz_compile(spec, path, blob, len);
+}
+
 static void draw_mode(engine *e, const fuzz_view *view, render_mode mode, int trusted)
 {
     cam_start(&e->cam, &e->sc);
@@ -77,9 +84,7 @@ static void draw_mode(engine *e, const fuzz_view *view, render_mode mode, int tr
 void fuzz_draw(const uint8_t *blob, size_t len, const fuzz_view *view, int trusted)
 {
     /* An exact-size copy, so that a read past the end is a sanitizer report. */
-    uint8_t *copy = malloc(len ? len : 1);
-    if (!copy) return;
-    memcpy(copy, blob, len);
+    uint8_t *copy = fuzz_copy_exact(blob, len);
     static engine e;
     memset(&e, 0, sizeof e);
     scene_error se;

@@ -4,22 +4,7 @@
 #ifndef FUZZ_COMMON_H
 #define FUZZ_COMMON_H
 
-#include <stddef.h>
-#include <stdint.h>
-#include <stdio.h>
-#include <stdlib.h>
-
-/* A property of the code under test failed: report it and stop, so libFuzzer keeps
- * the input as a crash. */
-#define FUZZ_REQUIRE(cond, ...)                                                   \
-    do {                                                                          \
-        if (!(cond)) {                                                            \
-            fprintf(stderr, "fuzz: %s:%d: %s: ", __FILE__, __LINE__, #cond);      \
-            fprintf(stderr, __VA_ARGS__);                                         \
-            fputc('\n', stderr);                                                  \
-            abort();                                                              \
-        }                                                                         \
-    } while (0)
+#include "fuzz_util.h"
 
 /* A camera and a time, as raw as the fuzzer gives them: the renderer must take
  * any (it clamps the eye into the world box and the look). */
@@ -32,13 +17,14 @@ typedef struct {
 /* Read a fuzz_view from the first FUZZ_VIEW_BYTES of data (little-endian). */
 fuzz_view fuzz_view_from(const uint8_t *data);
 
-/* Write data to this process's temporary file whose name ends in suffix (".scene",
- * ".wad"); returns its path (static storage), or NULL if it could not be written. */
-const char *fuzz_temp_file(const uint8_t *data, size_t size, const char *suffix);
-
 /* Compile spec quietly. Returns 0 and a malloc'd blob, or -1; a refusal must say
  * which file it refuses (the message names spec's file), or the harness stops. */
 int fuzz_compile(const char *spec, const char *file, uint8_t **blob, size_t *len);
+
+/* The input as this process's temporary file ending in suffix, compiled (map: the
+ * map to take from a WAD, NULL for a text scene). 0 and the blob, or -1. */
+int fuzz_compile_input(const uint8_t *data, size_t size, const char *suffix, const char *map, uint8_t **blob,
+                       size_t *len);
 
 /* Load blob as the firmware does and draw it in every mode, from view (NULL: the
  * player start) at view->t_ms with the objects and doors moved there.

@@ -41,19 +41,9 @@
 #include "dfu_device.h"
 #include "dfu_image.h"
 #include "dfu_proto.h"
-
-#define REQUIRE(c)                                                                  \
-    do {                                                                            \
-        if (!(c)) {                                                                 \
-            fprintf(stderr, "fuzz_dfu.c:%d: property failed: %s\n", __LINE__, #c); \
-            abort();                                                                \
-        }                                                                           \
-    } while (0)
+#include "fuzz_util.h"
 
 #define MAX_OPS 256
-
-/* The harness's own checks are not traced: libFuzzer learns nothing from them. */
-#define UNTRACED __attribute__((no_sanitize("coverage")))
 
 typedef struct {
     const uint8_t *p;
@@ -77,46 +67,6 @@ static uint32_t next32(cursor *c)
 {
     uint32_t v = next16(c);
     return v | next16(c) << 16;
-}
-
-static uint32_t rd32(const uint8_t *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-
-static void wr32(uint8_t *p, uint32_t v)
-{
-    p[0] = (uint8_t)v;
-    p[1] = (uint8_t)(v >> 8);
-    p[2] = (uint8_t)(v >> 16);
-    p[3] = (uint8_t)(v >> 24);
-}
-
-/* CRC-32 as zlib's crc32(), written here to check firmware/crc32.c's users. */
-static uint32_t crc_table[256];
-
-UNTRACED static void ref_crc_init(void)
-{
-    for (uint32_t i = 0; i < 256; i++) {
-        uint32_t c = i;
-        for (int k = 0; k < 8; k++) c = c & 1u ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-        crc_table[i] = c;
-    }
-}
-
-UNTRACED static uint32_t ref_crc(const uint8_t *p, size_t n)
-{
-    uint32_t c = 0xFFFFFFFFu;
-    for (size_t i = 0; i < n; i++) c = crc_table[(c ^ p[i]) & 0xFFu] ^ (c >> 8);
-    return ~c;
-}
-
-static uint8_t *copy_exact(const uint8_t *p, size_t n)
-{
-    uint8_t *b = malloc(n ? n : 1);
-    if (!b) abort();
-    if (n) memcpy(b, p, n);
-    return b;
 }
 
 /* ======================================================================== */
@@ -197,7 +147,7 @@ static dfu_image_err check_file(const uint8_t *d, size_t len, uint16_t vid, uint
 
 static void run_file(const uint8_t *p, size_t n)
 {
-    uint8_t *d = copy_exact(p, n);
+    uint8_t *d = fuzz_copy_exact(p, n);
     check_file(d, n, 0x1209, 0x0001);
     free(d);
 }
@@ -227,7 +177,7 @@ static void run_suffix(cursor *c)
     for (uint32_t i = 0; i < (edit & 3u); i++) f[len - 1 - edits[i][0] % (len < 32 ? len : 32)] ^= edits[i][1];
     if (edit & 4u) wr32(f + len - 4, dfu_suffix_crc(f, len - 4));
     len -= cut % (len + 1);
-    uint8_t *g = copy_exact(f, len); /* exact again after the cut */
+    uint8_t *g = fuzz_copy_exact(f, len); /* exact again after the cut */
     free(f);
     check_file(g, len, (uint16_t)vid, (uint16_t)pid);
     free(g);
@@ -261,15 +211,6 @@ typedef struct {
     int com_valid;
     uint32_t commits;
 } fake_flash;
-
-static uint32_t xorshift(uint32_t *s)
-{
-    uint32_t x = *s ? *s : 0x9E3779B9u;
-    x ^= x << 13;
-    x ^= x >> 17;
-    x ^= x << 5;
-    return *s = x;
-}
 
 /* 0: do it; 1: fail; 2: corrupt. */
 static int fault(fake_flash *f, int kind)
@@ -590,11 +531,6 @@ out:
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    static int ready;
-    if (!ready) {
-        ref_crc_init();
-        ready = 1;
-    }
     if (size < 1) return 0;
     cursor c = {data + 1, size - 1};
     switch (data[0] % 3u) {

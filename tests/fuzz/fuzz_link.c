@@ -60,14 +60,7 @@
 
 #include "fl_internal.h"
 #include "framelink.h"
-
-#define REQUIRE(c)                                                                   \
-    do {                                                                             \
-        if (!(c)) {                                                                  \
-            fprintf(stderr, "fuzz_link.c:%d: property failed: %s\n", __LINE__, #c); \
-            abort();                                                                 \
-        }                                                                            \
-    } while (0)
+#include "fuzz_util.h"
 
 /* Decoding a frame costs the receiver a few milliseconds under the sanitizers and
  * libFuzzer's tracing: a few frames per input keep an execution fast. */
@@ -114,40 +107,8 @@ static uint32_t u32_or0(cursor *c)
     return fl_get32(b);
 }
 
-static uint32_t xorshift(uint32_t *s)
-{
-    uint32_t x = *s ? *s : 0x9E3779B9u;
-    x ^= x << 13;
-    x ^= x >> 17;
-    x ^= x << 5;
-    return *s = x;
-}
-
-/* The harness's own checks run over whole frames several times per frame message;
- * with libFuzzer's comparison tracing they would cost more than the code under test
- * and tell the fuzzer nothing about it, so they are not traced. */
-#define UNTRACED __attribute__((no_sanitize("coverage")))
-
-/* ---- CRC-32 and the frame check, as docs/frame-link.md defines them (independent of
- * firmware/crc32.c and fl_codec.c, which they check) -------------------------------- */
-
-static uint32_t crc_table[256];
-
-UNTRACED static void ref_crc_init(void)
-{
-    for (uint32_t i = 0; i < 256; i++) {
-        uint32_t c = i;
-        for (int k = 0; k < 8; k++) c = c & 1u ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-        crc_table[i] = c;
-    }
-}
-
-UNTRACED static uint32_t ref_crc(const uint8_t *p, size_t n)
-{
-    uint32_t c = 0xFFFFFFFFu;
-    for (size_t i = 0; i < n; i++) c = crc_table[(c ^ p[i]) & 0xFFu] ^ (c >> 8);
-    return ~c;
-}
+/* ---- the frame check, as docs/frame-link.md defines it (independent of fl_codec.c,
+ * which it checks; the CRC-32 is fuzz_util.h's ref_crc) ----------------------------- */
 
 UNTRACED static uint32_t ref_mix(uint32_t h)
 {
@@ -225,33 +186,25 @@ static fl_encoder *g_enc;
 static fl_coder *g_coder;
 static uint32_t g_line_len;
 
-static void *xmalloc(size_t n)
-{
-    void *p = malloc(n);
-    if (!p) abort();
-    return p;
-}
-
 static void setup_once(void)
 {
     if (g_dec) return;
-    ref_crc_init();
     /* exact sizes: ASan reports any access outside what the API says it may touch */
-    g_frame = xmalloc(FL_FRAME_BYTES);
-    g_work = xmalloc(FL_DEC_WORK_BYTES);
-    g_shadow = xmalloc(FL_FRAME_BYTES);
-    g_pic = xmalloc(FL_FRAME_BYTES);
-    g_payload = xmalloc(FL_PAYLOAD_MAX + 64);
-    g_line = xmalloc(LINE_BYTES);
+    g_frame = fuzz_alloc(FL_FRAME_BYTES);
+    g_work = fuzz_alloc(FL_DEC_WORK_BYTES);
+    g_shadow = fuzz_alloc(FL_FRAME_BYTES);
+    g_pic = fuzz_alloc(FL_FRAME_BYTES);
+    g_payload = fuzz_alloc(FL_PAYLOAD_MAX + 64);
+    g_line = fuzz_alloc(LINE_BYTES);
     for (int i = 0; i < 2; i++) {
-        g_page_a[i] = xmalloc(FL_FRAME_BYTES);
-        g_page_u[i] = xmalloc(FL_FRAME_BYTES + 1);
+        g_page_a[i] = fuzz_alloc(FL_FRAME_BYTES);
+        g_page_u[i] = fuzz_alloc(FL_FRAME_BYTES + 1);
     }
-    g_wrong = xmalloc(FL_FRAME_BYTES);
-    for (int i = 0; i < MAX_RT; i++) g_sent[i] = xmalloc(FL_FRAME_BYTES);
-    g_dec = xmalloc(sizeof *g_dec);
-    g_enc = xmalloc(sizeof *g_enc);
-    g_coder = xmalloc(sizeof *g_coder);
+    g_wrong = fuzz_alloc(FL_FRAME_BYTES);
+    for (int i = 0; i < MAX_RT; i++) g_sent[i] = fuzz_alloc(FL_FRAME_BYTES);
+    g_dec = fuzz_alloc(sizeof *g_dec);
+    g_enc = fuzz_alloc(sizeof *g_enc);
+    g_coder = fuzz_alloc(sizeof *g_coder);
 }
 
 UNTRACED static int frame_unchanged(const harness *h)
@@ -826,7 +779,7 @@ static void run_round_trip(cursor *c, uint32_t knobs)
     harness_init(&h, send_acks);
     uint32_t no = u32_or0(c), scratch_bytes = u16_or0(c) % 16384u, key_interval = u8_or0(c) % 16u;
     if (scratch_bytes == 0) scratch_bytes = 8192;
-    uint8_t *scratch = xmalloc(scratch_bytes);
+    uint8_t *scratch = fuzz_alloc(scratch_bytes);
     uint8_t palette[FL_PALETTE_BYTES];
     for (uint32_t i = 0; i < FL_PALETTE_BYTES; i++) palette[i] = (uint8_t)(i * 7u + no);
 

@@ -59,10 +59,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     uint8_t choice = data[FUZZ_VIEW_BYTES];
     const uint8_t *text = data + FUZZ_VIEW_BYTES + 1;
     size_t tlen = size - FUZZ_VIEW_BYTES - 1;
-    const char *path = fuzz_temp_file(text, tlen, ".scene");
-    uint8_t *blob = NULL;
-    size_t len = 0;
-    if (path && tlen && fuzz_compile(path, path, &blob, &len) == 0) {
+    uint8_t *blob;
+    size_t len;
+    if (tlen && fuzz_compile_input(text, tlen, ".scene", NULL, &blob, &len) == 0) {
         fuzz_draw(blob, len, &view, 1);
         free(blob);
     } else if (npool) {

@@ -13,27 +13,19 @@
 #include "fuzz_common.h"
 #include "scene_format.h"
 
-static void put32(uint8_t *p, uint32_t v)
-{
-    for (int i = 0; i < 4; i++) p[i] = (uint8_t)(v >> (8 * i));
-}
-
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     if (size < 1 + FUZZ_VIEW_BYTES || size - 1 - FUZZ_VIEW_BYTES > (4u << 20)) return 0;
     uint8_t flags = data[0];
     fuzz_view view = fuzz_view_from(data + 1);
     size_t len = size - 1 - FUZZ_VIEW_BYTES;
-    uint8_t *blob = malloc(len ? len : 1);
-    if (!blob) return 0;
-    memcpy(blob, data + 1 + FUZZ_VIEW_BYTES, len);
+    uint8_t *blob = fuzz_copy_exact(data + 1 + FUZZ_VIEW_BYTES, len);
     if (len >= sizeof(scn_header)) {
-        if (flags & 2) put32(blob + offsetof(scn_header, total_bytes), (uint32_t)len);
+        if (flags & 2) wr32(blob + offsetof(scn_header, total_bytes), (uint32_t)len);
         /* over the length the header declares, as the loader reads it, when that lies in the blob */
-        uint32_t total = (uint32_t)blob[8] | (uint32_t)blob[9] << 8 | (uint32_t)blob[10] << 16 |
-                         (uint32_t)blob[11] << 24;
+        uint32_t total = rd32(blob + offsetof(scn_header, total_bytes));
         if (total < 16 || total > len) total = (uint32_t)len;
-        if (flags & 1) put32(blob + offsetof(scn_header, crc32), crc_update(0, blob + 16, total - 16));
+        if (flags & 1) wr32(blob + offsetof(scn_header, crc32), crc_update(0, blob + 16, total - 16));
     }
     fuzz_draw(blob, len, NULL, 0);
     fuzz_draw(blob, len, &view, 0);

@@ -9,12 +9,9 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    if (size > TEXT_MAX) return 0;
-    const char *path = fuzz_temp_file(data, size, ".scene");
-    if (!path) return 0;
     uint8_t *blob;
     size_t len;
-    if (fuzz_compile(path, path, &blob, &len) == 0) {
+    if (size <= TEXT_MAX && fuzz_compile_input(data, size, ".scene", NULL, &blob, &len) == 0) {
         fuzz_draw(blob, len, NULL, 1);
         free(blob);
     }
