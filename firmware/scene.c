@@ -261,10 +261,10 @@ static scene_status check_tree(const scene *s, scene_error *err)
     uint32_t sp = 0, visits = 0, deepest = 0;
     uint32_t root = s->hdr->root;
     if (root & SCN_LEAF_BIT) {
-        if ((root & ~SCN_LEAF_BIT) >= s->nleaves) return fail(err, SCENE_ERR_INDEX, -1, 0);
-        return (s->nnodes == 0) ? SCENE_OK : fail(err, SCENE_ERR_TREE, -1, 0);
+        if ((root & ~SCN_LEAF_BIT) >= s->nleaves) return fail(err, SCENE_ERR_INDEX, -1, SCENE_FIELD_ROOT);
+        return (s->nnodes == 0) ? SCENE_OK : fail(err, SCENE_ERR_TREE, -1, SCENE_FIELD_ROOT);
     }
-    if (root >= s->nnodes) return fail(err, SCENE_ERR_INDEX, -1, 0);
+    if (root >= s->nnodes) return fail(err, SCENE_ERR_INDEX, -1, SCENE_FIELD_ROOT);
     stack[sp] = root;
     depth[sp++] = 1;
     while (sp > 0) {
@@ -281,7 +281,7 @@ static scene_status check_tree(const scene *s, scene_error *err)
             depth[sp++] = (uint8_t)(d + 1);
         }
     }
-    if (deepest > s->hdr->max_depth) return fail(err, SCENE_ERR_TREE, -1, 0);
+    if (deepest > s->hdr->max_depth) return fail(err, SCENE_ERR_TREE, -1, SCENE_FIELD_MAX_DEPTH);
     return SCENE_OK;
 }
 
@@ -296,19 +296,20 @@ scene_status scene_parse(scene *s, const void *blob, uint32_t len, scene_error *
     if (!blob || len < sizeof(scn_header)) return fail(err, SCENE_ERR_SHORT, -1, 0);
     if (((uintptr_t)blob & 3u) != 0) return fail(err, SCENE_ERR_ALIGN, -1, 0);
     const scn_header *h = (const scn_header *)blob;
-    if (h->magic != SCN_MAGIC) return fail(err, SCENE_ERR_MAGIC, -1, 0);
-    if (h->version != SCN_VERSION) return fail(err, SCENE_ERR_VERSION, -1, 0);
+    if (h->magic != SCN_MAGIC) return fail(err, SCENE_ERR_MAGIC, -1, SCENE_FIELD_MAGIC);
+    if (h->version != SCN_VERSION) return fail(err, SCENE_ERR_VERSION, -1, SCENE_FIELD_VERSION);
+    if (h->header_bytes != sizeof(scn_header)) return fail(err, SCENE_ERR_HEADER, -1, SCENE_FIELD_HEADER_BYTES);
     /* total_bytes below the header would make the CRC's length below wrap */
-    if (h->header_bytes != sizeof(scn_header) || (h->total_bytes & 3u) || h->total_bytes < sizeof(scn_header))
-        return fail(err, SCENE_ERR_HEADER, -1, 0);
-    if (h->total_bytes > len) return fail(err, SCENE_ERR_SHORT, -1, 0);
-    if (crc_update(0, base + 16, h->total_bytes - 16) != h->crc32) return fail(err, SCENE_ERR_CRC, -1, 0);
-    if (h->flags != 0) return fail(err, SCENE_ERR_HEADER, -1, 0);
-    if (h->max_depth > SCN_MAX_DEPTH) return fail(err, SCENE_ERR_TREE, -1, 0);
+    if ((h->total_bytes & 3u) || h->total_bytes < sizeof(scn_header))
+        return fail(err, SCENE_ERR_HEADER, -1, SCENE_FIELD_TOTAL_BYTES);
+    if (h->total_bytes > len) return fail(err, SCENE_ERR_SHORT, -1, SCENE_FIELD_TOTAL_BYTES);
+    if (crc_update(0, base + 16, h->total_bytes - 16) != h->crc32) return fail(err, SCENE_ERR_CRC, -1, SCENE_FIELD_CRC);
+    if (h->flags != 0) return fail(err, SCENE_ERR_HEADER, -1, SCENE_FIELD_FLAGS);
+    if (h->max_depth > SCN_MAX_DEPTH) return fail(err, SCENE_ERR_TREE, -1, SCENE_FIELD_MAX_DEPTH);
     if (h->player_sector != SCN_NONE && h->player_sector >= h->sec[SCN_SEC_SECTORS].count)
-        return fail(err, SCENE_ERR_INDEX, -1, 0);
+        return fail(err, SCENE_ERR_INDEX, -1, SCENE_FIELD_PLAYER_SECTOR);
     if (!coord_ok(h->player_x, SCN_COORD_MAX) || !coord_ok(h->player_y, SCN_COORD_MAX))
-        return fail(err, SCENE_ERR_RANGE, -1, 0);
+        return fail(err, SCENE_ERR_RANGE, -1, SCENE_FIELD_PLAYER_START);
     s->hdr = h;
     s->root = h->root;
     scene_status st = check_sections(s, base, h, err);

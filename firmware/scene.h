@@ -48,9 +48,16 @@ typedef enum {
 typedef struct {
     scene_status status;
     int section;     /* SCN_SEC_* of the offending record, or -1 */
-    uint32_t index;  /* its index; SCENE_ERR_BUILD: the SCENE_ITEM_* that does not fit */
+    uint32_t index;  /* its index; section -1: the SCENE_FIELD_*; SCENE_ERR_BUILD: the SCENE_ITEM_* that does not fit */
     uint32_t need, have; /* SCENE_ERR_BUILD: what the scene needs, what the build provides */
 } scene_error;
+
+/* A refusal of the header itself (section -1): which field, as scene_error.index. */
+enum {
+    SCENE_FIELD_NONE, SCENE_FIELD_MAGIC, SCENE_FIELD_VERSION, SCENE_FIELD_HEADER_BYTES, SCENE_FIELD_TOTAL_BYTES,
+    SCENE_FIELD_CRC, SCENE_FIELD_FLAGS, SCENE_FIELD_MAX_DEPTH, SCENE_FIELD_PLAYER_SECTOR, SCENE_FIELD_PLAYER_START,
+    SCENE_FIELD_ROOT
+};
 
 /* What a build provides, item by item (SCENE_ERR_BUILD's index): the features
  * SCN_NEED_* by bit number, then the sizes. */

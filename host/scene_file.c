@@ -80,60 +80,61 @@ int scene_file_load(const char *spec, const bspc_options *opt, uint8_t **blob, s
     return bspc_compile(spec, opt, blob, len, NULL, err, errlen);
 }
 
-/* What a header-level refusal (the loader's section -1) is about: the loader
- * checks the header's fields in a fixed order (firmware/scene.c scene_parse),
- * so the field is the first one that fails that status's check. */
-static void describe_header(const scn_header *h, size_t len, scene_status st, char *out, size_t n)
+/* A refusal of the header itself (the loader's section -1): the field the loader
+ * names (scene_error.index, SCENE_FIELD_*) with its value. */
+static void describe_header(const scn_header *h, size_t len, const scene_error *se, char *out, size_t n)
 {
-    switch (st) {
-    case SCENE_ERR_MAGIC:
+    switch (se->index) {
+    case SCENE_FIELD_MAGIC:
         snprintf(out, n, "header: magic 0x%08x, expected 0x%08x (\"BSCN\")", h->magic, SCN_MAGIC);
         break;
-    case SCENE_ERR_VERSION:
+    case SCENE_FIELD_VERSION:
         snprintf(out, n, "header: unsupported version %u (this program reads version %u: recompile the scene)",
                  h->version, SCN_VERSION);
         break;
-    case SCENE_ERR_HEADER:
-        if (h->header_bytes != sizeof(scn_header))
-            snprintf(out, n, "header: header_bytes = %u, expected %zu", h->header_bytes, sizeof(scn_header));
+    case SCENE_FIELD_HEADER_BYTES:
+        snprintf(out, n, "header: header_bytes = %u, expected %zu", h->header_bytes, sizeof(scn_header));
+        break;
+    case SCENE_FIELD_TOTAL_BYTES:
+        if (se->status == SCENE_ERR_SHORT)
+            snprintf(out, n, "truncated: header total_bytes = %u, but the file has %zu bytes", h->total_bytes, len);
         else if (h->total_bytes & 3u)
             snprintf(out, n, "header: total_bytes = %u is not a multiple of 4", h->total_bytes);
-        else if (h->total_bytes < sizeof(scn_header))
+        else
             snprintf(out, n, "header: total_bytes = %u, less than the header's %zu", h->total_bytes,
                      sizeof(scn_header));
-        else
-            snprintf(out, n, "header: flags = 0x%x, expected 0 (reserved)", h->flags);
         break;
-    case SCENE_ERR_SHORT:
-        snprintf(out, n, "truncated: header total_bytes = %u, but the file has %zu bytes", h->total_bytes, len);
+    case SCENE_FIELD_FLAGS:
+        snprintf(out, n, "header: flags = 0x%x, expected 0 (reserved)", h->flags);
         break;
-    case SCENE_ERR_CRC:
+    case SCENE_FIELD_CRC:
         snprintf(out, n, "bad CRC-32: header crc32 = 0x%08x, but bytes [16, %u) give 0x%08x (the file is damaged)",
                  h->crc32, h->total_bytes, crc_update(0, (const uint8_t *)h + 16, h->total_bytes - 16));
         break;
-    case SCENE_ERR_INDEX:
-        if (h->player_sector != SCN_NONE && h->player_sector >= h->sec[SCN_SEC_SECTORS].count)
-            snprintf(out, n, "header: player_sector = %u out of range (%u sectors)", h->player_sector,
-                     h->sec[SCN_SEC_SECTORS].count);
+    case SCENE_FIELD_PLAYER_SECTOR:
+        snprintf(out, n, "header: player_sector = %u out of range (%u sectors)", h->player_sector,
+                 h->sec[SCN_SEC_SECTORS].count);
+        break;
+    case SCENE_FIELD_PLAYER_START:
+        snprintf(out, n, "header: player start out of range (|coordinate| <= %d)", SCN_COORD_MAX);
+        break;
+    case SCENE_FIELD_ROOT:
+        if (se->status == SCENE_ERR_TREE)
+            snprintf(out, n, "header: root is a leaf, but there are %u nodes (not a tree)", h->sec[SCN_SEC_NODES].count);
         else if (h->root & SCN_LEAF_BIT)
             snprintf(out, n, "header: root = leaf %u out of range (%u leaves)", h->root & ~SCN_LEAF_BIT,
                      h->sec[SCN_SEC_LEAVES].count);
         else
             snprintf(out, n, "header: root = node %u out of range (%u nodes)", h->root, h->sec[SCN_SEC_NODES].count);
         break;
-    case SCENE_ERR_RANGE:
-        snprintf(out, n, "header: player start out of range (|coordinate| <= %d)", SCN_COORD_MAX);
-        break;
-    case SCENE_ERR_TREE:
+    case SCENE_FIELD_MAX_DEPTH:
         if (h->max_depth > SCN_MAX_DEPTH)
             snprintf(out, n, "header: max_depth = %u, deeper than %d", h->max_depth, SCN_MAX_DEPTH);
-        else if (h->root & SCN_LEAF_BIT)
-            snprintf(out, n, "header: root is a leaf, but there are %u nodes (not a tree)", h->sec[SCN_SEC_NODES].count);
         else
             snprintf(out, n, "header: max_depth = %u, but the tree is deeper", h->max_depth);
         break;
     default:
-        snprintf(out, n, "%s", scene_status_text(st));
+        snprintf(out, n, "%s", scene_status_text(se->status));
     }
 }
 
@@ -178,7 +179,7 @@ void scene_file_describe_error(const char *spec, const uint8_t *blob, size_t len
         snprintf(err, errlen, "%s: compiled scene rejected: %s record %u: %s", spec, scene_section_name(se->section),
                  se->index, st);
     else if (h) {
-        describe_header(h, len, se->status, what, sizeof what);
+        describe_header(h, len, se, what, sizeof what);
         snprintf(err, errlen, "%s: compiled scene rejected: %s", spec, what);
     } else
         snprintf(err, errlen, "%s: compiled scene rejected: %s", spec, st);
