@@ -164,9 +164,8 @@ def figures(name, log):
                 crashed=bool(CRASH.search(text)) or not done)
 
 
-def run_harness(name, seconds, corpus, log):
+def run_harness(name, seconds, corpus, log, seeds):
     """One libFuzzer run (its output in log); returns its figures, crashed if it did not end cleanly."""
-    seeds = make_seeds(name)
     regress = ROOT / "tests/fuzz/regress" / name
     crashes = FUZZ / "crashes" / name
     crashes.mkdir(parents=True, exist_ok=True)
@@ -186,9 +185,9 @@ def run_harness(name, seconds, corpus, log):
     return r
 
 
-def replay(name):
+def replay(name, seeds):
     """Every seed and regression input once (libFuzzer runs a corpus before fuzzing; -runs=0 stops there)."""
-    dirs = [make_seeds(name)] + [d for d in [ROOT / "tests/fuzz/regress" / name] if d.is_dir()]
+    dirs = [seeds] + [d for d in [ROOT / "tests/fuzz/regress" / name] if d.is_dir()]
     with tempfile.TemporaryDirectory() as tmp:
         r = subprocess.run([str(FUZZ / f"fuzz_{name}"), "-runs=0", *map(str, dirs)], cwd=ROOT,
                            capture_output=True, text=True, env=dict(os.environ, TMPDIR=tmp))
@@ -228,11 +227,12 @@ def main():
             sys.exit(f"fuzz: {FUZZ / f'fuzz_{n}'} is missing: build it with make fuzz-build")
 
     if a.smoke:
-        failed = [n for n in names if not replay(n)]
+        seeds = {n: make_seeds(n) for n in names}
+        failed = [n for n in names if not replay(n, seeds[n])]
         for n in failed:
             print(f"fuzz-smoke: {n}: a seed or kept regression fails (above)", file=sys.stderr)
         with tempfile.TemporaryDirectory() as tmp:
-            rows = [run_harness(n, 3, Path(tmp) / n, Path(tmp) / f"{n}.log") for n in names if n not in failed]
+            rows = [run_harness(n, 3, Path(tmp) / n, Path(tmp) / f"{n}.log", seeds[n]) for n in names if n not in failed]
             for r in rows:
                 if r["crashed"]:
                     sys.stderr.write(r["log"].read_text(errors="replace")[-4000:])
@@ -245,7 +245,7 @@ def main():
 
     print(f"fuzz: {len(names)} harnesses, {a.time} s each, {a.jobs} at once", flush=True)
     with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, a.jobs)) as pool:
-        futures = {pool.submit(run_harness, n, a.time, FUZZ / "corpus" / n, FUZZ / f"{n}.log"): n for n in names}
+        futures = {pool.submit(run_harness, n, a.time, FUZZ / "corpus" / n, FUZZ / f"{n}.log", make_seeds(n)): n for n in names}
         rows = []
         for f in concurrent.futures.as_completed(futures):
             r = f.result()
