@@ -26,12 +26,14 @@ NULL_SRC  := hal/ram_target.c hal/null/hal_null.c
 SDL_SRC   := hal/ram_target.c hal/sdl/hal_sdl.c
 BSPC_LIB  := $(filter-out tools/bspc/main.c,$(sort $(wildcard tools/bspc/*.c)))
 HOST_LIB  := host/png.c host/scene_file.c
-FLOATFREE := firmware/% hal/fb.c hal/perf.c hal/ram_target.c hal/null/% hal/serial/% hal/mps2/% $(GEN)/%
+FLOATFREE := firmware/% hal/fb.c hal/perf.c hal/ram_target.c hal/null/% hal/serial/% hal/mps2/% hal/bare/% hal/pcvga/% $(GEN)/%
 
 # Each subsystem with rules of its own keeps them in mk/NAME.mk. They may add
 # sources to LINK_SRC (the frame link, linked into host programs and unit tests),
 # UNIT_EXTRA (more sources for the unit tests) and EXTRA_NOFLOAT_SRC.
 LINK_SRC   := $(wildcard hal/serial/*.c)
+# Shared by the bare-metal targets (hal/mps2, hal/pcvga): camera paths, options, printf, memory functions.
+BARE_SRC   := $(sort $(wildcard hal/bare/*.c))
 UNIT_EXTRA := tests/unit/scene_fixture.c
 EXTRA_NOFLOAT_SRC :=
 -include $(sort $(wildcard mk/*.mk))

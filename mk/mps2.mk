@@ -43,11 +43,11 @@ MPS2_LINK_SRC :=
 else
 $(error mk/mps2.mk: STREAM=$(STREAM): framelink or raw)
 endif
-MPS2_ALL_SRC := $(sort $(wildcard hal/mps2/*.c))
+MPS2_ALL_SRC := $(sort $(wildcard hal/mps2/*.c)) $(BARE_SRC)
 MPS2_SRC := $(filter-out hal/mps2/stream_%.c,$(MPS2_ALL_SRC)) $(if $(filter raw,$(STREAM)),hal/mps2/stream_raw.c,hal/mps2/stream_fl.c)
 ARM_CFLAGS := -std=c11 -O2 -g -mcpu=cortex-m3 -mthumb -mfloat-abi=soft -ffreestanding -nostdlib \
               -fno-strict-aliasing -fno-tree-loop-distribute-patterns -ffunction-sections -fdata-sections \
-              $(WARN) -Ifirmware -Ihal -Ihal/mps2 -Ihal/serial
+              $(WARN) -Ifirmware -Ihal -Ihal/mps2 -Ihal/bare -Ihal/serial
 ARM_SRC  := $(FW_SRC) $(HAL_SRC) $(MPS2_SRC) $(MPS2_LINK_SRC)
 # Objects of a FULL=1 build do not depend on the scene: its ARM_OBJ may be
 # shared by several ARM_OUTs. A build for one scene compiles them for it.

@@ -24,7 +24,7 @@ if command -v arm-none-eabi-gcc >/dev/null; then
   for f in "${arm_srcs[@]}"; do
     o="$tmp/$(echo "$f" | tr '/' '_').o"
     if ! arm-none-eabi-gcc -std=c11 -O2 -mcpu=cortex-m3 -mthumb -mfloat-abi=soft -ffreestanding \
-         -fno-strict-aliasing -fno-tree-loop-distribute-patterns -Ifirmware -Ihal -Ihal/null -c "$f" -o "$o"; then
+         -fno-strict-aliasing -fno-tree-loop-distribute-patterns -Ifirmware -Ihal -Ihal/null -Ihal/bare -c "$f" -o "$o"; then
       echo "nofloat: $f does not compile for Cortex-M3"; fail=1; continue
     fi
     objs+=("$o")

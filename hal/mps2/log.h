@@ -1,5 +1,5 @@
-/* log.h - text messages from the firmware (prefix log_): a tiny printf (%s %c
- * %d %u %x, with optional 0 flag and width, and %% only) into one line, sent to
+/* log.h - text messages from the firmware (prefix log_): one line formatted by
+ * hal/bare/format.h's tiny printf, sent to
  * the host's console over semihosting and, as text, over the UART.
  *
  * On the UART, text is only ever sent outside a frame-link message (before the
@@ -18,8 +18,5 @@ void log_vprintf(const char *fmt, va_list ap);
 #define LOG_TO_UART 1u
 #define LOG_TO_SEMIHOST 2u
 void log_set_sinks(unsigned sinks);
-
-/* Format into buf (always NUL-terminated); returns the length written. */
-int log_format(char *buf, int size, const char *fmt, va_list ap);
 
 #endif

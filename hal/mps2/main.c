@@ -64,6 +64,11 @@ static const char *status_text(scene_status st)
     return scene_status_text(st);
 }
 
+static stream_acks acks_of(int a)
+{
+    return a == ARGS_ACKS_ON ? STREAM_ACKS_ON : a == ARGS_ACKS_OFF ? STREAM_ACKS_OFF : STREAM_ACKS_AUTO;
+}
+
 static void setup_fixed_view(engine *e, const fw_args *a)
 {
     if (a->have_at) {
@@ -88,7 +93,7 @@ int main(void)
 
     mps2_board_init();
     if (sh_get_cmdline(cmdline, sizeof cmdline) != 0) cmdline[0] = '\0';
-    if (args_parse(&args, cmdline, err, sizeof err) != 0) {
+    if (args_parse(&args, cmdline, ARGS_STREAM | ARGS_NO_TICK, err, sizeof err) != 0) {
         log_printf("firmware: %s\n", err);
         return FW_EXIT_ARGS;
     }
@@ -135,7 +140,7 @@ int main(void)
     uint32_t frames = args.frames >= 0 ? (uint32_t)args.frames : campath_frames(path);
     mps2_set_path(fixed_view ? 0 : path);
     /* the ack timeout runs on the tick: without it a silent receiver would stall the firmware */
-    stream_set_acks(args.no_tick ? STREAM_ACKS_OFF : (stream_acks)args.acks);
+    stream_set_acks(args.no_tick ? STREAM_ACKS_OFF : acks_of(args.acks));
     /* Once a frame-link stream is on the UART, text goes to the semihosting
      * console only: text between its messages would cost the receiver a bad
      * message. Errors before that point go to both. */

@@ -19,6 +19,7 @@
 #include "crc32.h"
 #include "framelink.h"
 #include "hal.h"
+#include "format.h"
 #include "log.h"
 #include "uart.h"
 
@@ -128,7 +129,7 @@ static void format(char *buf, int size, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    log_format(buf, size, fmt, ap);
+    fmt_format(buf, size, fmt, ap);
     va_end(ap);
 }
 

@@ -1,12 +1,11 @@
-/* args.c - the firmware's run-time options (see args.h). */
+/* args.c - the bare-metal firmwares' run-time options (see args.h). */
 #include "args.h"
 
 #include <stdarg.h>
 
 #include "hal.h"
-#include "log.h"
+#include "format.h"
 #include "render.h"
-#include "stream.h"
 
 #define FRAC_DIGITS_MAX 30 /* as many as the host tools use for rounding */
 
@@ -68,9 +67,18 @@ static int fail(char *err, int size, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    log_format(err, size, fmt, ap);
+    fmt_format(err, size, fmt, ap);
     va_end(ap);
     return -1;
+}
+
+/* The ARGS_* feature an option belongs to (0: every target has it). */
+static unsigned option_feature(const char *o)
+{
+    if (same(o, "--no-stream") || same(o, "--acks")) return ARGS_STREAM;
+    if (same(o, "--no-tick")) return ARGS_NO_TICK;
+    if (same(o, "--wait")) return ARGS_WAIT;
+    return 0;
 }
 
 /* Split "a,b[,c]" in place; returns the number of parts (at most max). */
@@ -88,7 +96,7 @@ static int split_commas(char *s, char **parts, int max)
     return n;
 }
 
-int args_parse(fw_args *a, char *line, char *err, int errsize)
+int args_parse(fw_args *a, char *line, unsigned offered, char *err, int errsize)
 {
     char *words[32];
     int n = 0;
@@ -106,13 +114,18 @@ int args_parse(fw_args *a, char *line, char *err, int errsize)
     a->x = a->y = a->z = a->angle_deg = 0;
     a->look = 0;
     a->mode = a->present = -1;
-    a->no_stream = a->no_tick = a->fault = 0;
-    a->acks = STREAM_ACKS_AUTO;
+    a->no_stream = a->no_tick = a->fault = a->wait = 0;
+    a->acks = ARGS_ACKS_AUTO;
     for (int i = 1; i < n; i++) { /* words[0]: the program */
         const char *o = words[i];
         char *val = i + 1 < n ? words[i + 1] : 0;
-        if (same(o, "--no-stream") || same(o, "--no-tick") || same(o, "--fault")) {
-            *(same(o, "--no-stream") ? &a->no_stream : same(o, "--no-tick") ? &a->no_tick : &a->fault) = 1;
+        unsigned needs = option_feature(o);
+        if (needs && !(offered & needs)) return fail(err, errsize, "option '%s' is not available on this target", o);
+        if (same(o, "--no-stream") || same(o, "--no-tick") || same(o, "--fault") || same(o, "--wait")) {
+            *(same(o, "--no-stream") ? &a->no_stream
+              : same(o, "--no-tick") ? &a->no_tick
+              : same(o, "--wait")    ? &a->wait
+                                     : &a->fault) = 1;
             continue;
         }
         if (!val) return fail(err, errsize, "%s: missing value", o);
@@ -143,9 +156,9 @@ int args_parse(fw_args *a, char *line, char *err, int errsize)
             if ((a->present = hal_present_parse(val)) < 0)
                 return fail(err, errsize, "--present '%s': flip, copy8, copy16 or copy32", val);
         } else if (same(o, "--acks")) {
-            if (same(val, "auto")) a->acks = STREAM_ACKS_AUTO;
-            else if (same(val, "on")) a->acks = STREAM_ACKS_ON;
-            else if (same(val, "off")) a->acks = STREAM_ACKS_OFF;
+            if (same(val, "auto")) a->acks = ARGS_ACKS_AUTO;
+            else if (same(val, "on")) a->acks = ARGS_ACKS_ON;
+            else if (same(val, "off")) a->acks = ARGS_ACKS_OFF;
             else return fail(err, errsize, "--acks '%s': auto, on or off", val);
         } else {
             return fail(err, errsize, "unknown option '%s'", o);
