@@ -56,15 +56,86 @@ static int shown_index(void)
 
 hal_surface hal_begin_frame(hal_present_mode m)
 {
-    hal_surface s = { NULL, 0 };
+    hal_surface s = { NULL, 0, 0 };
     if (m == HAL_PRESENT_FLIP) {
         s.pixels = hal_target_vram(1 - shown_index());
         s.in_vram = 1;
+        s.planar = hal_target_vram_planar() ? 1 : 0;
     } else if (m == HAL_PRESENT_COPY8 || m == HAL_PRESENT_COPY16 || m == HAL_PRESENT_COPY32) {
         s.pixels = hal_target_sysmem();
         s.in_vram = 0;
     }
     return s; /* unknown mode: pixels NULL, hal_fill_span ignores it */
+}
+
+/* Write n bytes of one value from p: a byte to reach 2-alignment, a word to
+ * reach 4-alignment, aligned dwords, then a word and a byte; adds the
+ * transactions of each width to w[0..2]. */
+static void fill_run(uint8_t *p, uint32_t n, uint8_t colour, uint32_t w[3])
+{
+    uint16_t c16 = (uint16_t)(colour * 0x0101u);
+    uint32_t c32 = colour * 0x01010101u;
+    if (((uintptr_t)p & 1u) != 0 && n >= 1) {
+        *(volatile uint8_t *)p = colour;
+        p += 1;
+        n -= 1;
+        w[0]++;
+    }
+    if (((uintptr_t)p & 2u) != 0 && n >= 2) {
+        *(volatile uint16_t *)(void *)p = c16;
+        p += 2;
+        n -= 2;
+        w[1]++;
+    }
+    uint32_t n32 = n >> 2;
+    volatile uint32_t *d = (volatile uint32_t *)(void *)p;
+    for (uint32_t i = 0; i < n32; i++)
+        d[i] = c32;
+    w[2] += n32;
+    p += n32 * 4u;
+    n &= 3u;
+    if (n >= 2) {
+        *(volatile uint16_t *)(void *)p = c16;
+        p += 2;
+        n -= 2;
+        w[1]++;
+    }
+    if (n != 0) {
+        *(volatile uint8_t *)p = colour;
+        w[0]++;
+    }
+}
+
+/* Pixels [x, x + len) of a planar row: 4-pixel groups, one byte each. A group
+ * the span only partly covers is written alone with its pixels' planes; the
+ * whole groups between are one run with every plane enabled. */
+static void fill_planar(uint8_t *row, uint32_t x, uint32_t len, uint8_t colour, uint32_t w[3])
+{
+    uint32_t g0 = x >> 2, g1 = (x + len - 1u) >> 2; /* first and last group, inclusive */
+    unsigned first = (0xFu << (x & 3u)) & 0xFu;
+    unsigned last = 0xFu >> (3u - ((x + len - 1u) & 3u));
+    if (g0 == g1) {
+        hal_target_plane_mask(first & last);
+        *(volatile uint8_t *)(row + g0) = colour;
+        w[0]++;
+        return;
+    }
+    if (first != 0xFu) {
+        hal_target_plane_mask(first);
+        *(volatile uint8_t *)(row + g0) = colour;
+        w[0]++;
+        g0++;
+    }
+    if (last != 0xFu) {
+        hal_target_plane_mask(last);
+        *(volatile uint8_t *)(row + g1) = colour;
+        w[0]++;
+        g1--;
+    }
+    if (g0 <= g1) {
+        hal_target_plane_mask(0xFu);
+        fill_run(row + g0, g1 - g0 + 1u, colour, w);
+    }
 }
 
 void hal_fill_span(const hal_surface *s, int y, int x, int len, uint8_t colour)
@@ -82,45 +153,12 @@ void hal_fill_span(const hal_surface *s, int y, int x, int len, uint8_t colour)
     if (len > HAL_WIDTH - x)
         len = HAL_WIDTH - x;
 
-    uint8_t *p = s->pixels + (uint32_t)y * HAL_WIDTH + (uint32_t)x;
-    uint32_t n = (uint32_t)len;
-    uint32_t n8 = 0, n16 = 0, n32;
-    uint16_t c16 = (uint16_t)(colour * 0x0101u);
-    uint32_t c32 = colour * 0x01010101u;
-
-    /* head: a byte to reach 2-alignment, a word to reach 4-alignment */
-    if (((uintptr_t)p & 1u) != 0) {
-        *(volatile uint8_t *)p = colour;
-        p += 1;
-        n -= 1;
-        n8++;
-    }
-    if (((uintptr_t)p & 2u) != 0 && n >= 2) {
-        *(volatile uint16_t *)(void *)p = c16;
-        p += 2;
-        n -= 2;
-        n16++;
-    }
-    /* middle: aligned dwords */
-    n32 = n >> 2;
-    volatile uint32_t *w = (volatile uint32_t *)(void *)p;
-    for (uint32_t i = 0; i < n32; i++)
-        w[i] = c32;
-    p += n32 * 4u;
-    n &= 3u;
-    /* tail: a word, then a byte */
-    if (n >= 2) {
-        *(volatile uint16_t *)(void *)p = c16;
-        p += 2;
-        n -= 2;
-        n16++;
-    }
-    if (n != 0) {
-        *(volatile uint8_t *)p = colour;
-        n8++;
-    }
-
-    hal_perf_add_span(s->in_vram ? HAL_DEST_VRAM : HAL_DEST_SYSMEM, n8, n16, n32, (uint32_t)len);
+    uint32_t w[3] = { 0, 0, 0 }; /* transactions of 1, 2 and 4 bytes */
+    if (s->planar)
+        fill_planar(s->pixels + (uint32_t)y * (HAL_WIDTH / 4), (uint32_t)x, (uint32_t)len, colour, w);
+    else
+        fill_run(s->pixels + (uint32_t)y * HAL_WIDTH + (uint32_t)x, (uint32_t)len, colour, w);
+    hal_perf_add_span(s->in_vram ? HAL_DEST_VRAM : HAL_DEST_SYSMEM, w[0], w[1], w[2], (uint32_t)len);
 }
 
 /* The copies: the system-memory buffer and the pages are 4-aligned and
@@ -182,6 +220,8 @@ void hal_present(hal_present_mode m)
 
 const uint8_t *hal_shown_page(void)
 {
+    if (hal_target_vram_planar())
+        return NULL;
     return hal_target_vram(shown_index());
 }
 

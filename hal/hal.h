@@ -12,7 +12,7 @@
  * the Pentium's (two programmable counters with selectable events plus a
  * time-stamp-style cycle counter driven by a bus cost model).
  *
- * Per target (hal/null, hal/sdl, hal/mps2, ...): where VRAM, the system-memory
+ * Per target (hal/null, hal/sdl, hal/mps2, hal/pcvga, ...): where VRAM, the system-memory
  * buffer and the palette live, what showing a page means, input and time.
  * The firmware owns no main loop: the target calls the engine step.
  */
@@ -76,8 +76,9 @@ uint64_t hal_perf_tsc(void);                     /* modelled bus cycles since re
 
 /* ---- framebuffer writes (counted) -------------------------------------- */
 typedef struct {
-    uint8_t *pixels; /* 320 x 200, pitch 320 */
+    uint8_t *pixels; /* linear: 320 x 200, pitch 320; planar: the page's first byte */
     uint8_t in_vram; /* 1: VRAM page, 0: system memory */
+    uint8_t planar;  /* 1: a VRAM page in the VGA's unchained layout (hal_target_vram_planar) */
 } hal_surface;
 
 /* Start a frame: the surface to draw into is the hidden VRAM page (flip) or the
@@ -87,14 +88,19 @@ hal_surface hal_begin_frame(hal_present_mode m);
 
 /* Fill pixels [x, x+len) of row y with one colour, with aligned dword writes in
  * the middle and byte/word writes at the ends, counting every transaction.
- * Out-of-range rows or columns are clipped, never written. */
+ * Out-of-range rows or columns are clipped, never written. On a planar page a
+ * byte covers 4 pixels (one per plane): the partial groups at the ends are
+ * written with the plane mask of their pixels, the whole groups between them
+ * with every plane enabled, so a dword write fills 16 pixels; the bytes event
+ * counts the bytes the processor wrote, the pixels event the pixels. */
 void hal_fill_span(const hal_surface *s, int y, int x, int len, uint8_t colour);
 
 /* Finish a frame: flip the display start to the drawn page, or copy the
  * system-memory buffer to the shown VRAM page with the chosen width (counted). */
 void hal_present(hal_present_mode m);
 
-/* The page the display shows now (what a camera pointed at the screen sees). */
+/* The page the display shows now (what a camera pointed at the screen sees);
+ * NULL when the pages are planar (the target reads those back itself). */
 const uint8_t *hal_shown_page(void);
 
 /* Palette: 768 bytes, 8 bits per gun. */
@@ -129,5 +135,12 @@ uint8_t *hal_target_sysmem(void);          /* the system-memory back buffer */
 uint8_t *hal_target_palette(void);         /* HAL_PALETTE_BYTES */
 void hal_target_set_display_start(int page);
 int hal_target_display_start(void);
+/* How the VRAM pages are laid out: 0 linear (pitch 320, every target but
+ * hal/pcvga in flip mode); 1 the VGA's unchained layout, pixel (x, y) in plane
+ * x & 3 at byte y * 80 + x / 4 of the page, each write reaching the planes
+ * hal_target_plane_mask last enabled (bit p: plane p). The system-memory
+ * buffer is always linear. */
+int hal_target_vram_planar(void);
+void hal_target_plane_mask(unsigned planes);
 
 #endif

@@ -127,7 +127,7 @@ void hal_perf_add_span(int dest, uint32_t n8, uint32_t n16, uint32_t n32, uint32
 {
     uint64_t n = (uint64_t)n8 + n16 + n32;
     perf.total[HAL_EV_WRITES] += n;
-    perf.total[HAL_EV_BYTES] += pixels;
+    perf.total[HAL_EV_BYTES] += (uint64_t)n8 + 2u * (uint64_t)n16 + 4u * (uint64_t)n32;
     perf.total[HAL_EV_WRITES8] += n8;
     perf.total[HAL_EV_WRITES16] += n16;
     perf.total[HAL_EV_WRITES32] += n32;

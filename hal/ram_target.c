@@ -35,6 +35,17 @@ int hal_target_display_start(void)
     return display_start;
 }
 
+/* linear pages: no planes to select */
+int hal_target_vram_planar(void)
+{
+    return 0;
+}
+
+void hal_target_plane_mask(unsigned planes)
+{
+    (void)planes;
+}
+
 void hal_ram_target_reset(void)
 {
     for (int p = 0; p < 2; p++)

@@ -6,7 +6,8 @@ import pytest
 
 from conftest import ROOT
 
-FILES = ["firmware/raster.c", "firmware/scene.c", "hal/fb.c", "hal/null/hal_null.c", "hal/sdl/hal_sdl.c"]
+FILES = ["firmware/raster.c", "firmware/scene.c", "hal/fb.c", "hal/null/hal_null.c", "hal/sdl/hal_sdl.c",
+         "hal/pcvga/vga.c"]
 
 
 def nofloat(*extra):

@@ -12,6 +12,8 @@ PACKAGES=(
   libcmocka-dev               # C unit tests
   gcc-arm-none-eabi           # Cortex-M build (firmware, no-float check)
   qemu-system-arm             # the Cortex-M3 board (mps2-an385) the firmware runs on in tests
+  qemu-system-x86             # the PC (i386, VGA) the hal/pcvga kernel runs on in tests
+  gcc-multilib                # gcc -m32 and its libgcc: the hal/pcvga kernel
   libglib2.0-dev pkg-config   # building the QEMU instruction-counting plugin
   libusb-1.0-0-dev            # host/flash: USB DFU
   freedoom                    # real maps: freedoom1.wad, freedoom2.wad

@@ -38,6 +38,17 @@ int hal_target_display_start(void)
     return mps2_display_start ? 1 : 0;
 }
 
+/* linear pages: no planes to select */
+int hal_target_vram_planar(void)
+{
+    return 0;
+}
+
+void hal_target_plane_mask(unsigned planes)
+{
+    (void)planes;
+}
+
 uint32_t hal_input(void)
 {
     return st.path ? campath_keys(st.path, st.frame) : 0;
