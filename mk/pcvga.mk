@@ -10,6 +10,9 @@
 #       headless); COM1 (the kernel's log) on the terminal; QEMU's exit status is
 #       2 * the kernel's + 1 (isa-debug-exit). RUN_ARGS defaults to
 #       "--linger 3000", which keeps the last frame up for three seconds.
+#   make bench-pcvga  write counters per frame in each present mode over the
+#       camera path, beside the host's linear page (tools/pcvga.py bench ->
+#       build/bench-pcvga.md); make bench runs it too
 #
 # Integer-only: compiled with -mgeneral-regs-only (no x87 or SSE register can
 # be used), and the link fails if libgcc's floating-point helpers are in it.
@@ -33,7 +36,7 @@ PC_OBJS   := $(patsubst %.c,$(PC_OBJ)/%.o,$(PC_SRC)) $(patsubst %.S,$(PC_OBJ)/%.
 # libgcc's floating-point helpers for i386 (soft-float entry points and conversions).
 PC_FLOAT_HELPERS := '^__(add|sub|mul|div|neg|fix|fixuns|float|floatun|extend|trunc|cmp|eq|ne|lt|le|gt|ge|unord|pow|powi)[sdtx]f[0-9]?$$'
 
-.PHONY: pcvga run-pcvga nofloat-pcvga
+.PHONY: pcvga run-pcvga nofloat-pcvga bench-pcvga
 
 # hal/pcvga is a target like the others: no floating point (`make nofloat`).
 nofloat: nofloat-pcvga
@@ -89,5 +92,10 @@ run-pcvga: $(PC_OUT)/kernel.elf
 	@echo "pcvga: display $(PC_DISPLAY); COM1 below; QEMU exits with 2 x the kernel's status + 1"
 	$(PC_QEMU) -display $(PC_DISPLAY) $(if $(RUN_ARGS),-append '$(RUN_ARGS)'); \
 	  s=$$?; echo "pcvga: QEMU exit status $$s (kernel status $$(( (s - 1) / 2 )))"; [ $$s -eq 1 ]
+
+bench-pcvga: $(PC_OUT)/kernel.elf $(BUILD)/render
+	$(PY) tools/pcvga.py bench $(PC_OUT)/kernel.elf --scene $(PC_OUT)/scene.bsc -o $(BUILD)/bench-pcvga.md
+
+bench: bench-pcvga
 
 -include $(shell find $(PC_OBJ) -name '*.d' 2>/dev/null)

@@ -3,6 +3,7 @@
 
     python tools/pcvga.py shot KERNEL [--args "--at 700.5,120 --present copy32"]
                               [--scene SCENE.bsc] [-o shot.png] [--json out.json]
+    python tools/pcvga.py bench KERNEL --scene SCENE.bsc [--frames N] [-o table.md]
 
 boots KERNEL headless (-display none) with COM1 on a pipe and QMP on a unix socket,
 runs it with --wait added to its options, takes the screen with QMP's screendump once
@@ -13,6 +14,9 @@ back into 320x200 DAC values and, with --scene, compared with what build/render
 draws from the camera of the last frame and in the same modes: the DAC values of every pixel, and the
 palette indices wherever the scene's palette tells them apart at 6 bits. -o writes
 the screendump as a PNG. Prints one JSON object.
+
+bench runs the kernel's camera path in each present mode and prints the median write
+counters per frame, beside build/render's linear page for the same frames (make bench-pcvga).
 
 Library use (tests/test_pcvga.py): Kernel, dac_frame, indices, render_reference.
 """
@@ -228,7 +232,7 @@ def render_reference(scene, frame, args, render=ROOT / "build" / "render"):
 
 
 COUNTERS = ("writes", "bytes", "writes8", "writes16", "writes32", "vram_writes", "sysmem_writes", "pixels",
-            "copy_writes")
+            "copy_writes", "bus_cycles")
 FRAME_LINE = re.compile(r"^frame (\d+) (.*)$", re.M)
 
 
@@ -287,6 +291,35 @@ def shot(kernel, args, scene=None, png=None, timeout=60):
     return out
 
 
+def bench(kernel, scene, frames=None):
+    """Per-frame write counters of the kernel's camera path in each present mode (medians),
+    beside build/render's linear page for the same frames in flip mode. Markdown text."""
+    rows, cams = [], None
+    for present in ("copy8", "copy16", "copy32", "flip"):
+        args = f"--present {present}" + (f" --frames {frames}" if frames else "")
+        status, log = run(kernel, args, timeout=600)
+        if exit_status(status) != 0:
+            raise RuntimeError(f"pcvga: the kernel failed ({args}):\n{log}")
+        lines = frame_lines(log)
+        cams = cams or lines
+        rows.append((f"{present} (VGA{' unchained' if present == 'flip' else ' mode 13h'})", lines))
+    linear = [render_reference(scene, f, "--present flip")[2] for f in cams]
+    rows.append(("flip, linear page (build/render, host)", linear))
+
+    def med(items, key):
+        return int(np.median([it[key] for it in items]))
+
+    keys = ("writes", "bytes", "writes8", "writes16", "writes32", "vram_writes", "sysmem_writes", "copy_writes",
+            "bus_cycles")
+    out = [f"Per frame, median of {len(cams)} frames of the kernel's camera path (bus cycles: hal.h's model, "
+           "VRAM 8 and system memory 1 a transaction):", "",
+           "| present | " + " | ".join(k.replace("_", " ") for k in keys) + " |",
+           "|---|" + "---:|" * len(keys)]
+    for name, items in rows:
+        out.append(f"| {name} | " + " | ".join(f"{med(items, k):,}" for k in keys) + " |")
+    return "\n".join(out) + "\n"
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="pcvga.py", description=__doc__.split("\n\n")[1],
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -298,7 +331,21 @@ def main(argv=None):
     s.add_argument("-o", dest="png", help="write the screendump as a PNG")
     s.add_argument("--json", help="also write the summary here")
     s.add_argument("--timeout", type=float, default=60)
+    b = sub.add_parser("bench", help="write counters per present mode over the camera path (markdown)")
+    b.add_argument("kernel", help="build/pcvga/kernel.elf (make pcvga)")
+    b.add_argument("--scene", required=True, help="its compiled scene (build/pcvga/scene.bsc)")
+    b.add_argument("--frames", type=int, help="only the path's first N frames")
+    b.add_argument("-o", dest="out", help="also write the table here")
     a = ap.parse_args(argv)
+    if a.cmd == "bench":
+        for f in (a.kernel, a.scene):
+            if not Path(f).is_file():
+                ap.error(f"{f}: no such file (make pcvga)")
+        text = bench(a.kernel, a.scene, a.frames)
+        print(text, end="")
+        if a.out:
+            Path(a.out).write_text(text)
+        return 0
     if not Path(a.kernel).is_file():
         ap.error(f"{a.kernel}: no such kernel (make pcvga)")
     if a.scene and not Path(a.scene).is_file():

@@ -6,7 +6,8 @@
  * (unchained for flip), then for each frame of the scripted camera path (or of
  * a fixed view) step the engine and report on COM1 one line: the CRC-32 of the
  * frame the VGA shows (read back from VGA memory), the camera it was rendered
- * from and the frame's write counters. Then, with --wait, wait for a byte on
+ * from, the frame's write counters and its modelled bus cycles (hal.h). Then,
+ * with --wait, wait for a byte on
  * COM1 (a test takes the screen meanwhile), and exit through isa-debug-exit.
  *
  * Exit statuses: exit.h (QEMU exits with 2 * status + 1).
@@ -108,7 +109,7 @@ static void report_frame(const engine *e, uint32_t f)
                (int)v->look, (unsigned)e->t_ms);
     for (int ev = 0; ev < HAL_EV_COUNT; ev++)
         log_printf(" %s %u", hal_event_name((hal_event)ev), (unsigned)hal_perf_event((hal_event)ev));
-    log_printf("\n");
+    log_printf(" bus_cycles %u\n", (unsigned)hal_perf_tsc());
 }
 
 static void wait_ms(uint32_t ms)
