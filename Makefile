@@ -58,6 +58,9 @@ $(1)/emu: $(call objs,$(1)/obj,host/emu.c $(GEN)/default_scene.c $(HOST_LIB) $(B
 	$$(CC) $(2) $$^ -o $$@ $$(SDL_LIBS) -lm
 $(1)/display: $(call objs,$(1)/obj,host/display.c host/png.c firmware/crc32.c $(HAL_SRC) $(SDL_SRC) $(sort $(LINK_SRC)))
 	$$(CC) $(2) $$^ -o $$@ $$(SDL_LIBS)
+# test_planar brings its own fake VGA target (hal_target_*): only fb.c and perf.c beside it
+$(1)/test_planar: $(call objs,$(1)/obj,tests/unit/test_planar.c $(HAL_SRC))
+	$$(CC) $(2) $$^ -o $$@ -lcmocka
 $(1)/test_%: $(call objs,$(1)/obj,tests/unit/test_%.c) $(call objs,$(1)/obj,$(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC) $(sort $(LINK_SRC) $(UNIT_EXTRA)))
 	$$(CC) $(2) $$^ -o $$@ -lcmocka -lm
 endef
@@ -96,6 +99,7 @@ help:
 	@echo "make test       deps, build, unit tests and pytest, with ASan and UBSan"
 	@echo "make bench      instructions per frame (callgrind), overdraw, VRAM writes, bus cycles on 20 views;"
 	@echo "                Cortex-M3 instructions per frame (bench-m3); link faults (bench-faults);"
+	@echo "                the PC kernel's write counters per present mode (bench-pcvga);"
 	@echo "                firmware flash and RAM, full against built for one scene (bench-size)"
 	@echo "make scene-host SCENE=...  build/scene/NAME/render, emu built for one scene (docs/needs.md)"
 	@echo "make fuzz       each libFuzzer harness (tests/fuzz) for FUZZ_TIME seconds (default 60), FUZZ=names;"
@@ -103,6 +107,9 @@ help:
 	@echo "make bench-link the frame link's bytes per frame and encoder cost"
 	@echo "make firmware   build/arm/firmware.elf for QEMU mps2-an385, built for its scene (SCENE=, FULL=1,"
 	@echo "                CAMPATH=); make run-firmware"
+	@echo "make pcvga      build/pcvga/kernel.elf: the bare PC kernel (multiboot, VGA mode 13h) for"
+	@echo "                qemu-system-i386 (SCENE=, FULL=1, CAMPATH=); make run-pcvga [RUN_ARGS=...];"
+	@echo "                make bench-pcvga (write counters per present mode)"
 	@echo "make flash      IMAGE=x.dfu DEVICE=VID:PID (or LOOPBACK=1): USB DFU download"
 	@echo "make bench-bsp  bspc over all 68 Freedoom maps per strategy, beside zdbsp and glbsp"
 	@echo "make report     error against the reference vs instructions per frame, per render mode and"
