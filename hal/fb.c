@@ -68,14 +68,15 @@ hal_surface hal_begin_frame(hal_present_mode m)
     return s; /* unknown mode: pixels NULL, hal_fill_span ignores it */
 }
 
-/* Write n bytes of one value from p: a byte to reach 2-alignment, a word to
- * reach 4-alignment, aligned dwords, then a word and a byte; adds the
- * transactions of each width to w[0..2]. */
-static void fill_run(uint8_t *p, uint32_t n, uint8_t colour, uint32_t w[3])
+/* Write n >= 1 bytes of one value from p: a byte to reach 2-alignment, a word
+ * to reach 4-alignment, aligned dwords, then a word and a byte; adds the
+ * transactions of each width to w[0..2]. Inlined into both callers, so the
+ * counts stay in registers. */
+static inline __attribute__((always_inline)) void fill_run(uint8_t *p, uint32_t n, uint8_t colour, uint32_t w[3])
 {
     uint16_t c16 = (uint16_t)(colour * 0x0101u);
     uint32_t c32 = colour * 0x01010101u;
-    if (((uintptr_t)p & 1u) != 0 && n >= 1) {
+    if (((uintptr_t)p & 1u) != 0) {
         *(volatile uint8_t *)p = colour;
         p += 1;
         n -= 1;
@@ -108,16 +109,19 @@ static void fill_run(uint8_t *p, uint32_t n, uint8_t colour, uint32_t w[3])
 
 /* Pixels [x, x + len) of a planar row: 4-pixel groups, one byte each. A group
  * the span only partly covers is written alone with its pixels' planes; the
- * whole groups between are one run with every plane enabled. */
-static void fill_planar(uint8_t *row, uint32_t x, uint32_t len, uint8_t colour, uint32_t w[3])
+ * whole groups between are one run with every plane enabled. Kept out of
+ * hal_fill_span (noinline): its calls to the target would otherwise make the
+ * linear path save and restore registers on every span. */
+static __attribute__((noinline)) void fill_planar(uint8_t *row, uint32_t x, uint32_t len, uint8_t colour)
 {
+    uint32_t w[3] = { 0, 0, 0 }; /* transactions of 1, 2 and 4 bytes */
     uint32_t g0 = x >> 2, g1 = (x + len - 1u) >> 2; /* first and last group, inclusive */
     unsigned first = (0xFu << (x & 3u)) & 0xFu;
     unsigned last = 0xFu >> (3u - ((x + len - 1u) & 3u));
     if (g0 == g1) {
         hal_target_plane_mask(first & last);
         *(volatile uint8_t *)(row + g0) = colour;
-        w[0]++;
+        hal_perf_add_span(HAL_DEST_VRAM, 1, 0, 0, len, 1);
         return;
     }
     if (first != 0xFu) {
@@ -136,6 +140,7 @@ static void fill_planar(uint8_t *row, uint32_t x, uint32_t len, uint8_t colour, 
         hal_target_plane_mask(0xFu);
         fill_run(row + g0, g1 - g0 + 1u, colour, w);
     }
+    hal_perf_add_span(HAL_DEST_VRAM, w[0], w[1], w[2], len, w[0] + 2u * w[1] + 4u * w[2]);
 }
 
 void hal_fill_span(const hal_surface *s, int y, int x, int len, uint8_t colour)
@@ -153,12 +158,13 @@ void hal_fill_span(const hal_surface *s, int y, int x, int len, uint8_t colour)
     if (len > HAL_WIDTH - x)
         len = HAL_WIDTH - x;
 
+    if (s->planar) { /* planar pages are VRAM */
+        fill_planar(s->pixels + (uint32_t)y * (HAL_WIDTH / 4), (uint32_t)x, (uint32_t)len, colour);
+        return;
+    }
     uint32_t w[3] = { 0, 0, 0 }; /* transactions of 1, 2 and 4 bytes */
-    if (s->planar)
-        fill_planar(s->pixels + (uint32_t)y * (HAL_WIDTH / 4), (uint32_t)x, (uint32_t)len, colour, w);
-    else
-        fill_run(s->pixels + (uint32_t)y * HAL_WIDTH + (uint32_t)x, (uint32_t)len, colour, w);
-    hal_perf_add_span(s->in_vram ? HAL_DEST_VRAM : HAL_DEST_SYSMEM, w[0], w[1], w[2], (uint32_t)len);
+    fill_run(s->pixels + (uint32_t)y * HAL_WIDTH + (uint32_t)x, (uint32_t)len, colour, w);
+    hal_perf_add_span(s->in_vram ? HAL_DEST_VRAM : HAL_DEST_SYSMEM, w[0], w[1], w[2], (uint32_t)len, (uint32_t)len);
 }
 
 /* The copies: the system-memory buffer and the pages are 4-aligned and

@@ -94,7 +94,7 @@ uint64_t hal_perf_tsc(void)
 }
 
 /* n transactions landing in VRAM or system memory, and their modelled cycles. */
-static void count_destination(int dest, uint64_t n)
+static inline __attribute__((always_inline)) void count_destination(int dest, uint64_t n)
 {
     if (dest == HAL_DEST_VRAM) {
         perf.total[HAL_EV_VRAM_WRITES] += n;
@@ -123,11 +123,11 @@ void hal_perf_add_writes(unsigned width_bytes, int dest, uint32_t count, int is_
         perf.total[HAL_EV_COPY_WRITES] += n;
 }
 
-void hal_perf_add_span(int dest, uint32_t n8, uint32_t n16, uint32_t n32, uint32_t pixels)
+void hal_perf_add_span(int dest, uint32_t n8, uint32_t n16, uint32_t n32, uint32_t pixels, uint32_t bytes)
 {
     uint64_t n = (uint64_t)n8 + n16 + n32;
     perf.total[HAL_EV_WRITES] += n;
-    perf.total[HAL_EV_BYTES] += (uint64_t)n8 + 2u * (uint64_t)n16 + 4u * (uint64_t)n32;
+    perf.total[HAL_EV_BYTES] += bytes;
     perf.total[HAL_EV_WRITES8] += n8;
     perf.total[HAL_EV_WRITES16] += n16;
     perf.total[HAL_EV_WRITES32] += n32;

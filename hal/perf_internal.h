@@ -20,9 +20,10 @@ void hal_perf_add_writes(unsigned width_bytes, int dest, uint32_t count, int is_
 void hal_perf_add_pixels(uint32_t count);
 
 /* Record one span fill in one call: n8, n16 and n32 transactions of each width
- * to dest, covering `pixels` pixels. The same totals as the separate calls, for
- * a fraction of the cost per span. (Bytes: n8 + 2 n16 + 4 n32, which is the
- * pixel count on a linear surface and a quarter of it, or so, on a planar one.) */
-void hal_perf_add_span(int dest, uint32_t n8, uint32_t n16, uint32_t n32, uint32_t pixels);
+ * to dest, covering `pixels` pixels with `bytes` = n8 + 2 n16 + 4 n32 bytes (the
+ * pixel count on a linear surface, a quarter of it or so on a planar one; the
+ * caller knows it without the sum). The same totals as the separate calls, for
+ * a fraction of the cost per span. */
+void hal_perf_add_span(int dest, uint32_t n8, uint32_t n16, uint32_t n32, uint32_t pixels, uint32_t bytes);
 
 #endif
