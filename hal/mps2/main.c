@@ -20,6 +20,7 @@
 #include "args.h"
 #include "campath.h"
 #include "engine.h"
+#include "fixed_view.h"
 #include "hal.h"
 #include "hal_mps2.h"
 #include "log.h"
@@ -69,22 +70,6 @@ static stream_acks acks_of(int a)
     return a == ARGS_ACKS_ON ? STREAM_ACKS_ON : a == ARGS_ACKS_OFF ? STREAM_ACKS_OFF : STREAM_ACKS_AUTO;
 }
 
-static void setup_fixed_view(engine *e, const fw_args *a)
-{
-    if (a->have_at) {
-        e->cam.view.x = a->x;
-        e->cam.view.y = a->y;
-    }
-    if (a->have_angle) e->cam.view.angle_deg = a->angle_deg;
-    e->cam.view.look = a->look;
-    if (a->have_z) {
-        e->cam.view.z = a->z;
-    } else {
-        e->cam.view.z = CAM_EYE_HEIGHT;
-        cam_follow_floor(&e->cam, &e->sc);
-    }
-}
-
 int main(void)
 {
     static engine e;
@@ -104,7 +89,7 @@ int main(void)
     }
     if (args.no_tick) tick_stop();
     if (args.fault) __asm__ volatile("udf #0");
-    int fixed_view = args.have_at || args.have_angle || args.look != 0;
+    int fixed_view = fixed_view_wanted(&args);
 
     scene_error se;
     scene_status st = eng_init(&e, fw_scene, fw_scene_len, &se);
@@ -135,7 +120,7 @@ int main(void)
     }
     if (args.mode >= 0) e.mode = (render_mode)args.mode;
     if (args.present >= 0) e.present = (hal_present_mode)args.present;
-    if (fixed_view) setup_fixed_view(&e, &args);
+    if (fixed_view) fixed_view_apply(&e, &args);
 
     uint32_t frames = args.frames >= 0 ? (uint32_t)args.frames : campath_frames(path);
     mps2_set_path(fixed_view ? 0 : path);

@@ -22,6 +22,7 @@
 #include "com1.h"
 #include "crc32.h"
 #include "engine.h"
+#include "fixed_view.h"
 #include "exit.h"
 #include "hal.h"
 #include "hal_pcvga.h"
@@ -63,22 +64,6 @@ static void keep_boot_info(boot_info *b, const uint32_t *info)
             n++;
         }
         b->cmdline[n] = '\0';
-    }
-}
-
-static void setup_fixed_view(engine *e, const fw_args *a)
-{
-    if (a->have_at) {
-        e->cam.view.x = a->x;
-        e->cam.view.y = a->y;
-    }
-    if (a->have_angle) e->cam.view.angle_deg = a->angle_deg;
-    e->cam.view.look = a->look;
-    if (a->have_z) {
-        e->cam.view.z = a->z;
-    } else {
-        e->cam.view.z = CAM_EYE_HEIGHT;
-        cam_follow_floor(&e->cam, &e->sc);
     }
 }
 
@@ -147,7 +132,7 @@ void pcvga_start(uint32_t magic, const uint32_t *info)
         pcvga_exit(PCVGA_EXIT_ARGS);
     }
     if (args.fault) __asm__ volatile("ud2");
-    int fixed_view = args.have_at || args.have_angle || args.look != 0;
+    int fixed_view = fixed_view_wanted(&args);
 
     scene_error se;
     scene_status st = eng_init(&e, fw_scene, fw_scene_len, &se);
@@ -165,7 +150,7 @@ void pcvga_start(uint32_t magic, const uint32_t *info)
     }
     if (args.mode >= 0) e.mode = (render_mode)args.mode;
     if (args.present >= 0) e.present = (hal_present_mode)args.present;
-    if (fixed_view) setup_fixed_view(&e, &args);
+    if (fixed_view) fixed_view_apply(&e, &args);
     pcvga_use_present(e.present);
 
     uint32_t frames = args.frames >= 0 ? (uint32_t)args.frames : campath_frames(path);
