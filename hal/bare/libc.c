@@ -1,7 +1,7 @@
 /* libc.c - the four memory functions gcc may call on its own (struct copies,
  * zeroed locals, freestanding code still gets them; -nostdlib links no libc).
  * Plain byte loops, word loops where both sides are aligned. This file is
- * compiled with -fno-tree-loop-distribute-patterns (mk/mps2.mk) so the loops
+ * compiled with -fno-tree-loop-distribute-patterns (mk/mps2.mk, mk/pcvga.mk) so the loops
  * below are not turned back into calls to themselves. */
 #include <stddef.h>
 #include <stdint.h>
