@@ -25,6 +25,7 @@
 #include "hal_mps2.h"
 #include "log.h"
 #include "mps2.h"
+#include "scene_refusal.h"
 #include "semihost.h"
 #include "stream.h"
 #include "tick.h"
@@ -60,11 +61,6 @@ __attribute__((noinline, noipa, used)) void fw_mark_frame_end(uint32_t frame)
     fw_mark_done = frame + 1u;
 }
 
-static const char *status_text(scene_status st)
-{
-    return scene_status_text(st);
-}
-
 static stream_acks acks_of(int a)
 {
     return a == ARGS_ACKS_ON ? STREAM_ACKS_ON : a == ARGS_ACKS_OFF ? STREAM_ACKS_OFF : STREAM_ACKS_AUTO;
@@ -93,22 +89,10 @@ int main(void)
 
     scene_error se;
     scene_status st = eng_init(&e, fw_scene, fw_scene_len, &se);
-    if (st == SCENE_ERR_BUILD) {
-        if (se.index < SCENE_ITEM_EDGES)
-            log_printf("firmware: the built-in scene %s needs %s, which this build leaves out; refusing to run\n",
-                       fw_scene_name, scene_item_name(se.index));
-        else
-            log_printf("firmware: the built-in scene %s needs %s %u; this build provides %u; refusing to run\n",
-                       fw_scene_name, scene_item_name(se.index), (unsigned)se.need, (unsigned)se.have);
-        return FW_EXIT_SCENE;
-    }
     if (st != SCENE_OK) {
-        if (se.section >= 0)
-            log_printf("firmware: the built-in scene %s is invalid: %s (%s record %u); refusing to run\n",
-                       fw_scene_name, status_text(st), scene_section_name(se.section), (unsigned)se.index);
-        else
-            log_printf("firmware: the built-in scene %s is invalid: %s; refusing to run\n", fw_scene_name,
-                       status_text(st));
+        static char why[240]; /* with the prefix, within a log line (256) */
+        scene_refusal_format(why, sizeof why, fw_scene_name, st, &se);
+        log_printf("firmware: %s\n", why);
         return FW_EXIT_SCENE;
     }
     uint32_t need = eng_work_bytes(&e);

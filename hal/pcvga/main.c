@@ -27,6 +27,7 @@
 #include "hal.h"
 #include "hal_pcvga.h"
 #include "log.h"
+#include "scene_refusal.h"
 #include "trap.h"
 
 #define MULTIBOOT_MAGIC 0x2BADB002u
@@ -65,22 +66,6 @@ static void keep_boot_info(boot_info *b, const uint32_t *info)
         }
         b->cmdline[n] = '\0';
     }
-}
-
-static void refuse_scene(scene_status st, const scene_error *se)
-{
-    if (st == SCENE_ERR_BUILD && se->index < SCENE_ITEM_EDGES)
-        log_printf("pcvga: the built-in scene %s needs %s, which this build leaves out; refusing to run\n",
-                   fw_scene_name, scene_item_name(se->index));
-    else if (st == SCENE_ERR_BUILD)
-        log_printf("pcvga: the built-in scene %s needs %s %u; this build provides %u; refusing to run\n",
-                   fw_scene_name, scene_item_name(se->index), (unsigned)se->need, (unsigned)se->have);
-    else if (se->section >= 0)
-        log_printf("pcvga: the built-in scene %s is invalid: %s (%s record %u); refusing to run\n", fw_scene_name,
-                   scene_status_text(st), scene_section_name(se->section), (unsigned)se->index);
-    else
-        log_printf("pcvga: the built-in scene %s is invalid: %s; refusing to run\n", fw_scene_name,
-                   scene_status_text(st));
 }
 
 /* One line a frame: what the screen shows, from which camera, at what cost. */
@@ -137,7 +122,9 @@ void pcvga_start(uint32_t magic, const uint32_t *info)
     scene_error se;
     scene_status st = eng_init(&e, fw_scene, fw_scene_len, &se);
     if (st != SCENE_OK) {
-        refuse_scene(st, &se);
+        static char why[240]; /* with the prefix, within a log line (256) */
+        scene_refusal_format(why, sizeof why, fw_scene_name, st, &se);
+        log_printf("pcvga: %s\n", why);
         pcvga_exit(PCVGA_EXIT_SCENE);
     }
     uint8_t *work = (uint8_t *)(((uintptr_t)__end + 7u) & ~(uintptr_t)7u);
