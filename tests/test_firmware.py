@@ -21,6 +21,7 @@ from linkrig import Firmware
 
 sys.path.insert(0, str(ROOT / "tools"))
 from armelf import symbol  # noqa: E402
+from fxtext import fx_text  # noqa: E402
 
 QEMU = shutil.which("qemu-system-arm")
 TIMEOUT = 60
@@ -71,16 +72,6 @@ def raw_frames(data):
     assert end >= 0, "no end record"
     assert struct.unpack("<I", data[end + 4:end + 8])[0] == len(frames)
     return frames, palette
-
-
-def fx_text(raw):
-    """Exact decimal of a 16.16 value (what build/render parses back to the same raw value)."""
-    sign = "-" if raw < 0 else ""
-    raw = abs(raw)
-    whole, frac = raw >> 16, raw & 0xFFFF
-    if not frac:
-        return f"{sign}{whole}"
-    return f"{sign}{whole}." + f"{frac * 152587890625:016d}".rstrip("0")
 
 
 @pytest.fixture(scope="module")

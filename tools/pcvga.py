@@ -32,10 +32,12 @@ import subprocess
 import sys
 import tempfile
 import time
-import zlib
 from pathlib import Path
 
 import numpy as np
+
+from fxtext import fx_text
+from refrender import write_png_rgb
 
 ROOT = Path(__file__).resolve().parent.parent
 QEMU = "qemu-system-i386"
@@ -206,13 +208,6 @@ def png_palette(path):
     return data[i + 4:i + 4 + n]
 
 
-def fx_text(raw):
-    """The exact decimal of a 16.16 value (build/render parses it back to the same value)."""
-    sign, raw = ("-" if raw < 0 else ""), abs(raw)
-    whole, frac = raw >> 16, raw & 0xFFFF
-    return f"{sign}{whole}" + (f".{frac * 152587890625:016d}".rstrip("0") if frac else "")
-
-
 def render_reference(scene, frame, args, render=ROOT / "build" / "render"):
     """build/render's frame from the camera of one of the kernel's frame lines, in the render
     and present modes among its options: (64,000 palette indices, the 768-byte palette, its
@@ -246,17 +241,6 @@ def frame_lines(log):
             d[key] = value if key == "crc" else int(value)
         frames.append(d)
     return frames
-
-
-def write_png_rgb(path, rgb):
-    h, w, _ = rgb.shape
-    raw = b"".join(b"\0" + rgb[y].tobytes() for y in range(h))
-
-    def chunk(kind, body):
-        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
-
-    Path(path).write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
-                           + chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
 
 
 def shot(kernel, args, scene=None, png=None, timeout=60):
