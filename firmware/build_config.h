@@ -38,6 +38,16 @@
 #define CFG_FACE_VERTS SCN_MAX_FACE_VERTS
 #endif
 
+/* The render modes this build carries (render.h): a bit each. A firmware carries
+ * only the modes it runs, so its work area is only what they need. */
+#define CFG_MODE_SPANS 1u
+#define CFG_MODE_PAINTER 2u
+#define CFG_MODE_DIRECT 4u
+#ifndef CFG_RENDER_MODES
+#define CFG_RENDER_MODES (CFG_MODE_SPANS | CFG_MODE_PAINTER | CFG_MODE_DIRECT)
+#endif
+#define CFG_MODE(bit) ((CFG_RENDER_MODES & (bit)) != 0)
+
 #define CFG_HAS(bit) ((CFG_FEATURES & (bit)) != 0)
 #define CFG_OBJECTS CFG_HAS(SCN_NEED_OBJECTS)
 #define CFG_DOORS CFG_HAS(SCN_NEED_DOORS)
@@ -57,5 +67,6 @@ _Static_assert(CFG_LEAF_VERTS >= 3 && CFG_LEAF_VERTS <= SCN_MAX_LEAF_VERTS, "CFG
 _Static_assert(CFG_MODEL_VERTS >= 1 && CFG_MODEL_VERTS <= SCN_MAX_MODEL_VERTS, "CFG_MODEL_VERTS");
 _Static_assert(CFG_FACE_VERTS >= 1 && CFG_FACE_VERTS <= SCN_MAX_FACE_VERTS, "CFG_FACE_VERTS");
 _Static_assert((CFG_FEATURES & ~SCN_NEED_ALL) == 0, "CFG_FEATURES");
+_Static_assert((CFG_RENDER_MODES & 7u) != 0 && (CFG_RENDER_MODES & ~7u) == 0, "CFG_RENDER_MODES");
 
 #endif

@@ -6,7 +6,7 @@ scene_status eng_init(engine *e, const void *blob, uint32_t len, scene_error *er
 {
     scene_status st = scene_load(&e->sc, blob, len, err);
     if (st != SCENE_OK) return st;
-    e->mode = RENDER_SPANS;
+    e->mode = render_mode_default();
     e->work.mem = e->rwork.mem = 0;
     e->work.bytes = e->rwork.bytes = 0;
     e->world = (world_state){0, 0, 0, 0};
@@ -63,7 +63,7 @@ void eng_render(engine *e, uint32_t *ids)
 
 void eng_step(engine *e, uint32_t input, uint32_t dt_ms)
 {
-    if (input & HAL_KEY_NEXT_MODE) e->mode = (render_mode)((e->mode + 1) % RENDER_MODE_COUNT);
+    if (input & HAL_KEY_NEXT_MODE) e->mode = render_mode_next(e->mode);
     if (input & HAL_KEY_NEXT_PRESENT) e->present = (hal_present_mode)((e->present + 1) % HAL_PRESENT_COUNT);
     cam_move(&e->cam, &e->sc, world_of(e), input, dt_ms);
     e->t_ms += dt_ms; /* wraps after 49.7 days (a jump along the paths; doors only see dt) */

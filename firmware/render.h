@@ -4,47 +4,34 @@
 
 #include <stdint.h>
 #include "objects.h"
+#include "render_stats.h"
 #include "raster.h"
 #include "scene.h"
 #include "view.h"
 
 typedef enum {
-    RENDER_SPANS,   /* front to back, sorted spans, zero overdraw (the default) */
+    RENDER_SPANS,   /* front to back, sorted edge lists and spans, zero overdraw (spans.h) */
     RENDER_PAINTER, /* Listing 62.1: back to front, with overdraw */
+    RENDER_DIRECT,  /* front to back, each polygon row filled where free, zero overdraw (direct.h; the default) */
     RENDER_MODE_COUNT
 } render_mode;
 
-typedef struct {
-    uint32_t nodes;     /* nodes visited */
-    uint32_t leaves;    /* leaves visited */
-    uint32_t segs;      /* wall pieces considered */
-    uint32_t culled;    /* wall pieces rejected as back-facing */
-    uint32_t polygons;  /* polygons that reached the rasteriser */
-    uint32_t clipped_away; /* polygons entirely outside the frustum */
-    uint32_t boxes_culled; /* subtrees rejected by their bounding box */
-    uint32_t occluded;     /* polygons wholly behind nearer ones (spans: no edges added) */
-    uint32_t edges;        /* edges entered into the scan (spans) */
-    uint32_t spans;        /* spans emitted (spans) */
-    uint32_t surfaces_drawn; /* surface batches filled (spans) */
-    uint32_t refused;      /* 1: the work memory given was smaller than the scene needs */
-    uint32_t objects_visible; /* objects drawn: in view (spans: and in a leaf the walk visited) */
-    uint32_t object_faces;    /* object faces that reached the rasteriser */
-    uint32_t object_pass;     /* spans: 1 if the frame ran the object pass (an object was in the frustum) */
-    uint32_t overflow;        /* polygons dropped for a full pool: 0 while the scene's bounds hold */
-    uint32_t yclip_skipped;   /* polygons inside the top and bottom planes: no y-clipping done */
-    uint32_t planes_skipped;  /* floors and ceilings not set up: the eye is level with or beyond them */
-} render_stats;
 
 const char *render_mode_name(render_mode m);
-int render_mode_parse(const char *name); /* -1 if unknown */
+/* -1 if unknown or not in this build (CFG_RENDER_MODES) */
+int render_mode_parse(const char *name);
+/* The default of this build (direct if it carries it), and the mode after m
+ * among the ones it carries (the mode key's cycle). */
+render_mode render_mode_default(void);
+render_mode render_mode_next(render_mode m);
 
-/* Work memory for the modes that need it (spans): see span_work_bytes(). */
+/* Work memory for the modes (spans.h, direct.h, painter_work_bytes). */
 typedef struct {
     void *mem;
     uint32_t bytes;
 } render_work;
 
-/* Work bytes the scene needs in any mode, with w's objects (w NULL: no objects;
+/* Work bytes the scene needs in any mode this build carries, with w's objects (w NULL: no objects;
  * w->objs NULL: the scene's own objects, as obj_init will place them). 0 if it
  * would not fit in 32 bits: the caller must refuse the scene. */
 uint32_t render_work_bytes(const scene *s, const world_state *w);

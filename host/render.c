@@ -30,7 +30,8 @@ static const char usage[] =
     "  --angle DEG        view angle in degrees, 0 = east, counter-clockwise\n"
     "                     (default: the player start's angle)\n"
     "  --look PX          vertical shear in pixels, -100..100 (default 0)\n"
-    "  --mode MODE        spans (zero overdraw, the default) or painter (back to\n"
+    "  --mode MODE        direct (zero overdraw, the default), spans (zero overdraw,\n"
+    "                     sorted edge lists) or painter (back to\n"
     "                     front, Listing 62.1)\n"
     "  --present P        flip | copy8 | copy16 | copy32 (default flip)\n"
     "  --split S          BSP split strategy when compiling a source: fewest |\n"
@@ -137,7 +138,7 @@ static int parse_args(options *o, int argc, char **argv)
             o->cam.look = (int32_t)v;
         } else if (!strcmp(a, "--mode")) {
             int m = render_mode_parse(val);
-            if (m < 0) return die("--mode '%s': unknown mode (have: spans, painter)%s", val, "");
+            if (m < 0) return die("--mode '%s': unknown mode (have: direct, spans, painter)%s", val, "");
             o->mode = (render_mode)m;
         } else if (!strcmp(a, "--present")) {
             int m = hal_present_parse(val);
@@ -477,7 +478,7 @@ int main(int argc, char **argv)
 {
     options o;
     memset(&o, 0, sizeof o);
-    o.mode = RENDER_SPANS;
+    o.mode = render_mode_default();
     o.present = HAL_PRESENT_FLIP;
     o.bspc = bspc_defaults();
     o.repeat = 1;

@@ -1,0 +1,528 @@
+/* direct.c - render mode "direct" (see direct.h): the walk, world polygon rows
+ * filled where free, objects held back where they are nearer. */
+#include "direct.h"
+
+#include "bsp_walk.h"
+#include "cover.h"
+#include "eye.h"
+#include "obj_draw.h"
+#include "surfaces.h"
+
+#define BACKGROUND_COLOUR 0
+
+/* Pools for the faces of the active objects; a per-scene build may size them. */
+#ifndef DIRECT_FACE_POOL
+#define DIRECT_FACE_POOL 128
+#endif
+#ifndef DIRECT_EDGE_POOL
+#define DIRECT_EDGE_POOL 512
+#endif
+#define FACE_EDGES CLIP_MAX_VERTS /* a clipped face's edges */
+
+typedef struct {
+    rast_edge e;     /* set up at its first row; stepped to any row by edge_x */
+    uint8_t leading; /* a left edge */
+} dr_edge;
+
+typedef struct {
+    objd_plane pl;
+    int16_t top, bottom; /* rows [top, bottom) */
+    uint16_t first_edge; /* into the edge pool (or the scratch face's own) */
+    uint8_t nedges, colour;
+    uint32_t obj, model_face; /* whose face it is: the object, and the face in the scene's faces */
+} dr_face;
+
+typedef struct {
+    uint32_t index;          /* the object (its id) */
+    int16_t x0, x1, y0, y1;  /* screen box of its faces: pixels [x0, x1) x [y0, y1) */
+    uint16_t first_face;     /* stored: its faces in the pool */
+    uint16_t nfaces;         /* faces facing the eye and on screen */
+    uint8_t active, stored;
+} dr_obj;
+
+typedef struct {
+    const scene *sc;
+    const world_state *w;
+    const view_xform *v;
+    const rast_target *t;
+    render_stats *st;
+    surf_sink sink;
+    cov_mask cov;
+    occ_columns occ;
+    int use_occ;
+    dr_obj *objs; /* objects in view */
+    uint32_t nobjs, nactive, nfaces, nedges;
+    dr_face *faces;
+    dr_edge *edges;
+    uint32_t (*claim)[COV_WORDS]; /* pixels the active objects will fill after the walk */
+    dr_face scratch_face; /* a face of an object the pools could not hold */
+    dr_edge scratch_edges[FACE_EDGES];
+} dr_state;
+
+static uint32_t align8(uint64_t n)
+{
+    return (uint32_t)((n + 7u) & ~(uint64_t)7u);
+}
+
+static uint32_t object_count(const world_state *w)
+{
+    return (CFG_OBJECTS && w && (w->objs || w->n)) ? w->n : 0;
+}
+
+uint32_t direct_work_bytes(const scene *s, const world_state *w)
+{
+    (void)s;
+    uint32_t n = object_count(w);
+    uint64_t total = align8(sizeof(dr_state));
+    if (n)
+        total += align8((uint64_t)n * sizeof(dr_obj)) + align8((uint64_t)DIRECT_FACE_POOL * sizeof(dr_face)) +
+                 align8((uint64_t)DIRECT_EDGE_POOL * sizeof(dr_edge)) + align8(sizeof(uint32_t[VIEW_H][COV_WORDS]));
+    return total > 0xFFFFFFF0u ? 0 : (uint32_t)total;
+}
+
+/* ---- object faces on screen ---------------------------------------------------------- */
+
+/* x (16.16) of edge e at row y, as rast_edge_step would reach it: the whole steps
+ * and the carries of the remainder at once. rem + k srem < (k + 1) dy <= 200 *
+ * 2^23.7, which fits 32 bits unsigned; the whole steps wrap as the stepping does. */
+static int32_t edge_x(const rast_edge *e, int y)
+{
+    uint32_t k = (uint32_t)(y - e->row);
+    uint32_t x = (uint32_t)e->x + k * (uint32_t)e->step;
+#if RAST_STEP_BITS == 0
+    x += ((uint32_t)e->rem + k * (uint32_t)e->srem) / (uint32_t)e->dy;
+#endif
+    return (int32_t)x;
+}
+
+/* The face's pixels on row y: [*a, *b). 0 if none. */
+static int face_row(const dr_face *f, const dr_edge *edges, int y, int *a, int *b)
+{
+    int lo = VIEW_W, hi = 0;
+    if (y < f->top || y >= f->bottom) return 0;
+    for (int i = 0; i < f->nedges; i++) {
+        const dr_edge *e = &edges[i];
+        if (y < e->e.row || y >= e->e.end_row) continue;
+        int col = rast_first_sample(edge_x(&e->e, y));
+        col = col < 0 ? 0 : (col > VIEW_W ? VIEW_W : col);
+        if (e->leading) lo = col;
+        else hi = col;
+    }
+    *a = lo;
+    *b = hi;
+    return lo < hi;
+}
+
+/* Face fi of the object's model, if it faces the eye and shows: its plane, rows
+ * and edges (into edges[], at most FACE_EDGES). */
+static int face_build(const dr_state *S, const dr_obj *o, const view_pt *verts, uint32_t fi, dr_face *f,
+                      dr_edge *edges, screen_pt box[2])
+{
+    const scene *sc = S->sc;
+    const scn_model *m = &sc->models[S->w->objs[o->index].model];
+    screen_pt pts[CLIP_MAX_VERTS];
+    if (!objd_face_plane(sc, m, fi, verts, &f->pl)) return 0;
+    int n = objd_face_screen(sc, m, fi, verts, S->v, pts);
+    if (!n) return 0;
+    int ne = 0, top = VIEW_H, bottom = 0;
+    for (int i = 0; i < n; i++) {
+        screen_pt a = pts[i], b = pts[(i + 1 == n) ? 0 : i + 1];
+        if (a.x < box[0].x) box[0].x = a.x;
+        if (a.x > box[1].x) box[1].x = a.x;
+        if (a.y < box[0].y) box[0].y = a.y;
+        if (a.y > box[1].y) box[1].y = a.y;
+        if (a.y == b.y) continue;
+        dr_edge *e = &edges[ne];
+        e->leading = a.y > b.y; /* going up the screen: a left edge (raster.c) */
+        if (!(e->leading ? rast_edge_setup(&e->e, b.x, b.y, a.x, a.y) : rast_edge_setup(&e->e, a.x, a.y, b.x, b.y)))
+            continue;
+        if (e->e.row < top) top = e->e.row;
+        if (e->e.end_row > bottom) bottom = e->e.end_row;
+        ne++;
+    }
+    if (top >= bottom) return 0;
+    f->top = (int16_t)top;
+    f->bottom = (int16_t)bottom;
+    f->nedges = (uint8_t)ne;
+    f->colour = sc->faces[fi].colour;
+    f->obj = o->index;
+    f->model_face = fi;
+    return 1;
+}
+
+/* Calls visit(S, o, face, its edges, ctx) for each face of the active object o
+ * that shows: from the pools, or worked out again into the scratch face. */
+typedef void (*face_visit)(dr_state *S, const dr_obj *o, const dr_face *f, const dr_edge *edges, void *ctx);
+
+static void each_face(dr_state *S, const dr_obj *o, face_visit visit, void *ctx)
+{
+    if (o->stored) {
+        for (uint32_t k = 0; k < o->nfaces; k++) {
+            const dr_face *f = &S->faces[o->first_face + k];
+            visit(S, o, f, &S->edges[f->first_edge], ctx);
+        }
+        return;
+    }
+    const scene *sc = S->sc;
+    const scn_model *m = &sc->models[S->w->objs[o->index].model];
+    view_pt verts[CFG_MODEL_VERTS];
+    screen_pt box[2];
+    objd_transform(sc, &S->w->objs[o->index], S->v, verts);
+    for (uint32_t fi = m->first_face; fi < m->first_face + m->num_faces; fi++)
+        if (face_build(S, o, verts, fi, &S->scratch_face, S->scratch_edges, box))
+            visit(S, o, &S->scratch_face, S->scratch_edges, ctx);
+}
+
+/* The object's faces into the pools if they fit (else it is worked out again
+ * where needed), and its screen box. */
+static void activate(dr_state *S, dr_obj *o)
+{
+    const scene *sc = S->sc;
+    const scn_model *m = &sc->models[S->w->objs[o->index].model];
+    view_pt verts[CFG_MODEL_VERTS];
+    screen_pt box[2] = {{INT32_MAX, INT32_MAX}, {INT32_MIN, INT32_MIN}};
+    uint32_t nf = 0, ne = S->nedges, stored = 1;
+    o->active = 1;
+    S->nactive++;
+    objd_transform(sc, &S->w->objs[o->index], S->v, verts);
+    for (uint32_t fi = m->first_face; fi < m->first_face + m->num_faces; fi++) {
+        int room = stored && S->nfaces + nf < DIRECT_FACE_POOL && ne + FACE_EDGES <= DIRECT_EDGE_POOL;
+        dr_face *f = room ? &S->faces[S->nfaces + nf] : &S->scratch_face;
+        dr_edge *e = room ? &S->edges[ne] : S->scratch_edges;
+        if (!face_build(S, o, verts, fi, f, e, box)) continue;
+        if (room) {
+            f->first_edge = (uint16_t)ne;
+            ne += f->nedges;
+        }
+        stored &= (uint32_t)room;
+        nf++;
+    }
+    o->nfaces = (uint16_t)nf;
+    o->stored = (uint8_t)stored;
+    if (stored) {
+        o->first_face = (uint16_t)S->nfaces;
+        S->nfaces += nf;
+        S->nedges = ne;
+    }
+    if (!nf) return;
+    int x0 = rast_first_sample(box[0].x) - 1, x1 = rast_first_sample(box[1].x) + 1;
+    int y0 = rast_first_sample(box[0].y) - 1, y1 = rast_first_sample(box[1].y) + 1;
+    o->x0 = (int16_t)(x0 < 0 ? 0 : x0);
+    o->x1 = (int16_t)(x1 > VIEW_W ? VIEW_W : x1);
+    o->y0 = (int16_t)(y0 < 0 ? 0 : y0);
+    o->y1 = (int16_t)(y1 > VIEW_H ? VIEW_H : y1);
+}
+
+/* ---- objects against the leaves ---------------------------------------------------- */
+
+/* Does the object's box (origin +- its model's radius) reach into the leaf's
+ * convex polygon? Its bounding box first, then each edge as a separating line.
+ * Offsets are shifted (edges by 1, corners by 3) so the cross products stay
+ * below 2^61; a box within the rounding of an edge counts as touching, which
+ * only makes an object active a leaf early. */
+static int box_touches_leaf(const scene *sc, const scn_leaf *f, int64_t bx0, int64_t by0, int64_t bx1, int64_t by1)
+{
+    const scn_vertex *p = &sc->pverts[f->first_pvert];
+    uint32_t n = f->num_pverts;
+    if (n < 3) return 0;
+    int64_t x0 = INT64_MAX, x1 = INT64_MIN, y0 = INT64_MAX, y1 = INT64_MIN;
+    for (uint32_t i = 0; i < n; i++) {
+        if (p[i].x < x0) x0 = p[i].x;
+        if (p[i].x > x1) x1 = p[i].x;
+        if (p[i].y < y0) y0 = p[i].y;
+        if (p[i].y > y1) y1 = p[i].y;
+    }
+    if (x0 > bx1 || x1 < bx0 || y0 > by1 || y1 < by0) return 0;
+    for (uint32_t i = 0; i < n; i++) {
+        const scn_vertex *a = &p[i], *b = &p[i + 1 == n ? 0 : i + 1];
+        int64_t dx = fx_asr64((int64_t)b->x - a->x, 1), dy = fx_asr64((int64_t)b->y - a->y, 1);
+        /* the corner farthest to the left of a -> b (the polygon runs counter-clockwise) */
+        int64_t cx = fx_asr64((dy > 0 ? bx0 : bx1) - a->x, 3), cy = fx_asr64((dx > 0 ? by1 : by0) - a->y, 3);
+        int64_t slack = (dx < 0 ? -dx : dx) + (dy < 0 ? -dy : dy);
+        if (dx * cy - dy * cx < -slack) return 0; /* the whole box is to the right: outside */
+    }
+    return 1;
+}
+
+static void activate_objects_in(dr_state *S, uint32_t leaf)
+{
+    const scn_leaf *f = &S->sc->leaves[leaf];
+    for (uint32_t i = 0; i < S->nobjs; i++) {
+        dr_obj *o = &S->objs[i];
+        if (o->active) continue;
+        const obj_state *os = &S->w->objs[o->index];
+        int64_t r = S->sc->models[os->model].radius;
+        if (box_touches_leaf(S->sc, f, (int64_t)os->x - r, (int64_t)os->y - r, (int64_t)os->x + r, (int64_t)os->y + r))
+            activate(S, o);
+    }
+}
+
+/* ---- world polygons -------------------------------------------------------------------- */
+
+typedef struct {
+    uint32_t *keep; /* the row's mask of pixels the world polygon leaves alone */
+    const objd_plane *world;
+    int y, x0, x1;
+} keep_ctx;
+
+/* Mark where face f is in front of the world surface on the row: 1/z is linear
+ * along a row, so "in front" changes at most once between the ends; the change
+ * is found by bisection. */
+static void keep_face(dr_state *S, const dr_obj *o, const dr_face *f, const dr_edge *edges, void *ctx)
+{
+    (void)o;
+    keep_ctx *k = ctx;
+    int a, b;
+    if (!face_row(f, edges, k->y, &a, &b)) return;
+    if (a < k->x0) a = k->x0;
+    if (b > k->x1) b = k->x1;
+    if (a >= b) return;
+    int look = VIEW_LOOK(S->v);
+    int fa = objd_front(&f->pl, 1, k->world, 0, look, a, k->y), fb = objd_front(&f->pl, 1, k->world, 0, look, b - 1, k->y);
+    if (fa == fb) {
+        if (fa) cov_line_set(k->keep, a, b);
+        return;
+    }
+    int lo = a, hi = b - 1; /* front differs at lo and hi */
+    while (hi - lo > 1) {
+        int mid = lo + (hi - lo) / 2;
+        if (objd_front(&f->pl, 1, k->world, 0, look, mid, k->y) == fa) lo = mid;
+        else hi = mid;
+    }
+    if (fa) cov_line_set(k->keep, a, hi);
+    else cov_line_set(k->keep, hi, b);
+}
+
+static void world_plane(const dr_state *S, uint32_t id, uint32_t seg, objd_plane *p)
+{
+    if (seg == SCN_NONE) {
+        uint32_t sec = id & 0xFFFFFFu;
+        int32_t h = (id >> 24) == RAST_KIND_FLOOR ? S->sc->sectors[sec].floor_h : obj_ceil(S->w, S->sc, sec);
+        objd_plane_flat(S->v, h, p);
+    } else {
+        const scn_seg *g = &S->sc->segs[seg];
+        objd_plane_wall(S->v, &S->sc->verts[g->v1], &S->sc->verts[g->v2], p);
+    }
+}
+
+/* Active objects whose screen box meets [x0, x1) x [y0, y1). */
+static int objects_meet(const dr_state *S, int x0, int x1, int y0, int y1)
+{
+    for (uint32_t i = 0; i < S->nobjs; i++) {
+        const dr_obj *o = &S->objs[i];
+        if (o->active && o->nfaces && o->x0 < x1 && o->x1 > x0 && o->y0 < y1 && o->y1 > y0) return 1;
+    }
+    return 0;
+}
+
+/* A world row with active objects about: where a face is nearer, the pixel is
+ * the objects' (the nearest active face's, or a nearer one's of an object met
+ * later, but never a world surface's: everything the walk reaches later at
+ * that pixel lies behind this one). It is claimed, so that it counts as taken
+ * for the walk, and filled after it. */
+static uint32_t fill_row_behind_objects(dr_state *S, int y, int x0, int x1, const objd_plane *world, uint8_t colour,
+                                        uint32_t id)
+{
+    uint32_t keep[COV_WORDS] = {0};
+    keep_ctx k = {keep, world, y, x0, x1};
+    int any = 0;
+    for (uint32_t i = 0; i < S->nobjs; i++) {
+        const dr_obj *o = &S->objs[i];
+        if (o->active && o->nfaces && o->y0 <= y && o->y1 > y && o->x0 < x1 && o->x1 > x0) {
+            each_face(S, o, keep_face, &k);
+            any = 1;
+        }
+    }
+    if (any) cov_claim(&S->cov, y, keep, S->claim);
+    return cov_fill(&S->cov, S->t, y, x0, x1, 0, colour, id);
+}
+
+static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id, uint32_t seg)
+{
+    dr_state *S = ctx;
+    int32_t xmin = INT32_MAX, xmax = INT32_MIN, ymin = INT32_MAX, ymax = INT32_MIN;
+    for (int i = 0; i < n; i++) {
+        if (pts[i].x < xmin) xmin = pts[i].x;
+        if (pts[i].x > xmax) xmax = pts[i].x;
+        if (pts[i].y < ymin) ymin = pts[i].y;
+        if (pts[i].y > ymax) ymax = pts[i].y;
+    }
+    int top = rast_first_sample(ymin), bottom = rast_first_sample(ymax);
+    int c0 = rast_first_sample(xmin), c1 = rast_first_sample(xmax);
+    if (top < 0) top = 0;
+    if (bottom > VIEW_H) bottom = VIEW_H;
+    if (top >= bottom || cov_box_covered(&S->cov, top, bottom, c0, c1)) {
+        S->st->occluded++;
+        return;
+    }
+    /* each row's extent, exactly as the fill rule samples it */
+    int16_t lo[VIEW_H], hi[VIEW_H];
+    for (int y = top; y < bottom; y++) {
+        lo[y] = VIEW_W;
+        hi[y] = 0;
+    }
+    for (int i = 0; i < n; i++) {
+        screen_pt a = pts[i], b = pts[(i + 1 == n) ? 0 : i + 1];
+        if (a.y == b.y) continue;
+        int leading = a.y > b.y;
+        rast_edge e;
+        if (!(leading ? rast_edge_setup(&e, b.x, b.y, a.x, a.y) : rast_edge_setup(&e, a.x, a.y, b.x, b.y))) continue;
+        int16_t *side = leading ? lo : hi;
+        for (; e.row < e.end_row; rast_edge_step(&e)) {
+            int col = rast_first_sample(e.x);
+            side[e.row] = (int16_t)(col < 0 ? 0 : (col > VIEW_W ? VIEW_W : col));
+        }
+    }
+    uint32_t drawn = 0;
+    if (CFG_OBJECTS && S->nactive && objects_meet(S, c0, c1, top, bottom)) {
+        objd_plane world;
+        world_plane(S, id, seg, &world);
+        for (int y = top; y < bottom; y++)
+            if (lo[y] < hi[y]) drawn += fill_row_behind_objects(S, y, lo[y], hi[y], &world, colour, id);
+    } else {
+        for (int y = top; y < bottom; y++)
+            if (lo[y] < hi[y]) drawn += cov_fill(&S->cov, S->t, y, lo[y], hi[y], 0, colour, id);
+    }
+    if (!drawn) S->st->occluded++; else S->st->surfaces_drawn++;
+}
+
+static int visit_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
+{
+    dr_state *S = ctx;
+    if (CFG_OBJECTS && S->nactive < S->nobjs) activate_objects_in(S, leaf);
+    surf_leaf(S->sc, S->w, S->v, leaf, clip_mask, &S->sink, S->use_occ ? &S->occ : 0, S->st);
+    return cov_full(&S->cov);
+}
+
+/* ---- objects after the walk ------------------------------------------------------------- */
+
+typedef struct {
+    const dr_face *self; /* the face being drawn (a copy: the scratch face may be rebuilt) */
+    uint32_t *keep;
+    int y, x0, x1;
+} near_ctx;
+
+/* Mark where another face g is in front of the face being drawn. */
+static void keep_nearer_face(dr_state *S, const dr_obj *o, const dr_face *g, const dr_edge *edges, void *ctx)
+{
+    (void)o;
+    near_ctx *k = ctx;
+    if (g->obj == k->self->obj && g->model_face == k->self->model_face) return;
+    int a, b;
+    if (!face_row(g, edges, k->y, &a, &b)) return;
+    if (a < k->x0) a = k->x0;
+    if (b > k->x1) b = k->x1;
+    if (a >= b) return;
+    int look = VIEW_LOOK(S->v);
+    const objd_plane *f = &k->self->pl;
+    int fa = objd_front(&g->pl, 1, f, 1, look, a, k->y), fb = objd_front(&g->pl, 1, f, 1, look, b - 1, k->y);
+    if (fa == fb) {
+        if (fa) cov_line_set(k->keep, a, b);
+        return;
+    }
+    int lo = a, hi = b - 1;
+    while (hi - lo > 1) {
+        int mid = lo + (hi - lo) / 2;
+        if (objd_front(&g->pl, 1, f, 1, look, mid, k->y) == fa) lo = mid;
+        else hi = mid;
+    }
+    if (fa) cov_line_set(k->keep, a, hi);
+    else cov_line_set(k->keep, hi, b);
+}
+
+/* Fill face f's rows where it is free and no other active face is nearer. The
+ * face is copied first: looking at the other faces may rebuild the scratch face.
+ * ctx: the object's pixel count. */
+static void draw_face(dr_state *S, const dr_obj *o, const dr_face *f, const dr_edge *edges, void *ctx)
+{
+    dr_face face = *f;
+    dr_edge own[FACE_EDGES];
+    for (int i = 0; i < f->nedges; i++) own[i] = edges[i];
+    uint32_t id = RAST_ID(RAST_KIND_OBJECT, o->index);
+    for (int y = face.top; y < face.bottom; y++) {
+        int a, b;
+        if (!face_row(&face, own, y, &a, &b) || S->cov.open[y] == 0) continue;
+        uint32_t keep[COV_WORDS] = {0};
+        near_ctx k = {&face, keep, y, a, b};
+        for (uint32_t i = 0; i < S->nobjs; i++) {
+            const dr_obj *p = &S->objs[i];
+            if (p->active && p->nfaces && p->y0 <= y && p->y1 > y && p->x0 < b && p->x1 > a)
+                each_face(S, p, keep_nearer_face, &k);
+        }
+        *(uint32_t *)ctx += cov_fill(&S->cov, S->t, y, a, b, keep, face.colour, id);
+    }
+    S->st->object_faces++;
+}
+
+/* Every active object's faces, after the claimed pixels are handed back. An
+ * object counts as visible when it wrote a pixel. */
+static void draw_objects(dr_state *S)
+{
+    cov_release(&S->cov, S->claim);
+    for (uint32_t i = 0; i < S->nobjs; i++) {
+        const dr_obj *o = &S->objs[i];
+        uint32_t pixels = 0;
+        if (o->active && o->nfaces) each_face(S, o, draw_face, &pixels);
+        if (pixels) S->st->objects_visible++;
+    }
+}
+
+/* ---- the frame ---------------------------------------------------------------------- */
+
+static void list_objects_in_view(dr_state *S)
+{
+    const scene *sc = S->sc;
+    const world_state *w = S->w;
+    S->nobjs = S->nactive = S->nfaces = S->nedges = 0;
+    if (!CFG_OBJECTS || !w || !w->objs) return;
+    for (uint32_t i = 0; i < w->n; i++) {
+        const obj_state *o = &w->objs[i];
+        if (o->model >= sc->nmodels || !objd_in_view(sc, o, S->v)) continue;
+        S->objs[S->nobjs++] = (dr_obj){.index = i};
+    }
+}
+
+void direct_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t,
+                   render_stats *st, void *work, uint32_t work_bytes)
+{
+    uint32_t need = direct_work_bytes(sc, w);
+    if (!work || need == 0 || work_bytes < need) {
+        st->refused = 1; /* the caller did not provide the memory this frame needs */
+        for (int y = 0; y < VIEW_H; y++) rast_span(t, y, 0, VIEW_W, BACKGROUND_COLOUR, RAST_ID(RAST_KIND_NONE, 0));
+        return;
+    }
+    uint8_t *mem = work;
+    dr_state *S = (dr_state *)(void *)mem;
+    mem += align8(sizeof(dr_state));
+    uint32_t n = object_count(w);
+    S->objs = (dr_obj *)(void *)mem;
+    mem += n ? align8((uint64_t)n * sizeof(dr_obj)) : 0;
+    S->faces = (dr_face *)(void *)mem;
+    mem += n ? align8((uint64_t)DIRECT_FACE_POOL * sizeof(dr_face)) : 0;
+    S->edges = (dr_edge *)(void *)mem;
+    mem += n ? align8((uint64_t)DIRECT_EDGE_POOL * sizeof(dr_edge)) : 0;
+    S->claim = (uint32_t(*)[COV_WORDS])(void *)mem;
+    S->sc = sc;
+    S->w = w;
+    S->v = v;
+    S->t = t;
+    S->st = st;
+    S->sink.polygon = add_polygon;
+    S->sink.ctx = S;
+    cov_reset(&S->cov);
+    occ_reset(&S->occ);
+    list_objects_in_view(S);
+    st->object_pass = S->nobjs != 0;
+    if (S->nobjs)
+        for (int y = 0; y < VIEW_H; y++)
+            for (int k = 0; k < COV_WORDS; k++) S->claim[y][k] = 0;
+    /* solid walls close columns only for an eye inside the world (spans.c says why) */
+    S->use_occ = eye_in_world(sc, w, v);
+    walk_stats ws;
+    walk_tree(sc, v, WALK_FRONT_TO_BACK, visit_leaf, S, S->use_occ ? &S->occ : 0, &ws);
+    st->nodes = ws.nodes;
+    st->boxes_culled = ws.boxes_culled + ws.boxes_hidden;
+    if (CFG_OBJECTS && S->nactive) draw_objects(S);
+    for (int y = 0; y < VIEW_H; y++) /* what no surface claimed: the background */
+        cov_fill(&S->cov, t, y, 0, VIEW_W, 0, BACKGROUND_COLOUR, RAST_ID(RAST_KIND_NONE, 0));
+}

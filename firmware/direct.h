@@ -1,0 +1,41 @@
+/* direct.h - render mode "direct": front to back, each polygon row drawn at
+ * once where it is still free (prefix direct_).
+ *
+ * The BSP tree is walked front to back (seed 001, "Drawing polygons front to
+ * back"). A mask of the pixels already written (cover.h) stands for the
+ * per-scan-line span lists: each polygon's rows are filled straight into the
+ * frame where the mask is still clear, and set in it, so every pixel is written
+ * exactly once, with no edge lists, no surface stack and no second pass. Solid
+ * walls close screen columns as in the other modes (occlusion.h), and the walk
+ * stops when every column is closed or every line is full.
+ *
+ * Objects (docs/objects.md). The objects in view are listed before the walk.
+ * An object becomes active when the walk reaches the first leaf its box
+ * touches: from then on, every world polygon row leaves alone the pixels where
+ * one of the active objects' faces is nearer (1/z, obj_draw.h's objd_front), and
+ * after the walk the faces fill what is still free, nearest face first at each
+ * pixel. World surfaces reached before the object's first leaf are in front of
+ * it by the tree's order; those after it are sorted against it by 1/z.
+ *
+ * Memory: a fixed part bounded by the screen (the mask, closed columns) and a
+ * part per object of the world state (at most every object is in view), plus
+ * fixed pools for the faces of the active objects; an object whose faces do not
+ * fit the pools is worked out again where it is needed, so no pool can drop
+ * anything (docs/needs.md gives the formula). */
+#ifndef DIRECT_H
+#define DIRECT_H
+
+#include <stdint.h>
+#include "objects.h"
+#include "raster.h"
+#include "render_stats.h"
+#include "scene.h"
+#include "view.h"
+
+/* Bytes of work memory direct_render needs with w's objects (w NULL: none). */
+uint32_t direct_work_bytes(const scene *s, const world_state *w);
+
+void direct_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t,
+                   render_stats *st, void *work, uint32_t work_bytes);
+
+#endif
