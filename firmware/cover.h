@@ -13,21 +13,58 @@
 
 #define COV_WORDS (VIEW_W / 32)
 
-_Static_assert(VIEW_W % 32 == 0, "a row is whole words");
+_Static_assert(VIEW_W % 32 == 0 && COV_WORDS <= 16, "a row is whole words, at most 16");
 
 typedef struct {
     uint32_t bits[VIEW_H][COV_WORDS];
-    uint8_t full_words[VIEW_H]; /* words of the row with every bit set */
+    uint16_t open[VIEW_H];      /* bit i: word i of the row has a clear bit */
     uint16_t full_rows;         /* rows with every pixel set */
 } cov_mask;
 
 void cov_clear(cov_mask *m);
 
+/* A run touches its two end words bit by bit; the words between are whole, so
+ * they are set, and tested, through the row's word summary (open) alone. */
+#define COV_ALL_OPEN ((uint16_t)((1u << COV_WORDS) - 1u))
+
+
+/* Words w0 < i < w1, as summary bits. */
+static inline uint32_t cov_inner_words(int w0, int w1)
+{
+    return w1 - w0 > 1 ? ((1u << w1) - (2u << w0)) : 0;
+}
+
 /* 1 if every pixel of [x0, x1) on row y is set (an empty run: 1). 0 <= x0, x1 <= VIEW_W. */
-int cov_all(const cov_mask *m, int y, int x0, int x1);
+static inline int cov_all(const cov_mask *m, int y, int x0, int x1)
+{
+    uint32_t open = m->open[y];
+    if (x1 <= x0 || !open) return 1;
+    const uint32_t *row = m->bits[y];
+    int w0 = x0 >> 5, w1 = (x1 - 1) >> 5;
+    uint32_t first = 0xFFFFFFFFu << (x0 & 31), last = 0xFFFFFFFFu >> (31 - ((x1 - 1) & 31));
+    if (w0 == w1) return (row[w0] & first & last) == (first & last);
+    return (row[w0] & first) == first && (row[w1] & last) == last && !(open & cov_inner_words(w0, w1));
+}
 
 /* Set [x0, x1) on row y (an empty run: nothing). */
-void cov_set(cov_mask *m, int y, int x0, int x1);
+static inline void cov_set(cov_mask *m, int y, int x0, int x1)
+{
+    uint32_t open = m->open[y];
+    if (x1 <= x0 || !open) return;
+    uint32_t *row = m->bits[y];
+    int w0 = x0 >> 5, w1 = (x1 - 1) >> 5;
+    uint32_t first = 0xFFFFFFFFu << (x0 & 31), last = 0xFFFFFFFFu >> (31 - ((x1 - 1) & 31));
+    if (w0 == w1) first &= last;
+    if ((row[w0] |= first) == 0xFFFFFFFFu) open &= ~(1u << w0);
+    if (w1 > w0) {
+        for (int i = w0 + 1; i < w1; i++) row[i] = 0xFFFFFFFFu;
+        open &= ~cov_inner_words(w0, w1);
+        if ((row[w1] |= last) == 0xFFFFFFFFu) open &= ~(1u << w1);
+    }
+    m->open[y] = (uint16_t)open;
+    if (!open) m->full_rows++;
+}
+
 
 /* The first pixel of [x, x1) on row y that is clear (cov_next_clear) or set
  * (cov_next_set); x1 if there is none. */
@@ -36,7 +73,7 @@ int cov_next_set(const cov_mask *m, int y, int x, int x1);
 
 static inline int cov_row_full(const cov_mask *m, int y)
 {
-    return m->full_words[y] == COV_WORDS;
+    return m->open[y] == 0;
 }
 
 /* 1 once every pixel of the screen is set. */

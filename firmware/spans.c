@@ -438,7 +438,7 @@ static void flush_spans(span_state *S)
     S->nspans = 0;
 }
 
-static void push_span(span_state *S, sp_surf *s, int y, int x0, int x1)
+static inline __attribute__((always_inline)) void push_span(span_state *S, sp_surf *s, int y, int x0, int x1)
 {
     if (S->nspans == SPAN_BUFFER) flush_spans(S);
     sp_span *sp = &S->spans[S->nspans];
@@ -452,7 +452,13 @@ static void push_span(span_state *S, sp_surf *s, int y, int x0, int x1)
     sp->next = s->span_head;
     s->span_head = S->nspans++;
     S->st->spans++;
-    if (!S->final) cov_set(&S->drawn, y, x0, x1); /* later batches leave these pixels alone */
+}
+
+/* Fill [x0, x1) of row y with s in a batch before the last: later batches leave these pixels alone. */
+static void push_marked(span_state *S, sp_surf *s, int y, int x0, int x1)
+{
+    push_span(S, s, y, x0, x1);
+    cov_set(&S->drawn, y, x0, x1);
 }
 
 /* s owns [x0, x1) of row y. In a batch before the last, the background and
@@ -463,13 +469,14 @@ static void emit_span(span_state *S, sp_surf *s, int y, int x0, int x1)
 {
     if (x1 <= x0) return;
     if (!S->final && (s == &S->background || s->silent)) return;
-    if (!S->flushed) {
+    if (S->final && !S->flushed) { /* the frame in one batch */
         push_span(S, s, y, x0, x1);
         return;
     }
     for (int x = cov_next_clear(&S->drawn, y, x0, x1); x < x1;) {
         int end = cov_next_set(&S->drawn, y, x, x1);
-        push_span(S, s, y, x, end);
+        if (S->final) push_span(S, s, y, x, end);
+        else push_marked(S, s, y, x, end);
         x = cov_next_clear(&S->drawn, y, end, x1);
     }
 }
@@ -683,6 +690,7 @@ static void scan(span_state *S, int objects)
 /* Draw what the lists hold (final: the frame's last batch), then empty them. */
 static void draw_batch(span_state *S, int final)
 {
+    if (!final && !S->flushed) cov_clear(&S->drawn);
     S->final = final;
     S->object_faces = 0;
     if (CFG_OBJECTS && S->nobjs) add_objects(S, !final);
@@ -746,8 +754,7 @@ void spans_render(const scene *sc, const world_state *w, const view_xform *v, co
     S->background = (sp_surf){.key = 0xFFFFFFFFu, .id = RAST_ID(RAST_KIND_NONE, 0), .plane = -1, .seg = SCN_NONE,
                               .colour = BACKGROUND_COLOUR, .span_head = -1};
     for (int y = 0; y < VIEW_H; y++) S->new_edges[y] = 0;
-    cov_clear(&S->claimed);
-    cov_clear(&S->drawn);
+    cov_clear(&S->claimed); /* S->drawn: cleared before the first batch that is not the last */
     walk_stats ws;
     /* Solid walls close columns only for an eye inside the world: from outside
      * every sector, or above or below its own sector, one sees past them. */
