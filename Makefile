@@ -66,6 +66,11 @@ $(1)/test_%: $(call objs,$(1)/obj,tests/unit/test_%.c) $(call objs,$(1)/obj,$(BS
 endef
 $(eval $(call variant,$(BUILD),$(REL)))
 $(eval $(call variant,$(BUILD)/san,$(SAN)))
+# Mode spans with pools of a few polygons, so that nearly every frame is drawn in
+# many batches (tests/test_span_batches.py compares its frames with build/render's).
+$(eval $(call variant,$(BUILD)/tinypools,$(REL) -DSPAN_POOL_EDGES=72u -DSPAN_POOL_SURFACES=6u))
+$(BUILD)/tinypools/obj/tools/bspc/wad.o: $(THINGS_H)
+$(BUILD)/tinypools/obj/tools/bspc/wad.o: BASE += -I$(GEN)
 
 UNIT_TESTS := $(patsubst tests/unit/%.c,%,$(wildcard tests/unit/test_*.c))
 PROGRAMS   := $(BUILD)/bspc $(BUILD)/render $(BUILD)/emu $(BUILD)/display

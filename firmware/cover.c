@@ -1,22 +1,40 @@
-/* cover.c - the written-pixel mask and filling what is still free. */
+/* cover.c - the coverage bit mask: clearing it, walking a row's runs, filling
+ * what is free (the tests and sets, called per polygon row, are inline in
+ * cover.h). */
 #include "cover.h"
 
-void cov_reset(cov_mask *c)
+void cov_clear(cov_mask *m)
 {
     for (int y = 0; y < VIEW_H; y++) {
-        for (int w = 0; w < COV_WORDS; w++) c->bits[y][w] = 0;
-        c->open[y] = VIEW_W;
+        for (int i = 0; i < COV_WORDS; i++) m->bits[y][i] = 0;
+        m->open[y] = COV_ALL_OPEN;
     }
-    c->full_rows = 0;
+    m->full_rows = 0;
 }
 
-/* The bits of word w that lie in [x0, x1), x0 < x1. */
-static inline uint32_t word_range(int w, int x0, int x1)
+/* The first pixel in [x, x1) whose bit, xor flip, is set; x1 if none. */
+static int next_bit(const uint32_t *row, int x, int x1, uint32_t flip)
 {
-    int lo = x0 - w * 32, hi = x1 - w * 32; /* [lo, hi) within the word, possibly beyond it */
-    uint32_t m = lo <= 0 ? 0xFFFFFFFFu : (0xFFFFFFFFu << lo);
-    if (hi < 32) m &= (1u << hi) - 1u;
-    return m;
+    if (x >= x1) return x1;
+    int i = x >> 5;
+    uint32_t w = (row[i] ^ flip) & (0xFFFFFFFFu << (x & 31));
+    int last = (x1 - 1) >> 5;
+    while (!w) {
+        if (++i > last) return x1;
+        w = row[i] ^ flip;
+    }
+    int at = (i << 5) + __builtin_ctz(w);
+    return at < x1 ? at : x1;
+}
+
+int cov_next_clear(const cov_mask *m, int y, int x, int x1)
+{
+    return next_bit(m->bits[y], x, x1, 0xFFFFFFFFu);
+}
+
+int cov_next_set(const cov_mask *m, int y, int x, int x1)
+{
+    return next_bit(m->bits[y], x, x1, 0);
 }
 
 static inline int clamp_w(int x)
@@ -24,21 +42,14 @@ static inline int clamp_w(int x)
     return x < 0 ? 0 : (x > VIEW_W ? VIEW_W : x);
 }
 
-int cov_box_covered(const cov_mask *c, int y0, int y1, int x0, int x1)
+int cov_box_covered(const cov_mask *m, int y0, int y1, int x0, int x1)
 {
     x0 = clamp_w(x0);
     x1 = clamp_w(x1);
     if (y0 < 0) y0 = 0;
     if (y1 > VIEW_H) y1 = VIEW_H;
-    if (x1 <= x0) return 1;
-    int w0 = x0 >> 5, w1 = (x1 - 1) >> 5;
-    for (int y = y0; y < y1; y++) {
-        if (c->open[y] == 0) continue;
-        for (int w = w0; w <= w1; w++) {
-            uint32_t want = word_range(w, x0, x1);
-            if ((c->bits[y][w] & want) != want) return 0;
-        }
-    }
+    for (int y = y0; y < y1; y++)
+        if (!cov_all(m, y, x0, x1)) return 0;
     return 1;
 }
 
@@ -47,65 +58,49 @@ void cov_line_set(uint32_t *line, int x0, int x1)
     x0 = clamp_w(x0);
     x1 = clamp_w(x1);
     if (x1 <= x0) return;
-    for (int w = x0 >> 5; w <= (x1 - 1) >> 5; w++) line[w] |= word_range(w, x0, x1);
-}
-
-int dbg_calls, dbg_empty, dbg_spans;
-static void take(cov_mask *c, int y, int n)
-{
-    c->open[y] = (int16_t)(c->open[y] - n);
-    if (c->open[y] == 0) c->full_rows++;
-}
-
-void cov_claim(cov_mask *c, int y, const uint32_t *m, uint32_t (*claim)[COV_WORDS])
-{
-    int n = 0;
-    for (int w = 0; w < COV_WORDS; w++) {
-        uint32_t fresh = m[w] & ~c->bits[y][w];
-        c->bits[y][w] |= fresh;
-        claim[y][w] |= fresh;
-        n += __builtin_popcount(fresh);
+    int w0 = x0 >> 5, w1 = (x1 - 1) >> 5;
+    uint32_t first = 0xFFFFFFFFu << (x0 & 31), last = 0xFFFFFFFFu >> (31 - ((x1 - 1) & 31));
+    if (w0 == w1) {
+        line[w0] |= first & last;
+        return;
     }
-    if (n) take(c, y, n);
+    line[w0] |= first;
+    for (int w = w0 + 1; w < w1; w++) line[w] = 0xFFFFFFFFu;
+    line[w1] |= last;
 }
 
-void cov_release(cov_mask *c, uint32_t (*claim)[COV_WORDS])
+/* Words of row y that became full: out of the row's summary. */
+static inline void close_words(cov_mask *m, int y, uint32_t full)
 {
-    for (int y = 0; y < VIEW_H; y++) {
-        int n = 0;
-        for (int w = 0; w < COV_WORDS; w++) {
-            c->bits[y][w] &= ~claim[y][w];
-            n += __builtin_popcount(claim[y][w]);
-        }
-        if (n && c->open[y] == 0) c->full_rows--;
-        c->open[y] = (int16_t)(c->open[y] + n);
-    }
+    if (!full || !m->open[y]) return;
+    m->open[y] = (uint16_t)(m->open[y] & ~full);
+    if (!m->open[y]) m->full_rows++;
 }
 
-uint32_t cov_fill(cov_mask *c, const rast_target *t, int y, int x0, int x1, const uint32_t *keep, uint8_t colour,
+uint32_t cov_fill(cov_mask *m, const rast_target *t, int y, int x0, int x1, const uint32_t *keep, uint8_t colour,
                   uint32_t id)
 {
     x0 = clamp_w(x0);
     x1 = clamp_w(x1);
-    if (x1 <= x0 || c->open[y] == 0) return 0;
-    uint32_t *line = c->bits[y];
+    if (x1 <= x0 || !m->open[y]) return 0;
+    uint32_t *line = m->bits[y];
     int w0 = x0 >> 5, w1 = (x1 - 1) >> 5;
     uint32_t first = 0xFFFFFFFFu << (x0 & 31), last = 0xFFFFFFFFu >> (31 - ((x1 - 1) & 31));
-    if (!keep) { /* the common case first: nothing of [x0, x1) written yet, one span */
-        uint32_t taken = line[w0] & first;
-        for (int w = w0 + 1; w < w1; w++) taken |= line[w];
-        if (w0 != w1) taken |= line[w1] & last;
-        else taken &= last;
+    uint32_t full = 0; /* words this fill completes */
+    if (!keep) { /* the common case first: nothing of [x0, x1) set yet, one span */
+        uint32_t taken = w0 == w1 ? line[w0] & first & last : (line[w0] & first) | (line[w1] & last);
+        for (int w = w0 + 1; w < w1 && !taken; w++) taken |= line[w];
         if (!taken) {
             if (w0 == w1) {
-                line[w0] |= first & last;
+                full = (uint32_t)((line[w0] |= first & last) == 0xFFFFFFFFu) << w0;
             } else {
-                line[w0] |= first;
+                full = (uint32_t)((line[w0] |= first) == 0xFFFFFFFFu) << w0;
                 for (int w = w0 + 1; w < w1; w++) line[w] = 0xFFFFFFFFu;
-                line[w1] |= last;
+                full |= cov_inner_words(w0, w1);
+                full |= (uint32_t)((line[w1] |= last) == 0xFFFFFFFFu) << w1;
             }
             rast_span(t, y, x0, x1, colour, id);
-            take(c, y, x1 - x0);
+            close_words(m, y, full);
             return (uint32_t)(x1 - x0);
         }
     }
@@ -118,8 +113,9 @@ uint32_t cov_fill(cov_mask *c, const rast_target *t, int y, int x0, int x1, cons
         if (keep) free &= ~keep[w];
         if (!free) continue;
         line[w] |= free;
+        full |= (uint32_t)(line[w] == 0xFFFFFFFFu) << w;
         int base = w * 32;
-        if (free == 0xFFFFFFFFu) { /* the common case: a whole free word */
+        if (free == 0xFFFFFFFFu) { /* a whole free word */
             if (base != run1) {
                 if (run1 > run0) rast_span(t, y, run0, run1, colour, id);
                 run0 = base;
@@ -142,6 +138,34 @@ uint32_t cov_fill(cov_mask *c, const rast_target *t, int y, int x0, int x1, cons
         }
     }
     if (run1 > run0) rast_span(t, y, run0, run1, colour, id);
-    if (drawn) take(c, y, (int)drawn);
+    close_words(m, y, full);
     return drawn;
+}
+
+void cov_claim(cov_mask *m, int y, const uint32_t *r, uint32_t (*claim)[COV_WORDS])
+{
+    uint32_t full = 0;
+    for (int w = 0; w < COV_WORDS; w++) {
+        uint32_t fresh = r[w] & ~m->bits[y][w];
+        if (!fresh) continue;
+        m->bits[y][w] |= fresh;
+        claim[y][w] |= fresh;
+        full |= (uint32_t)(m->bits[y][w] == 0xFFFFFFFFu) << w;
+    }
+    close_words(m, y, full);
+}
+
+void cov_release(cov_mask *m, uint32_t (*claim)[COV_WORDS])
+{
+    for (int y = 0; y < VIEW_H; y++) {
+        uint32_t reopened = 0;
+        for (int w = 0; w < COV_WORDS; w++) {
+            if (!claim[y][w]) continue;
+            m->bits[y][w] &= ~claim[y][w];
+            reopened |= 1u << w;
+        }
+        if (!reopened) continue;
+        if (!m->open[y]) m->full_rows--;
+        m->open[y] = (uint16_t)(m->open[y] | reopened);
+    }
 }

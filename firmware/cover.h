@@ -1,10 +1,10 @@
-/* cover.h - which pixels of the frame are already written (prefix cov_): one bit
- * per pixel, 320 bits a scan line. This is seed 001's per-scan-line span list
- * kept as a bit mask: exact (nothing is ever forgotten, so a front-to-back
- * renderer that fills only uncovered pixels writes each pixel exactly once),
- * of a fixed size (8,400 bytes) whatever the scene, and searched a 32-pixel word
- * at a time (count-trailing-zeros finds where a run of free pixels starts and
- * ends: RBIT + CLZ on a Cortex-M3, BSF on a 386). */
+/* cover.h - exact per-row pixel coverage of the 320x200 screen (prefix cov_).
+ *
+ * One bit per pixel, 40 bytes per scan line (8,000 bytes for the screen): a
+ * front-to-back renderer records here which pixels are already taken, asks
+ * whether a run of a row is wholly taken, and walks the free runs of a row.
+ * Unlike a list of intervals it never forgets anything and never runs out of
+ * room, so what it answers is exact. Bit (x & 31) of word x / 32 is pixel x. */
 #ifndef COVER_H
 #define COVER_H
 
@@ -14,38 +14,93 @@
 
 #define COV_WORDS (VIEW_W / 32)
 
-_Static_assert(VIEW_W % 32 == 0, "a scan line is a whole number of 32-bit words");
+_Static_assert(VIEW_W % 32 == 0 && COV_WORDS <= 16, "a row is whole words, at most 16");
 
 typedef struct {
-    uint32_t bits[VIEW_H][COV_WORDS]; /* bit x % 32 of word x / 32: pixel x written */
-    int16_t open[VIEW_H];             /* pixels of the line not yet written */
-    int16_t full_rows;                /* lines with open == 0 */
+    uint32_t bits[VIEW_H][COV_WORDS];
+    uint16_t open[VIEW_H];      /* bit i: word i of the row has a clear bit */
+    uint16_t full_rows;         /* rows with every pixel set */
 } cov_mask;
 
-void cov_reset(cov_mask *c);
+void cov_clear(cov_mask *m);
 
-static inline int cov_full(const cov_mask *c)
+/* A run touches its two end words bit by bit; the words between are whole, so
+ * they are set, and tested, through the row's word summary (open) alone. */
+#define COV_ALL_OPEN ((uint16_t)((1u << COV_WORDS) - 1u))
+
+
+/* Words w0 < i < w1, as summary bits. */
+static inline uint32_t cov_inner_words(int w0, int w1)
 {
-    return c->full_rows == VIEW_H;
+    return w1 - w0 > 1 ? ((1u << w1) - (2u << w0)) : 0;
 }
 
-/* 1 if every pixel of [x0, x1) on every line of [y0, y1) is written (clamped to
- * the screen; an empty box is covered). */
-int cov_box_covered(const cov_mask *c, int y0, int y1, int x0, int x1);
+/* 1 if every pixel of [x0, x1) on row y is set (an empty run: 1). 0 <= x0, x1 <= VIEW_W. */
+static inline int cov_all(const cov_mask *m, int y, int x0, int x1)
+{
+    uint32_t open = m->open[y];
+    if (x1 <= x0 || !open) return 1;
+    const uint32_t *row = m->bits[y];
+    int w0 = x0 >> 5, w1 = (x1 - 1) >> 5;
+    uint32_t first = 0xFFFFFFFFu << (x0 & 31), last = 0xFFFFFFFFu >> (31 - ((x1 - 1) & 31));
+    if (w0 == w1) return (row[w0] & first & last) == (first & last);
+    return (row[w0] & first) == first && (row[w1] & last) == last && !(open & cov_inner_words(w0, w1));
+}
 
-/* Write the pixels of [x0, x1) on line y that are neither written nor set in
- * keep (a line mask of pixels to leave alone, or NULL) in colour with id, one
- * span per run, and mark them written. Returns the pixels written. */
-uint32_t cov_fill(cov_mask *c, const rast_target *t, int y, int x0, int x1, const uint32_t *keep, uint8_t colour,
+/* Set [x0, x1) on row y (an empty run: nothing). */
+static inline void cov_set(cov_mask *m, int y, int x0, int x1)
+{
+    uint32_t open = m->open[y];
+    if (x1 <= x0 || !open) return;
+    uint32_t *row = m->bits[y];
+    int w0 = x0 >> 5, w1 = (x1 - 1) >> 5;
+    uint32_t first = 0xFFFFFFFFu << (x0 & 31), last = 0xFFFFFFFFu >> (31 - ((x1 - 1) & 31));
+    if (w0 == w1) first &= last;
+    if ((row[w0] |= first) == 0xFFFFFFFFu) open &= ~(1u << w0);
+    if (w1 > w0) {
+        for (int i = w0 + 1; i < w1; i++) row[i] = 0xFFFFFFFFu;
+        open &= ~cov_inner_words(w0, w1);
+        if ((row[w1] |= last) == 0xFFFFFFFFu) open &= ~(1u << w1);
+    }
+    m->open[y] = (uint16_t)open;
+    if (!open) m->full_rows++;
+}
+
+
+/* The first pixel of [x, x1) on row y that is clear (cov_next_clear) or set
+ * (cov_next_set); x1 if there is none. */
+int cov_next_clear(const cov_mask *m, int y, int x, int x1);
+int cov_next_set(const cov_mask *m, int y, int x, int x1);
+
+static inline int cov_row_full(const cov_mask *m, int y)
+{
+    return m->open[y] == 0;
+}
+
+/* 1 once every pixel of the screen is set. */
+static inline int cov_full(const cov_mask *m)
+{
+    return m->full_rows == VIEW_H;
+}
+
+/* 1 if every pixel of [x0, x1) on every row of [y0, y1) is set (clamped to the
+ * screen; an empty box: 1). */
+int cov_box_covered(const cov_mask *m, int y0, int y1, int x0, int x1);
+
+/* Fill the pixels of [x0, x1) on row y that are neither set nor set in keep (a
+ * row mask of pixels to leave alone, or NULL) in colour with id, one span per
+ * run (a free word at a time where it can), and set them. Returns the pixels
+ * written. */
+uint32_t cov_fill(cov_mask *m, const rast_target *t, int y, int x0, int x1, const uint32_t *keep, uint8_t colour,
                   uint32_t id);
 
-/* Set [x0, x1) in a line mask of COV_WORDS words. */
+/* Set [x0, x1) in a row mask of COV_WORDS words. */
 void cov_line_set(uint32_t *line, int x0, int x1);
 
-/* Mark the pixels of line mask m on line y as taken without writing them (a
- * later pass will), and record them in claim (a mask of the whole screen).
- * cov_release hands every claimed pixel back as unwritten. */
-void cov_claim(cov_mask *c, int y, const uint32_t *m, uint32_t (*claim)[COV_WORDS]);
-void cov_release(cov_mask *c, uint32_t (*claim)[COV_WORDS]);
+/* Set the pixels of row mask r on row y without writing them (a later pass
+ * will), and record them in claim (a mask of the screen); cov_release clears
+ * every claimed pixel again, so that the later pass finds them free. */
+void cov_claim(cov_mask *m, int y, const uint32_t *r, uint32_t (*claim)[COV_WORDS]);
+void cov_release(cov_mask *m, uint32_t (*claim)[COV_WORDS]);
 
 #endif

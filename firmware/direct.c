@@ -441,7 +441,7 @@ static void draw_face(dr_state *S, const dr_obj *o, const dr_face *f, const dr_e
     uint32_t id = RAST_ID(RAST_KIND_OBJECT, o->index);
     for (int y = face.top; y < face.bottom; y++) {
         int a, b;
-        if (!face_row(&face, own, y, &a, &b) || S->cov.open[y] == 0) continue;
+        if (!face_row(&face, own, y, &a, &b) || cov_row_full(&S->cov, y)) continue;
         uint32_t keep[COV_WORDS] = {0};
         near_ctx k = {&face, keep, y, a, b};
         for (uint32_t i = 0; i < S->nobjs; i++) {
@@ -509,7 +509,7 @@ void direct_render(const scene *sc, const world_state *w, const view_xform *v, c
     S->st = st;
     S->sink.polygon = add_polygon;
     S->sink.ctx = S;
-    cov_reset(&S->cov);
+    cov_clear(&S->cov);
     occ_reset(&S->occ);
     list_objects_in_view(S);
     st->object_pass = S->nobjs != 0;

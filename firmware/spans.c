@@ -1,14 +1,16 @@
-/* spans.c - edge lists, the surface stack, span collection and coverage. */
+/* spans.c - edge lists, the surface stack, span collection, coverage, and the
+ * batches that keep the pools a fixed size. */
 #include "spans.h"
 
 #include "bsp_walk.h"
+#include "cover.h"
 #include "eye.h"
 #include "obj_draw.h"
 #include "surfaces.h"
 
-#define SPAN_BUFFER 2048       /* spans collected before a flush */
-#define COVER_MAX 24           /* covered intervals remembered per scan line */
+#define SPAN_BUFFER 2048       /* spans collected before they are filled */
 #define BACKGROUND_COLOUR 0
+#define POLY_EDGES (CFG_POLY_VERTS + 5) /* the most edges one clipped polygon can have */
 
 typedef struct sp_edge {
     rast_edge d;               /* the DDA the fill rule is defined by (raster.h) */
@@ -25,6 +27,7 @@ typedef struct sp_surf {
     uint32_t seg;              /* a world surface's plane: a wall of this seg, or (SCN_NONE) the
                                 * floor or ceiling its id names */
     uint8_t object;            /* 1: an object's face */
+    uint8_t silent;            /* 1: owns its pixels but fills nothing (see spans_render) */
     int32_t state;             /* leading minus trailing edges seen on this line */
     uint8_t colour;
     struct sp_surf *below;     /* next surface down the stack */
@@ -38,10 +41,12 @@ typedef struct {
     int32_t next;
 } sp_span;
 
+/* An object in the view frustum, and the first visited leaf its box touches. */
 typedef struct {
-    int16_t n;                 /* intervals in use; -1 once the line is full */
-    int16_t x[COVER_MAX][2];   /* sorted, disjoint, not touching: [x0, x1) */
-} sp_cover;
+    int32_t x0, x1, y0, y1;    /* its box (16.16), clamped to 32 bits */
+    uint32_t index;            /* in w->objs */
+    uint32_t kmin;             /* the key of that leaf, 0 while none */
+} sp_obj;
 
 typedef struct {
     const scene *sc;
@@ -51,37 +56,46 @@ typedef struct {
     render_stats *st;
     surf_sink sink;
     sp_edge *edges;
-    uint32_t nedges, max_edges;
+    uint32_t nedges, max_edges; /* max_edges: world edges in one batch (object faces come on top) */
     sp_surf *surfs;
     uint32_t nsurfs, max_surfs;
-    uint32_t *leaf_key;        /* with objects: the key each leaf was visited with, 0 if not */
+    uint32_t cap_edges, cap_surfs; /* the pools: world's part plus every face of every object */
     objd_plane *planes;        /* with objects: 1/z planes of object faces and of world surfaces */
-    uint32_t nplanes, max_planes;
+    uint32_t nplanes;
     uint32_t object_faces;     /* object faces on the edge lists */
+    sp_obj *objs;              /* with objects: those in the frustum, by x0 */
+    uint32_t nobjs, pending;   /* pending: not yet found in a visited leaf */
+    int32_t obj_span;          /* the widest object box (x1 - x0) */
+    int world_planes;          /* world surfaces keep what finds their plane */
+    int final;                 /* the batch being drawn is the frame's last */
+    int flushed;               /* a batch was drawn before this one */
+    uint32_t edges_total;
     sp_edge *new_edges[VIEW_H];
-    sp_cover cover[VIEW_H];
+    cov_mask claimed;          /* pixels some polygon on the lists (any batch) covers */
+    cov_mask drawn;            /* pixels filled by an earlier batch */
     occ_columns occ;
     int use_occ;
-    int full_rows;
     uint32_t key;
     sp_span spans[SPAN_BUFFER];
     int nspans;
-    sp_surf *drawn;            /* surfaces with spans in this batch */
+    sp_surf *drawn_list;       /* surfaces with spans in the span buffer */
     sp_surf background;
 } span_state;
 
 /* ---- memory ------------------------------------------------------------- */
 
-/* Faces and their clipping-maximal edges of w's objects (0 without objects). */
-static void object_bound(const scene *s, const world_state *w, uint64_t *faces, uint64_t *edges)
+/* Faces and their clipping-maximal edges of w's objects, and the objects (0
+ * without objects). */
+static void object_bound(const scene *s, const world_state *w, uint64_t *faces, uint64_t *edges, uint64_t *objs)
 {
-    *faces = *edges = 0;
+    *faces = *edges = *objs = 0;
     if (!CFG_OBJECTS || !w) return;
     for (uint32_t i = 0; i < w->n; i++) {
         uint32_t mi = w->objs ? w->objs[i].model : (i < s->nobjects ? s->objects[i].model : SCN_NONE);
         if (mi >= s->nmodels) continue; /* nothing to draw */
         *faces += s->models[mi].num_faces;
         *edges += scene_model_edges(s, &s->models[mi]);
+        (*objs)++;
     }
 }
 
@@ -90,24 +104,34 @@ static uint32_t align8(uint64_t n)
     return (uint32_t)((n + 7u) & ~(uint64_t)7u);
 }
 
+static uint64_t min_u64(uint64_t a, uint64_t b)
+{
+    return a < b ? a : b;
+}
+
 typedef struct {
-    uint64_t edges, surfs, planes, leaves; /* counts; leaves and planes 0 without objects */
+    uint64_t world_edges, world_surfs;     /* one batch's world polygons */
+    uint64_t edges, surfs, planes, objs;   /* pool sizes; planes and objs 0 without objects */
     uint64_t total;                        /* bytes */
 } span_layout;
 
 static void layout(const scene *s, const world_state *w, span_layout *L)
 {
-    uint64_t faces, oedges;
-    object_bound(s, w, &faces, &oedges);
-    /* the world's part: the most one frame can take for any camera, as the
-     * compiler proved it (docs/needs.md) */
-    L->edges = (uint64_t)s->needs->edges + oedges;
-    L->surfs = (uint64_t)s->needs->surfaces + faces;
+    uint64_t faces, oedges, objs;
+    object_bound(s, w, &faces, &oedges, &objs);
+    /* the world's part: what the build allows, or less when the compiler proved
+     * that no frame of this scene needs more (docs/needs.md); at least one polygon */
+    L->world_edges = min_u64(s->needs->edges, SPAN_POOL_EDGES);
+    L->world_surfs = min_u64(s->needs->surfaces, SPAN_POOL_SURFACES);
+    if (L->world_edges < POLY_EDGES) L->world_edges = POLY_EDGES;
+    if (L->world_surfs < 1) L->world_surfs = 1;
+    L->edges = L->world_edges + oedges;
+    L->surfs = L->world_surfs + faces;
     L->planes = faces ? L->surfs : 0;
-    L->leaves = faces ? s->nleaves : 0;
+    L->objs = faces ? objs : 0;
     L->total = (uint64_t)align8(sizeof(span_state)) + align8(L->edges * sizeof(sp_edge)) +
-               align8(L->surfs * sizeof(sp_surf)) + align8(L->leaves * sizeof(uint32_t)) +
-               align8(L->planes * sizeof(objd_plane));
+               align8(L->surfs * sizeof(sp_surf)) + align8(L->planes * sizeof(objd_plane)) +
+               align8(L->objs * sizeof(sp_obj));
 }
 
 uint32_t span_work_bytes(const scene *s, const world_state *w)
@@ -117,58 +141,7 @@ uint32_t span_work_bytes(const scene *s, const world_state *w)
     return L.total > 0xFFFFFFF0u ? 0 : (uint32_t)L.total;
 }
 
-/* ---- coverage ----------------------------------------------------------- */
-
-/* 1 if [x0, x1) on row y is already covered by nearer polygons. */
-static int covered(const sp_cover *c, int x0, int x1)
-{
-    if (c->n < 0) return 1;
-    for (int i = 0; i < c->n; i++) {
-        if (c->x[i][0] > x0) return 0;
-        if (c->x[i][1] >= x1) return 1;
-    }
-    return 0;
-}
-
-/* Record [x0, x1) as covered. If the line has no room for another interval the
- * new one is forgotten: coverage then claims less than is true, which only
- * costs an early stop, never a hole. */
-static void cover(span_state *S, int y, int x0, int x1)
-{
-    sp_cover *c = &S->cover[y];
-    if (c->n < 0 || x1 <= x0) return;
-    int i = 0;
-    while (i < c->n && c->x[i][1] < x0) i++;          /* intervals wholly left */
-    int j = i;
-    while (j < c->n && c->x[j][0] <= x1) j++;         /* intervals touching [x0, x1) */
-    if (j > i) {                                       /* merge i .. j-1 into one */
-        if (c->x[i][0] < x0) x0 = c->x[i][0];
-        if (c->x[j - 1][1] > x1) x1 = c->x[j - 1][1];
-        c->x[i][0] = (int16_t)x0;
-        c->x[i][1] = (int16_t)x1;
-        int gone = j - i - 1;
-        for (int k = j; k < c->n; k++) {
-            c->x[k - gone][0] = c->x[k][0];
-            c->x[k - gone][1] = c->x[k][1];
-        }
-        c->n = (int16_t)(c->n - gone);
-    } else {
-        if (c->n == COVER_MAX) return;
-        for (int k = c->n; k > i; k--) {
-            c->x[k][0] = c->x[k - 1][0];
-            c->x[k][1] = c->x[k - 1][1];
-        }
-        c->x[i][0] = (int16_t)x0;
-        c->x[i][1] = (int16_t)x1;
-        c->n++;
-    }
-    if (c->n == 1 && c->x[0][0] == 0 && c->x[0][1] == VIEW_W) {
-        c->n = -1;
-        S->full_rows++;
-    }
-}
-
-/* ---- edges ---------------------------------------------------------------- */
+/* ---- coverage of polygons ------------------------------------------------- */
 
 /* Insert into a list kept sorted by x. */
 static void insert_sorted(sp_edge **list, sp_edge *e)
@@ -226,11 +199,15 @@ static int box_covered(const span_state *S, const screen_pt *pts, int n)
     }
     int x0 = rast_first_sample(xmin), x1 = rast_first_sample(xmax);
     int y0 = rast_first_sample(ymin), y1 = rast_first_sample(ymax);
+    if (x0 < 0) x0 = 0;
+    if (x1 > VIEW_W) x1 = VIEW_W;
     if (y1 > VIEW_H) y1 = VIEW_H;
     for (int y = y0 < 0 ? 0 : y0; y < y1; y++)
-        if (!covered(&S->cover[y], x0, x1)) return 0;
+        if (!cov_all(&S->claimed, y, x0, x1)) return 0;
     return 1;
 }
+
+/* ---- edges ---------------------------------------------------------------- */
 
 /* A new surface and its edges (the caller has checked the pools). */
 static sp_surf *add_surface(span_state *S, const screen_pt *pts, int n, uint8_t colour, uint32_t id)
@@ -243,6 +220,8 @@ static sp_surf *add_surface(span_state *S, const screen_pt *pts, int n, uint8_t 
     s->span_head = -1;
     s->next_drawn = 0;
     s->object = 0;
+    s->silent = 0;
+    s->below = s->above = 0;
     for (int i = 0; i < n; i++) {
         screen_pt a = pts[i], b = pts[(i + 1 == n) ? 0 : i + 1];
         if (a.y == b.y) continue;
@@ -258,6 +237,8 @@ static sp_surf *add_surface(span_state *S, const screen_pt *pts, int n, uint8_t 
     return s;
 }
 
+static void draw_batch(span_state *S, int final);
+
 static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id, uint32_t seg)
 {
     span_state *S = ctx;
@@ -269,58 +250,117 @@ static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, 
     int rows = polygon_rows(pts, n, &top, lo, hi);
     int visible = 0;
     for (int y = top; y < top + rows && !visible; y++)
-        visible = lo[y] < hi[y] && !covered(&S->cover[y], lo[y], hi[y]);
+        visible = lo[y] < hi[y] && !cov_all(&S->claimed, y, lo[y], hi[y]);
     if (!visible) {
         S->st->occluded++;
         return;
     }
-    if (S->nsurfs >= S->max_surfs || S->nedges + (uint32_t)n > S->max_edges) { /* the proof says: never */
+    /* The pools are full: what they hold is drawn now, and the walk goes on
+     * behind it (see spans_render). */
+    if (S->nsurfs >= S->max_surfs || S->nedges + (uint32_t)n > S->max_edges) draw_batch(S, 0);
+    if (S->nsurfs >= S->max_surfs || S->nedges + (uint32_t)n > S->max_edges) { /* n > CFG_POLY_VERTS + 5: never */
         S->st->overflow++;
         return;
     }
     sp_surf *s = add_surface(S, pts, n, colour, id);
-    if (S->leaf_key) { /* objects may meet it: how to find its plane if they do */
+    if (S->world_planes) { /* objects may meet it: how to find its plane if they do */
         s->plane = -1;
         s->seg = seg;
     }
-    for (int y = top; y < top + rows; y++) cover(S, y, lo[y], hi[y]);
+    for (int y = top; y < top + rows; y++) cov_set(&S->claimed, y, lo[y], hi[y]);
+}
+
+/* ---- objects -------------------------------------------------------------- */
+
+static int32_t clamp32(int64_t v)
+{
+    return v < INT32_MIN ? INT32_MIN : (v > INT32_MAX ? INT32_MAX : (int32_t)v);
+}
+
+/* The objects in the frustum, by the left side of their boxes. Returns how many. */
+static uint32_t collect_objects(span_state *S)
+{
+    const scene *sc = S->sc;
+    const world_state *w = S->w;
+    uint32_t n = 0;
+    S->obj_span = 0;
+    for (uint32_t i = 0; i < w->n; i++) {
+        const obj_state *o = &w->objs[i];
+        if (o->model >= sc->nmodels || !objd_in_view(sc, o, S->v)) continue;
+        int64_t r = sc->models[o->model].radius;
+        sp_obj b = {clamp32((int64_t)o->x - r), clamp32((int64_t)o->x + r), clamp32((int64_t)o->y - r),
+                    clamp32((int64_t)o->y + r), i, 0};
+        if (b.x1 - b.x0 > S->obj_span) S->obj_span = b.x1 - b.x0;
+        uint32_t k = n++;
+        for (; k > 0 && S->objs[k - 1].x0 > b.x0; k--) S->objs[k] = S->objs[k - 1];
+        S->objs[k] = b;
+    }
+    return n;
+}
+
+static void box_add(int32_t box[4], const scn_vertex *p)
+{
+    if (p->y > box[0]) box[0] = p->y;
+    if (p->y < box[1]) box[1] = p->y;
+    if (p->x < box[2]) box[2] = p->x;
+    if (p->x > box[3]) box[3] = p->x;
+}
+
+/* The objects whose box touches the leaf's bounding box (the compiler's: its
+ * floor polygon and its segs; top, bottom, left, right) and that no earlier
+ * leaf touched: this leaf's key is their kmin. */
+static void find_objects(span_state *S, uint32_t leaf)
+{
+    const scene *sc = S->sc;
+    const scn_leaf *f = &sc->leaves[leaf];
+    int32_t box[4] = {INT32_MIN, INT32_MAX, INT32_MAX, INT32_MIN};
+    for (uint32_t i = 0; i < f->num_pverts; i++) box_add(box, &sc->pverts[f->first_pvert + i]);
+    for (uint32_t i = 0; i < f->num_segs; i++) {
+        const scn_seg *g = &sc->segs[f->first_seg + i];
+        box_add(box, &sc->verts[g->v1]);
+        box_add(box, &sc->verts[g->v2]);
+    }
+    if (box[2] > box[3]) return; /* no geometry */
+    /* the first object that can reach the leaf from the left, by bisection */
+    int64_t from = (int64_t)box[2] - S->obj_span;
+    uint32_t lo = 0, hi = S->nobjs;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (S->objs[mid].x0 < from) lo = mid + 1;
+        else hi = mid;
+    }
+    for (uint32_t i = lo; i < S->nobjs && S->objs[i].x0 <= box[3]; i++) {
+        sp_obj *o = &S->objs[i];
+        if (o->kmin || o->x1 < box[2] || o->y0 > box[0] || o->y1 < box[1]) continue;
+        o->kmin = S->key;
+        S->pending--;
+    }
 }
 
 static int visit_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
 {
     span_state *S = ctx;
     S->key++;
-    if (S->leaf_key) S->leaf_key[leaf] = S->key;
+    if (CFG_OBJECTS && S->pending) find_objects(S, leaf);
     surf_leaf(S->sc, S->w, S->v, leaf, clip_mask, &S->sink, S->use_occ ? &S->occ : 0, S->st);
-    return S->full_rows == VIEW_H; /* the screen is full: nothing farther can show */
+    return cov_full(&S->claimed); /* the screen is full: nothing farther can show */
 }
 
-/* ---- objects -------------------------------------------------------------- */
-
-/* Is any object in the view frustum? If not, the frame skips the object pass:
- * no leaf keys during the walk, no locating, no planes. */
-static int any_in_view(const scene *sc, const world_state *w, const view_xform *v)
-{
-    for (uint32_t i = 0; i < w->n; i++)
-        if (w->objs[i].model < sc->nmodels && objd_in_view(sc, &w->objs[i], v)) return 1;
-    return 0;
-}
-
-/* Every object in a visited leaf and in view: its faces that face the eye, clipped
- * and projected, onto the edge lists (no coverage test: they are sorted in the
- * scan, against the world by key range and 1/z). */
-static void add_objects(span_state *S)
+/* Every object found in a visited leaf: its faces that face the eye, clipped and
+ * projected, onto the edge lists (no coverage test: they are sorted in the scan,
+ * against the world by kmin and 1/z). silent: a batch before the last, where
+ * they only keep world surfaces behind them from being filled. */
+static void add_objects(span_state *S, int silent)
 {
     const scene *sc = S->sc;
     const world_state *w = S->w;
     view_pt verts[CFG_MODEL_VERTS];
     screen_pt pts[CLIP_MAX_VERTS];
-    for (uint32_t i = 0; i < w->n; i++) {
+    for (uint32_t k = 0; k < S->nobjs; k++) {
+        if (!S->objs[k].kmin) continue;
+        uint32_t i = S->objs[k].index;
         const obj_state *o = &w->objs[i];
-        uint32_t kmin, kmax;
-        if (o->model >= sc->nmodels || !objd_in_view(sc, o, S->v) || !objd_locate(sc, o, S->leaf_key, &kmin, &kmax))
-            continue;
-        S->st->objects_visible++;
+        if (!silent) S->st->objects_visible++;
         const scn_model *m = &sc->models[o->model];
         objd_transform(sc, o, S->v, verts);
         for (uint32_t f = m->first_face; f < m->first_face + m->num_faces; f++) {
@@ -328,15 +368,16 @@ static void add_objects(span_state *S)
             if (!objd_face_plane(sc, m, f, verts, &pl)) continue;
             int n = objd_face_screen(sc, m, f, verts, S->v, pts);
             if (!n) continue;
-            if (S->nsurfs >= S->max_surfs || S->nedges + (uint32_t)n > S->max_edges || S->nplanes >= S->max_planes) {
-                S->st->overflow++; /* bounded by the objects' faces: never */
+            if (S->nsurfs >= S->cap_surfs || S->nedges + (uint32_t)n > S->cap_edges) {
+                S->st->overflow++; /* beyond the world's part, the pools hold every face of every object: never */
                 return;
             }
-            S->st->object_faces++;
+            if (!silent) S->st->object_faces++;
             sp_surf *s = add_surface(S, pts, n, sc->faces[f].colour, RAST_ID(RAST_KIND_OBJECT, i));
-            s->key = kmin;
-            s->kmax = kmax;
+            s->key = S->objs[k].kmin;
+            s->kmax = OBJD_KEY_OPEN;
             s->object = 1;
+            s->silent = (uint8_t)silent;
             s->plane = (int32_t)S->nplanes;
             S->planes[S->nplanes++] = pl;
             S->object_faces++;
@@ -387,31 +428,57 @@ static inline __attribute__((always_inline)) int in_front(span_state *S, sp_surf
 
 static void flush_spans(span_state *S)
 {
-    for (sp_surf *s = S->drawn; s; s = s->next_drawn) {
+    for (sp_surf *s = S->drawn_list; s; s = s->next_drawn) {
         for (int32_t i = s->span_head; i >= 0; i = S->spans[i].next)
             rast_span(S->t, S->spans[i].y, S->spans[i].x0, S->spans[i].x1, s->colour, s->id);
         s->span_head = -1;
         S->st->surfaces_drawn++;
     }
-    S->drawn = 0;
+    S->drawn_list = 0;
     S->nspans = 0;
 }
 
-static void emit_span(span_state *S, sp_surf *s, int y, int x0, int x1)
+static inline __attribute__((always_inline)) void push_span(span_state *S, sp_surf *s, int y, int x0, int x1)
 {
-    if (x1 <= x0) return;
     if (S->nspans == SPAN_BUFFER) flush_spans(S);
     sp_span *sp = &S->spans[S->nspans];
     sp->y = (int16_t)y;
     sp->x0 = (int16_t)x0;
     sp->x1 = (int16_t)x1;
     if (s->span_head < 0) {
-        s->next_drawn = S->drawn;
-        S->drawn = s;
+        s->next_drawn = S->drawn_list;
+        S->drawn_list = s;
     }
     sp->next = s->span_head;
     s->span_head = S->nspans++;
     S->st->spans++;
+}
+
+/* Fill [x0, x1) of row y with s in a batch before the last: later batches leave these pixels alone. */
+static void push_marked(span_state *S, sp_surf *s, int y, int x0, int x1)
+{
+    push_span(S, s, y, x0, x1);
+    cov_set(&S->drawn, y, x0, x1);
+}
+
+/* s owns [x0, x1) of row y. In a batch before the last, the background and
+ * silent surfaces (object faces) fill nothing there: the pixels stay open for
+ * the surfaces behind that later batches bring. After the first batch, pixels an
+ * earlier batch filled belong to nearer surfaces than any of this batch. */
+static void emit_span(span_state *S, sp_surf *s, int y, int x0, int x1)
+{
+    if (x1 <= x0) return;
+    if (!S->final && (s == &S->background || s->silent)) return;
+    if (S->final && !S->flushed) { /* the frame in one batch */
+        push_span(S, s, y, x0, x1);
+        return;
+    }
+    for (int x = cov_next_clear(&S->drawn, y, x0, x1); x < x1;) {
+        int end = cov_next_set(&S->drawn, y, x, x1);
+        if (S->final) push_span(S, s, y, x, end);
+        else push_marked(S, s, y, x, end);
+        x = cov_next_clear(&S->drawn, y, end, x1);
+    }
 }
 
 /* ---- the stack with objects: intersecting spans --------------------------- */
@@ -620,6 +687,24 @@ static void scan(span_state *S, int objects)
         scan_lines(S, 0);
 }
 
+/* Draw what the lists hold (final: the frame's last batch), then empty them. */
+static void draw_batch(span_state *S, int final)
+{
+    if (!final && !S->flushed) cov_clear(&S->drawn);
+    S->final = final;
+    S->object_faces = 0;
+    if (CFG_OBJECTS && S->nobjs) add_objects(S, !final);
+    S->edges_total += S->nedges;
+    scan(S, CFG_OBJECTS && S->object_faces > 0);
+    flush_spans(S);
+    for (int y = 0; y < VIEW_H; y++) S->new_edges[y] = 0;
+    S->nedges = S->nsurfs = S->nplanes = 0;
+    if (!final) {
+        S->flushed = 1;
+        S->st->flushes++;
+    }
+}
+
 void spans_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t, render_stats *st,
                   void *work, uint32_t work_bytes)
 {
@@ -634,40 +719,42 @@ void spans_render(const scene *sc, const world_state *w, const view_xform *v, co
     span_state *S = (span_state *)(void *)mem;
     mem += align8(sizeof(span_state));
     S->edges = (sp_edge *)(void *)mem;
-    S->max_edges = (uint32_t)L.edges;
+    S->max_edges = (uint32_t)L.world_edges;
+    S->cap_edges = (uint32_t)L.edges;
     mem += align8(L.edges * sizeof(sp_edge));
     S->surfs = (sp_surf *)(void *)mem;
-    S->max_surfs = (uint32_t)L.surfs;
+    S->max_surfs = (uint32_t)L.world_surfs;
+    S->cap_surfs = (uint32_t)L.surfs;
     mem += align8(L.surfs * sizeof(sp_surf));
-    /* objects need the leaves' keys, and planes for their faces and the world
-     * surfaces they meet; a frame without them pays nothing for either */
-    S->leaf_key = (CFG_OBJECTS && L.leaves && w->objs && any_in_view(sc, w, v)) ? (uint32_t *)(void *)mem : 0;
-    st->object_pass = S->leaf_key != 0;
-    mem += align8(L.leaves * sizeof(uint32_t));
     S->planes = (objd_plane *)(void *)mem;
-    S->max_planes = (uint32_t)L.planes;
-    S->nplanes = 0;
-    S->object_faces = 0;
+    mem += align8(L.planes * sizeof(objd_plane));
+    S->objs = (sp_obj *)(void *)mem;
     S->sc = sc;
     S->w = w;
     S->v = v;
     S->t = t;
     S->st = st;
+    /* objects need the objects in the frustum found in the walk's leaves, and
+     * planes for their faces and the world surfaces they meet; a frame without
+     * any pays for neither */
+    S->nobjs = (CFG_OBJECTS && L.objs && w->objs) ? collect_objects(S) : 0;
+    S->pending = S->nobjs;
+    S->world_planes = S->nobjs != 0;
+    st->object_pass = S->nobjs != 0;
+    S->nplanes = 0;
+    S->object_faces = 0;
     S->sink.polygon = add_polygon;
     S->sink.ctx = S;
     S->nedges = S->nsurfs = 0;
-    S->full_rows = 0;
+    S->edges_total = 0;
+    S->final = S->flushed = 0;
     S->key = 0;
     S->nspans = 0;
-    S->drawn = 0;
+    S->drawn_list = 0;
     S->background = (sp_surf){.key = 0xFFFFFFFFu, .id = RAST_ID(RAST_KIND_NONE, 0), .plane = -1, .seg = SCN_NONE,
                               .colour = BACKGROUND_COLOUR, .span_head = -1};
-    for (int y = 0; y < VIEW_H; y++) {
-        S->new_edges[y] = 0;
-        S->cover[y].n = 0;
-    }
-    if (S->leaf_key)
-        for (uint32_t i = 0; i < sc->nleaves; i++) S->leaf_key[i] = 0;
+    for (int y = 0; y < VIEW_H; y++) S->new_edges[y] = 0;
+    cov_clear(&S->claimed); /* S->drawn: cleared before the first batch that is not the last */
     walk_stats ws;
     /* Solid walls close columns only for an eye inside the world: from outside
      * every sector, or above or below its own sector, one sees past them. */
@@ -677,8 +764,6 @@ void spans_render(const scene *sc, const world_state *w, const view_xform *v, co
     walk_tree(sc, v, WALK_FRONT_TO_BACK, visit_leaf, S, occ, &ws);
     st->nodes = ws.nodes;
     st->boxes_culled = ws.boxes_culled + ws.boxes_hidden;
-    if (CFG_OBJECTS && S->leaf_key) add_objects(S);
-    st->edges = S->nedges;
-    scan(S, CFG_OBJECTS && S->object_faces > 0);
-    flush_spans(S);
+    draw_batch(S, 1);
+    st->edges = S->edges_total;
 }

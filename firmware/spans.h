@@ -10,14 +10,18 @@
  * collected per surface and drawn one surface at a time: every pixel is written
  * exactly once.
  *
- * Per-scan-line coverage (seed 001, "Drawing polygons front to back") records
- * the pixels already claimed by nearer polygons: a polygon wholly behind them
- * adds no edges, and the walk stops as soon as every line is covered.
+ * Coverage (seed 001, "Drawing polygons front to back") is a bit per pixel
+ * (cover.h): the pixels polygons on the lists already claim, so a polygon
+ * wholly behind them adds no edges and the walk stops once every pixel is
+ * claimed.
  *
- * Memory: all state lives in a caller-supplied work area. span_work_bytes()
- * returns what a scene can need in the worst case for any camera: every polygon
- * the scene has, each with the most edges clipping can give it, could be visible
- * at once. No pool can run out mid-frame, so there is no silent limit.
+ * Memory: all state lives in a caller-supplied work area of fixed-size pools
+ * (edges, surfaces, 1/z planes), sized by the build (SPAN_POOL_*), or smaller
+ * when the compiler proved the scene never needs that many (docs/needs.md).
+ * When a pool is full the frame is drawn in batches: what the pools hold is
+ * drawn, every pixel it fills is marked, and the walk goes on behind it; later
+ * batches fill only unmarked pixels. The frame is the same as with pools of
+ * any size, and no polygon is dropped.
  */
 #ifndef SPANS_H
 #define SPANS_H
@@ -27,18 +31,32 @@
 #include "scene.h"
 #include "view.h"
 
+/* World edges and surfaces one batch holds (a build may set them: -D or its
+ * scene header). The defaults hold every view of the Freedoom maps measured so
+ * far in one batch on the host (at most 1,688 edges and 514 surfaces). */
+#ifndef SPAN_POOL_EDGES
+#define SPAN_POOL_EDGES 2048u
+#endif
+#ifndef SPAN_POOL_SURFACES
+#define SPAN_POOL_SURFACES 640u
+#endif
+
 /* Bytes of work memory spans_render needs for this scene and w's objects (w
  * NULL: none; see render_work_bytes), 0 if it would not fit in 32 bits: the
- * caller must refuse the scene. Objects add, for every face of every object
- * (all could be in view at once), a surface, its clipping-maximal edges and a
- * 1/z plane, plus a plane for every world surface and a key per leaf. */
+ * caller must refuse the scene. The world's part is fixed: min(the scene's
+ * proven bound, SPAN_POOL_*) edges and surfaces. Objects add, for every face
+ * of every object (all could be in view at once), a surface, its
+ * clipping-maximal edges and a 1/z plane, a plane for every world surface of a
+ * batch, and an entry per object for those in the frustum. */
 uint32_t span_work_bytes(const scene *s, const world_state *w);
 
-/* w: doors and objects (NULL: the static world). Objects are drawn after the
- * walk (docs/objects.md): each one whose box touches a visited leaf enters the
- * same edge lists, sorted against world surfaces by the key range of its
- * visited leaves and, inside that range, and against other objects, by 1/z
- * (obj_draw.h); on lines with an object the top of the stack is also checked
+/* w: doors and objects (NULL: the static world). Objects (docs/objects.md):
+ * the walk finds, for each object in the frustum, the first visited leaf whose
+ * bounding box its box touches (kmin); its faces enter the same edge lists,
+ * behind world surfaces of smaller keys and sorted by 1/z against those of
+ * kmin and beyond and against other objects (obj_draw.h); a batch drawn before
+ * the walk ends holds them as silent surfaces, which own their pixels but fill
+ * nothing, and the last batch draws them; on lines with an object the top of the stack is also checked
  * for being overtaken along the line, so objects that reach into walls or into
  * each other are cut where they cross. Without objects the scan is the
  * key-only scan above, instruction for instruction. */

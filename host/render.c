@@ -446,9 +446,9 @@ static void print_json(const options *o, const engine *e, uint32_t crc)
            "\"polygons\": %u, \"occluded\": %u, \"edges\": %u, \"spans\": %u, \"work_bytes\": %u, \"frames\": %ld, ",
            st->nodes, st->boxes_culled, st->leaves, st->segs, st->culled, st->polygons, st->occluded, st->edges,
            st->spans, e->work.bytes, o->repeat);
-    printf("\"object_pass\": %u, \"overflow\": %u, \"yclip_skipped\": %u, \"planes_skipped\": %u, "
+    printf("\"object_pass\": %u, \"overflow\": %u, \"flushes\": %u, \"yclip_skipped\": %u, \"planes_skipped\": %u, "
            "\"features\": %u, \"build_features\": %u, ",
-           st->object_pass, st->overflow, st->yclip_skipped, st->planes_skipped, e->sc.needs->features,
+           st->object_pass, st->overflow, st->flushes, st->yclip_skipped, st->planes_skipped, e->sc.needs->features,
            (unsigned)CFG_FEATURES);
     printf("\"objects_visible\": %u, \"object_faces\": %u, \"objects\": [", st->objects_visible, st->object_faces);
     const world_state *w = &e->world;
