@@ -215,45 +215,13 @@ static void activate(dr_state *S, dr_obj *o)
 
 /* ---- objects against the leaves ---------------------------------------------------- */
 
-/* Does the object's box (origin +- its model's radius) reach into the leaf's
- * convex polygon? Its bounding box first, then each edge as a separating line.
- * Offsets are shifted (edges by 1, corners by 3) so the cross products stay
- * below 2^61; a box within the rounding of an edge counts as touching, which
- * only makes an object active a leaf early. */
-static int box_touches_leaf(const scene *sc, const scn_leaf *f, int64_t bx0, int64_t by0, int64_t bx1, int64_t by1)
-{
-    const scn_vertex *p = &sc->pverts[f->first_pvert];
-    uint32_t n = f->num_pverts;
-    if (n < 3) return 0;
-    int64_t x0 = INT64_MAX, x1 = INT64_MIN, y0 = INT64_MAX, y1 = INT64_MIN;
-    for (uint32_t i = 0; i < n; i++) {
-        if (p[i].x < x0) x0 = p[i].x;
-        if (p[i].x > x1) x1 = p[i].x;
-        if (p[i].y < y0) y0 = p[i].y;
-        if (p[i].y > y1) y1 = p[i].y;
-    }
-    if (x0 > bx1 || x1 < bx0 || y0 > by1 || y1 < by0) return 0;
-    for (uint32_t i = 0; i < n; i++) {
-        const scn_vertex *a = &p[i], *b = &p[i + 1 == n ? 0 : i + 1];
-        int64_t dx = fx_asr64((int64_t)b->x - a->x, 1), dy = fx_asr64((int64_t)b->y - a->y, 1);
-        /* the corner farthest to the left of a -> b (the polygon runs counter-clockwise) */
-        int64_t cx = fx_asr64((dy > 0 ? bx0 : bx1) - a->x, 3), cy = fx_asr64((dx > 0 ? by1 : by0) - a->y, 3);
-        int64_t slack = (dx < 0 ? -dx : dx) + (dy < 0 ? -dy : dy);
-        if (dx * cy - dy * cx < -slack) return 0; /* the whole box is to the right: outside */
-    }
-    return 1;
-}
-
 static void activate_objects_in(dr_state *S, uint32_t leaf)
 {
     const scn_leaf *f = &S->sc->leaves[leaf];
     for (uint32_t i = 0; i < S->nobjs; i++) {
         dr_obj *o = &S->objs[i];
         if (o->active) continue;
-        const obj_state *os = &S->w->objs[o->index];
-        int64_t r = S->sc->models[os->model].radius;
-        if (box_touches_leaf(S->sc, f, (int64_t)os->x - r, (int64_t)os->y - r, (int64_t)os->x + r, (int64_t)os->y + r))
-            activate(S, o);
+        if (objd_touches_leaf(S->sc, &S->w->objs[o->index], f)) activate(S, o);
     }
 }
 

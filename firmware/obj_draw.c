@@ -185,6 +185,35 @@ int objd_locate(const scene *s, const obj_state *o, const uint32_t *leaf_key, ui
     return 1;
 }
 
+/* Its bounding box first, then each edge of the leaf as a separating line.
+ * Offsets are shifted (edges by 1, corners by 3) so the cross products stay
+ * below 2^61 (offsets below 2^32.03 raw, as in objd_locate). */
+int objd_touches_leaf(const scene *sc, const obj_state *o, const scn_leaf *f)
+{
+    int64_t r = sc->models[o->model].radius;
+    int64_t bx0 = (int64_t)o->x - r, by0 = (int64_t)o->y - r, bx1 = (int64_t)o->x + r, by1 = (int64_t)o->y + r;
+    const scn_vertex *p = &sc->pverts[f->first_pvert];
+    uint32_t n = f->num_pverts;
+    if (n < 3) return 0;
+    int64_t x0 = INT64_MAX, x1 = INT64_MIN, y0 = INT64_MAX, y1 = INT64_MIN;
+    for (uint32_t i = 0; i < n; i++) {
+        if (p[i].x < x0) x0 = p[i].x;
+        if (p[i].x > x1) x1 = p[i].x;
+        if (p[i].y < y0) y0 = p[i].y;
+        if (p[i].y > y1) y1 = p[i].y;
+    }
+    if (x0 > bx1 || x1 < bx0 || y0 > by1 || y1 < by0) return 0;
+    for (uint32_t i = 0; i < n; i++) {
+        const scn_vertex *a = &p[i], *b = &p[i + 1 == n ? 0 : i + 1];
+        int64_t dx = fx_asr64((int64_t)b->x - a->x, 1), dy = fx_asr64((int64_t)b->y - a->y, 1);
+        /* the corner farthest to the left of a -> b (the polygon runs counter-clockwise) */
+        int64_t cx = fx_asr64((dy > 0 ? bx0 : bx1) - a->x, 3), cy = fx_asr64((dx > 0 ? by1 : by0) - a->y, 3);
+        int64_t slack = (dx < 0 ? -dx : dx) + (dy < 0 ? -dy : dy);
+        if (dx * cy - dy * cx < -slack) return 0; /* the whole box is to the right: outside */
+    }
+    return 1;
+}
+
 /* The horizontal offset of the origin from the eye, rotated into view axes (16.16,
  * int64): z forward, x right. */
 static void origin_view(const obj_state *o, const view_xform *v, int64_t *vx, int64_t *vz)

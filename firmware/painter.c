@@ -7,8 +7,9 @@
  * Objects are drawn with the leaves: each one right after the nearest leaf its
  * box touches that the walk visits, so every leaf nearer than that overdraws it
  * and none behind it does; objects of one leaf farthest origin first, faces
- * farthest centroid first (Chapter 65's z-sorted objects). A first walk numbers
- * the leaves (objd_locate needs their keys); the second draws. Not exact, by
+ * farthest centroid first (Chapter 65's z-sorted objects). A first walk, front
+ * to back, finds each object's nearest leaf (the first one it touches); the
+ * second, back to front, draws. Not exact, by
  * design: an object still overdraws the surfaces of its own leaf that are in
  * front of it, and two objects are ordered by their origins only. */
 #include "bsp_walk.h"
@@ -19,9 +20,10 @@
 #define PAINTER_BACKGROUND 0
 
 typedef struct {
-    uint32_t key;  /* objects: the key of the leaf they are drawn after; faces: unused */
+    uint32_t key;  /* objects: the front-to-back number of the leaf they are drawn after; faces: unused */
     int32_t depth; /* view z of the origin (objects) or the centroid (faces) */
     uint32_t index;
+    uint32_t leaf; /* objects: that leaf */
 } pt_order;
 
 typedef struct {
@@ -31,18 +33,18 @@ typedef struct {
     const rast_target *t;
     render_stats *st;
     surf_sink sink;
-    uint32_t *leaf_key;   /* first walk: nleaves - visit number (nearer leaves smaller), 0 unvisited */
-    uint32_t next_key;
-    const pt_order *objs; /* second walk: objects in drawing order, and the next one to draw */
+    pt_order *objs;       /* objects in view; the first walk finds their leaves, the second draws them in order */
     uint32_t nobjs, at;
+    uint32_t visits;      /* first walk: leaves visited so far */
+    uint32_t unplaced;    /* first walk: objects whose leaf is not found yet */
 } painter;
 
 uint32_t painter_work_bytes(const scene *s, const world_state *w)
 {
-    /* the leaves' keys, then the order and a merge buffer: 2 * 4096 * 12 bytes at most */
+    /* the objects' order and a merge buffer: 2 * 4096 * 16 bytes at most */
+    (void)s;
     uint32_t n = (CFG_OBJECTS && w && w->objs) ? w->n : 0;
-    if (!n) return 0;
-    return (uint32_t)((uint64_t)s->nleaves * sizeof(uint32_t) + 2u * (uint64_t)n * sizeof(pt_order));
+    return (uint32_t)(2u * (uint64_t)n * sizeof(pt_order));
 }
 
 static void fill_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id, uint32_t seg)
@@ -55,21 +57,28 @@ static void fill_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour,
 static void draw_object(const scene *sc, uint32_t i, const obj_state *o, const view_xform *v, const rast_target *t,
                         render_stats *st);
 
-static int number_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
+/* First walk, front to back: each object's nearest leaf is the first it touches. */
+static int place_objects(void *ctx, uint32_t leaf, unsigned clip_mask)
 {
     painter *p = ctx;
     (void)clip_mask;
-    p->leaf_key[leaf] = p->next_key--;
-    return 0;
+    p->visits++;
+    for (uint32_t k = 0; k < p->nobjs && p->unplaced; k++) {
+        pt_order *o = &p->objs[k];
+        if (o->key || !objd_touches_leaf(p->sc, &p->w->objs[o->index], &p->sc->leaves[leaf])) continue;
+        o->key = p->visits;
+        o->leaf = leaf;
+        p->unplaced--;
+    }
+    return p->unplaced == 0;
 }
 
 static int draw_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
 {
     painter *p = ctx;
     surf_leaf(p->sc, p->w, p->v, leaf, clip_mask, &p->sink, 0, p->st);
-    if (CFG_OBJECTS && p->leaf_key) {
-        uint32_t key = p->leaf_key[leaf];
-        for (; p->at < p->nobjs && p->objs[p->at].key == key; p->at++) {
+    if (CFG_OBJECTS && p->objs) {
+        for (; p->at < p->nobjs && p->objs[p->at].leaf == leaf; p->at++) {
             uint32_t i = p->objs[p->at].index;
             draw_object(p->sc, i, &p->w->objs[i], p->v, p->t, p->st);
         }
@@ -143,25 +152,22 @@ void painter_render(const scene *sc, const world_state *w, const view_xform *v, 
     p.sink.ctx = &p;
     render_clear(t, PAINTER_BACKGROUND);
     if (nobj) {
-        p.leaf_key = work->mem;
-        for (uint32_t i = 0; i < sc->nleaves; i++) p.leaf_key[i] = 0;
-        p.next_key = sc->nleaves;
-        walk_tree(sc, v, WALK_BACK_TO_FRONT, number_leaf, &p, 0, &ws);
-        pt_order *order = (pt_order *)(void *)(p.leaf_key + sc->nleaves), *tmp = order + nobj;
+        pt_order *order = work->mem, *tmp = order + nobj;
         uint32_t n = 0;
         for (uint32_t i = 0; i < nobj; i++) {
             const obj_state *o = &w->objs[i];
-            uint32_t kmin, kmax;
-            if (o->model >= sc->nmodels || !objd_in_view(sc, o, v) || !objd_locate(sc, o, p.leaf_key, &kmin, &kmax))
-                continue;
-            order[n].key = kmin; /* the nearest of its visited leaves */
-            order[n].depth = objd_depth(o, v);
-            order[n++].index = i;
+            if (o->model >= sc->nmodels || !objd_in_view(sc, o, v)) continue;
+            order[n++] = (pt_order){0, objd_depth(o, v), i, 0};
         }
-        sort_far_first(order, tmp, n);
-        st->objects_visible = n;
         p.objs = order;
-        p.nobjs = n;
+        p.nobjs = p.unplaced = n;
+        if (n) walk_tree(sc, v, WALK_FRONT_TO_BACK, place_objects, &p, 0, &ws);
+        uint32_t placed = 0; /* objects in no visited leaf are not drawn */
+        for (uint32_t k = 0; k < n; k++)
+            if (order[k].key) order[placed++] = order[k];
+        sort_far_first(order, tmp, placed);
+        st->objects_visible = placed;
+        p.nobjs = placed;
     }
     walk_tree(sc, v, WALK_BACK_TO_FRONT, draw_leaf, &p, 0, &ws);
     st->nodes = ws.nodes;
