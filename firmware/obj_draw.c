@@ -129,7 +129,10 @@ int objd_front(const objd_plane *s, int s_obj, const objd_plane *p, int p_obj, i
     /* in one plane: the one nearing the eye faster along the line, then down it */
     int g = w128_sign_diff(s->nx, p->d, p->nx, s->d);
     if (g) return g > 0;
-    return w128_sign_diff(p->ny, s->d, s->ny, p->d) > 0;
+    g = w128_sign_diff(p->ny, s->d, s->ny, p->d);
+    if (g) return g > 0;
+    /* one plane, one gradient: the same depth at every pixel, so a fixed order */
+    return s_obj == 0 ? p_obj != 0 : (p_obj != 0 && s_obj < p_obj);
 }
 
 /* ---- the object in the tree ------------------------------------------------------ */
