@@ -62,12 +62,13 @@ void objd_plane_wall(const view_xform *v, const scn_vertex *a, const scn_vertex 
  * surface is an object's face (its plane has a centroid) and the value is 1 + the
  * object's number. Depths within OBJ_TIE_EPS tie, and a tie goes to the side of
  * the planes each surface lies on (a face whose centroid is on the eye's side of
- * the other's plane is in front: it rests on it or against it); only faces lying
- * in one plane fall back to Abrash's rule, the larger 1/z gradient along the scan
- * line (then down it), and faces in one plane with one gradient (the coplanar
- * tops of two things of one height) to a fixed order: the world before objects,
- * then the lower object number, as tools/refrender.py breaks exact ties. A plane
- * with d = 0 is in front. */
+ * the other's plane is in front: it rests on it or against it). Faces of two
+ * objects lying in one plane (the tops or sides of two things of one height side
+ * by side) go in a fixed order, the lower object number first, as
+ * tools/refrender.py breaks exact ties; other surfaces in one plane fall back to
+ * Abrash's rule, the larger 1/z gradient along the scan line (then down it), and
+ * with one gradient too, the world goes before objects. A plane with d = 0 is in
+ * front. */
 int objd_front(const objd_plane *s, int s_obj, const objd_plane *p, int p_obj, int look, int px, int py);
 
 /* The object's box (its model's radius around the origin) walked through the
