@@ -233,9 +233,29 @@ typedef struct {
     int y, x0, x1;
 } keep_ctx;
 
-/* Mark where face f is in front of the world surface on the row: 1/z is linear
+/* Set in keep the pixels of [a, b) on row y where surface s is in front of p
+ * (objd_front's numbering: 0 the world, 1 + an object's index). 1/z is linear
  * along a row, so "in front" changes at most once between the ends; the change
  * is found by bisection. */
+static void mark_in_front(uint32_t *keep, const objd_plane *s, int sn, const objd_plane *p, int pn, int look, int y,
+                          int a, int b)
+{
+    int fa = objd_front(s, sn, p, pn, look, a, y), fb = objd_front(s, sn, p, pn, look, b - 1, y);
+    if (fa == fb) {
+        if (fa) cov_line_set(keep, a, b);
+        return;
+    }
+    int lo = a, hi = b - 1; /* in front at lo differs from at hi */
+    while (hi - lo > 1) {
+        int mid = lo + (hi - lo) / 2;
+        if (objd_front(s, sn, p, pn, look, mid, y) == fa) lo = mid;
+        else hi = mid;
+    }
+    if (fa) cov_line_set(keep, a, hi);
+    else cov_line_set(keep, hi, b);
+}
+
+/* Mark where face f is in front of the world surface on the row. */
 static void keep_face(dr_state *S, const dr_obj *o, const dr_face *f, const dr_edge *edges, void *ctx)
 {
     (void)o;
@@ -245,20 +265,7 @@ static void keep_face(dr_state *S, const dr_obj *o, const dr_face *f, const dr_e
     if (a < k->x0) a = k->x0;
     if (b > k->x1) b = k->x1;
     if (a >= b) return;
-    int look = VIEW_LOOK(S->v);
-    int fa = objd_front(&f->pl, 1, k->world, 0, look, a, k->y), fb = objd_front(&f->pl, 1, k->world, 0, look, b - 1, k->y);
-    if (fa == fb) {
-        if (fa) cov_line_set(k->keep, a, b);
-        return;
-    }
-    int lo = a, hi = b - 1; /* front differs at lo and hi */
-    while (hi - lo > 1) {
-        int mid = lo + (hi - lo) / 2;
-        if (objd_front(&f->pl, 1, k->world, 0, look, mid, k->y) == fa) lo = mid;
-        else hi = mid;
-    }
-    if (fa) cov_line_set(k->keep, a, hi);
-    else cov_line_set(k->keep, hi, b);
+    mark_in_front(k->keep, &f->pl, 1 + (int)f->obj, k->world, 0, VIEW_LOOK(S->v), k->y, a, b);
 }
 
 static void world_plane(const dr_state *S, uint32_t id, uint32_t seg, objd_plane *p)
@@ -381,21 +388,7 @@ static void keep_nearer_face(dr_state *S, const dr_obj *o, const dr_face *g, con
     if (a < k->x0) a = k->x0;
     if (b > k->x1) b = k->x1;
     if (a >= b) return;
-    int look = VIEW_LOOK(S->v);
-    const objd_plane *f = &k->self->pl;
-    int fa = objd_front(&g->pl, 1, f, 1, look, a, k->y), fb = objd_front(&g->pl, 1, f, 1, look, b - 1, k->y);
-    if (fa == fb) {
-        if (fa) cov_line_set(k->keep, a, b);
-        return;
-    }
-    int lo = a, hi = b - 1;
-    while (hi - lo > 1) {
-        int mid = lo + (hi - lo) / 2;
-        if (objd_front(&g->pl, 1, f, 1, look, mid, k->y) == fa) lo = mid;
-        else hi = mid;
-    }
-    if (fa) cov_line_set(k->keep, a, hi);
-    else cov_line_set(k->keep, hi, b);
+    mark_in_front(k->keep, &g->pl, 1 + (int)g->obj, &k->self->pl, 1 + (int)k->self->obj, VIEW_LOOK(S->v), k->y, a, b);
 }
 
 /* Fill face f's rows where it is free and no other active face is nearer. The

@@ -126,10 +126,16 @@ int objd_front(const objd_plane *s, int s_obj, const objd_plane *p, int p_obj, i
         int b = side(s, p->cx, p->cy, p->cz); /* p on the eye's side of s: p in front */
         if (b) return b < 0;
     }
+    /* two objects' faces in one plane (things of one height side by side): their
+     * planes differ only by rounding, so a fixed order, as the reference's */
+    if (s_obj && p_obj && s_obj != p_obj) return s_obj < p_obj;
     /* in one plane: the one nearing the eye faster along the line, then down it */
     int g = w128_sign_diff(s->nx, p->d, p->nx, s->d);
     if (g) return g > 0;
-    return w128_sign_diff(p->ny, s->d, s->ny, p->d) > 0;
+    g = w128_sign_diff(p->ny, s->d, s->ny, p->d);
+    if (g) return g > 0;
+    /* one plane, one gradient: the same depth at every pixel, so a fixed order */
+    return s_obj == 0 ? p_obj != 0 : (p_obj != 0 && s_obj < p_obj);
 }
 
 /* ---- the object in the tree ------------------------------------------------------ */

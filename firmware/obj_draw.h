@@ -58,12 +58,17 @@ void objd_plane_flat(const view_xform *v, int32_t h, objd_plane *p);
 void objd_plane_wall(const view_xform *v, const scn_vertex *a, const scn_vertex *b, objd_plane *p);
 
 /* Which of two surfaces is nearer at the centre of pixel (px, py) (clamped to the
- * screen): 1 if s is in front of p. s_obj, p_obj: the surface is an object's face
- * (its plane has a centroid). Depths within OBJ_TIE_EPS tie, and a tie goes to
- * the side of the planes each surface lies on (a face whose centroid is on the
- * eye's side of the other's plane is in front: it rests on it or against it);
- * only faces lying in one plane fall back to Abrash's rule, the larger 1/z
- * gradient along the scan line (then down it). A plane with d = 0 is in front. */
+ * screen): 1 if s is in front of p. s_obj, p_obj: 0 for a world surface, else the
+ * surface is an object's face (its plane has a centroid) and the value is 1 + the
+ * object's number. Depths within OBJ_TIE_EPS tie, and a tie goes to the side of
+ * the planes each surface lies on (a face whose centroid is on the eye's side of
+ * the other's plane is in front: it rests on it or against it). Faces of two
+ * objects lying in one plane (the tops or sides of two things of one height side
+ * by side) go in a fixed order, the lower object number first, as
+ * tools/refrender.py breaks exact ties; other surfaces in one plane fall back to
+ * Abrash's rule, the larger 1/z gradient along the scan line (then down it), and
+ * with one gradient too, the world goes before objects. A plane with d = 0 is in
+ * front. */
 int objd_front(const objd_plane *s, int s_obj, const objd_plane *p, int p_obj, int look, int px, int py);
 
 /* The object's box (its model's radius around the origin) walked through the

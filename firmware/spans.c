@@ -402,6 +402,12 @@ static const objd_plane *plane_of(span_state *S, sp_surf *s)
     return &S->planes[s->plane];
 }
 
+/* objd_front's name for a surface: 0 for the world's, 1 + the object's number. */
+static int obj_number(const sp_surf *s)
+{
+    return s->object ? (int)(s->id & 0xFFFFFFu) + 1 : 0;
+}
+
 /* Is s (being inserted) in front of p at pixel x of row y? World surfaces by key;
  * an object's face against the world by key outside its range, else by 1/z; and
  * faces of objects against each other by 1/z (docs/objects.md). */
@@ -414,7 +420,7 @@ static int mixed_front(span_state *S, sp_surf *s, sp_surf *p, int x, int y)
         if (p->key < s->key) return 0;
         if (p->key > s->kmax) return 1;
     }
-    return objd_front(plane_of(S, s), s->object, plane_of(S, p), p->object, VIEW_LOOK(S->v), x, y);
+    return objd_front(plane_of(S, s), obj_number(s), plane_of(S, p), obj_number(p), VIEW_LOOK(S->v), x, y);
 }
 
 static inline __attribute__((always_inline)) int in_front(span_state *S, sp_surf *s, sp_surf *p, int x, int y,

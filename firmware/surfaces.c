@@ -6,6 +6,7 @@
 #include "surfaces.h"
 
 #include "clip.h"
+#include "wide128.h"
 
 static void emit(const view_xform *v, clip_poly *p, unsigned mask, const surf_sink *sink, uint8_t colour,
                  uint32_t id, uint32_t seg, render_stats *st)
@@ -22,13 +23,11 @@ static void emit(const view_xform *v, clip_poly *p, unsigned mask, const surf_si
 }
 
 /* Front-facing: the eye strictly on the right of a -> b (edge-on is culled).
- * |b - a| < 2^32 and |eye - a| < 2^33 raw: shifted to 2^31 and 2^30 the products
- * stay below 2^61. */
+ * Exact: an eye 1/65536 in front of a wall, looking along it, sees the wall in
+ * a few columns, and dropping the offset's low bits would cull it as edge-on. */
 static int faces_eye(const view_xform *v, const scn_vertex *a, const scn_vertex *b)
 {
-    int64_t dx = fx_asr64((int64_t)b->x - a->x, 1), dy = fx_asr64((int64_t)b->y - a->y, 1);
-    int64_t ex = fx_asr64(v->cx - a->x, 3), ey = fx_asr64(v->cy - a->y, 3);
-    return dx * ey - dy * ex < 0;
+    return w128_sign_diff((int64_t)b->x - a->x, v->cy - a->y, (int64_t)b->y - a->y, v->cx - a->x) < 0;
 }
 
 static void wall_part(const view_xform *v, const scn_vertex *a, const scn_vertex *b, int32_t bottom, int32_t top,

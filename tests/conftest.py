@@ -17,6 +17,9 @@ ROOT = Path(__file__).resolve().parent.parent
 BUILD = ROOT / "build"
 SAN = Path(os.environ.get("BSPVGA_BIN", BUILD / "san"))
 WADDIR = Path(os.environ.get("DOOMWADDIR", "/usr/share/games/doom"))
+# Every render mode of build/render --mode, in one place: tests that run each mode take them from here.
+RENDER_MODES = ["direct", "spans", "painter"]
+
 SAN_ENV = dict(os.environ, ASAN_OPTIONS="detect_leaks=1:abort_on_error=0",
                UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1")
 

@@ -55,7 +55,10 @@ they enter a sector. A wall whose end is exactly on the ray counts as crossed (t
 inclusive). An eye exactly on a wall or vertex crosses it at depth 0, which the near plane
 ignores; each ray then starts in the near-side sector of the first wall it crosses (the sector it
 really goes into) rather than in the eye's sector, and a ray that crosses no wall (it leaves the
-map at once: the eye is on the map's outer edge, looking out) sees nothing.
+map at once: the eye is on the map's outer edge, looking out) sees nothing. Likewise a wall the
+ray crosses nearer than the near plane is not seen, but the ray goes through it: it reaches the
+near plane in the far-side sector of the last such wall (none past a one-sided wall), as the C
+renderer's near-clipped polygons show.
 
 Objects (docs/objects.md). Text scenes: `model NAME` ... `end` blocks of `part box w= d= h=
 [at=X,Y,Z]` (vertices at at + (+-W/2, +-D/2, 0 or H), a half of an odd number of 1/65536 units
@@ -745,6 +748,9 @@ def render_ids(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="
         t = tnum[None, :] / denom
         u = unum / denom
     hit = (denom != 0) & (u >= 0) & (u <= 1) & (t >= ZNEAR)
+    # walls nearer than the near plane are gone but the ray still passes them: it reaches the
+    # near plane in the sector beyond the last of them (possibly none)
+    pre = (denom != 0) & (u >= 0) & (u <= 1) & (t > 0) & (t < ZNEAR)
     # side of each line the eye is on: 0 front (right of v1 -> v2), 1 back
     side = ((wx * (-ay) - wy * (-ax)) >= 0).astype(np.int64)   # cross(w, E - A) >= 0
     near = np.where(side == 0, m.front, m.back)
@@ -776,7 +782,10 @@ def render_ids(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="
         nsec, bsec = near[li], far[li]
         # the walk: sector of interval j (before crossing j; interval k is past the last)
         cur = np.empty(k + 1, np.int64)
-        if on_wall:   # a ray that crosses nothing leaves the map at once: it sees nothing
+        pj = np.nonzero(pre[px])[0]
+        if len(pj):   # the sector past the walls it crossed before the near plane
+            cur[0] = far[pj[np.argmax(t[px, pj])]]
+        elif on_wall:   # a ray that crosses nothing leaves the map at once: it sees nothing
             cur[0] = nsec[0] if k else NONE
         else:
             cur[0] = start
