@@ -38,15 +38,18 @@ def test_world_against_reference(view, tmp_path):
     x, y = (float(c) for c in view["at"].split(","))
     spans_json, spans = c_ids(view, "spans", tmp_path, "--no-objects")
     painter_json, painter = c_ids(view, "painter", tmp_path, "--no-objects")
+    direct_json, direct = c_ids(view, "direct", tmp_path, "--no-objects")
     z = float(spans_json["camera"]["z"])  # the same eye height as the C renderer used
     ref = refrender.render_ids(view["scene"], x, y, z, float(view["angle"]), objects=[])
-    assert spans_json["overdraw"] == 1.0 and spans_json["pixels_written"] == 64000
-    for name, ids in (("spans", spans), ("painter", painter)):
+    for j in (spans_json, direct_json):
+        assert j["overdraw"] == 1.0 and j["pixels_written"] == 64000
+    for name, ids in (("spans", spans), ("painter", painter), ("direct", direct)):
         same = float((ids == ref).mean())
         assert same >= 0.999, f"{name}: only {same:.4%} of pixels match the reference"
         assert int(((ids >> 24) == 0).sum()) == 0, f"{name}: empty pixels inside a closed map"
-    # the two modes draw the same surfaces
+    # the modes draw the same surfaces
     assert (spans == painter).mean() >= 0.999
+    assert (direct == spans).mean() >= 0.999
 
 
 @pytest.mark.parametrize("view", VIEWS, ids=IDS)
@@ -54,11 +57,13 @@ def test_world_and_things_against_reference(view, tmp_path):
     x, y = (float(c) for c in view["at"].split(","))
     j, spans = c_ids(view, "spans", tmp_path)
     pj, painter = c_ids(view, "painter", tmp_path)
-    assert j["objects"] == pj["objects"]
+    dj, direct = c_ids(view, "direct", tmp_path)
+    assert j["objects"] == pj["objects"] == dj["objects"]
     ref = refrender.render_ids(view["scene"], x, y, float(j["camera"]["z"]), float(view["angle"]),
                                objects=j["objects"])
-    assert j["overdraw"] == 1.0 and j["pixels_written"] == 64000
-    for name, ids, bound in (("spans", spans, 0.999), ("painter", painter, 0.98)):
+    for jj in (j, dj):
+        assert jj["overdraw"] == 1.0 and jj["pixels_written"] == 64000
+    for name, ids, bound in (("spans", spans, 0.999), ("painter", painter, 0.98), ("direct", direct, 0.999)):
         assert int(((ids >> 24) == 0).sum()) == 0, f"{name}: empty pixels inside a closed map"
         same = float((ids == ref).mean())
         assert same >= bound, f"{name}: only {same:.4%} of pixels match the reference ({j['objects_visible']} objects seen)"

@@ -12,7 +12,7 @@ import sys
 import numpy as np
 import pytest
 
-from conftest import ROOT, render
+from conftest import RENDER_MODES, ROOT, render
 
 sys.path.insert(0, str(ROOT / "tools"))
 import refrender  # noqa: E402
@@ -216,7 +216,7 @@ def _slime_cameras():
     return cams
 
 
-@pytest.mark.parametrize("mode", ["spans", "painter"])
+@pytest.mark.parametrize("mode", RENDER_MODES)
 def test_no_slime_trails(mode, tmp_path):
     """Slime trails. Doom's node builders stored the points where a partition cut a wall rounded to
     whole map units, so the pieces of a cut wall were bent by up to half a unit and no longer met

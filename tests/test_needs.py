@@ -17,7 +17,7 @@ import sys
 
 import pytest
 
-from conftest import ROOT, WADDIR, program, run
+from conftest import RENDER_MODES, ROOT, WADDIR, program, run
 
 sys.path.insert(0, str(ROOT / "tools"))
 import armelf  # noqa: E402
@@ -177,7 +177,7 @@ def test_scene_build_is_bit_identical(spec, cams):
     bsc = out / "scene.bsc"
     config = (out / "scene_config.h").read_text()
     for args in cams:
-        for mode in ("spans", "painter"):
+        for mode in RENDER_MODES:
             full = json.loads(run([program("render", sanitized=False), bsc, "--mode", mode, *args]).stdout)
             mine = json.loads(run([out / "render", bsc, "--mode", mode, *args]).stdout)
             assert mine["crc32"] == full["crc32"], (spec, mode, args)
