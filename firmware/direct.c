@@ -361,6 +361,21 @@ static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, 
     if (!drawn) S->st->occluded++; else S->st->surfaces_drawn++;
 }
 
+/* The sink's question before clipping: is the points' box already drawn? */
+static int box_hidden(void *ctx, const screen_pt *pts, int n)
+{
+    const dr_state *S = ctx;
+    int32_t xmin = INT32_MAX, xmax = INT32_MIN, ymin = INT32_MAX, ymax = INT32_MIN;
+    for (int i = 0; i < n; i++) {
+        if (pts[i].x < xmin) xmin = pts[i].x;
+        if (pts[i].x > xmax) xmax = pts[i].x;
+        if (pts[i].y < ymin) ymin = pts[i].y;
+        if (pts[i].y > ymax) ymax = pts[i].y;
+    }
+    return cov_box_covered(&S->cov, rast_first_sample(ymin) - 1, rast_first_sample(ymax) + 1,
+                           rast_first_sample(xmin) - 1, rast_first_sample(xmax) + 1);
+}
+
 static int visit_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
 {
     dr_state *S = ctx;
@@ -469,6 +484,7 @@ void direct_render(const scene *sc, const world_state *w, const view_xform *v, c
     S->t = t;
     S->st = st;
     S->sink.polygon = add_polygon;
+    S->sink.hidden = box_hidden;
     S->sink.ctx = S;
     cov_clear(&S->cov);
     occ_reset(&S->occ);

@@ -750,6 +750,7 @@ void spans_render(const scene *sc, const world_state *w, const view_xform *v, co
     S->nplanes = 0;
     S->object_faces = 0;
     S->sink.polygon = add_polygon;
+    S->sink.hidden = 0;
     S->sink.ctx = S;
     S->nedges = S->nsurfs = 0;
     S->edges_total = 0;

@@ -8,16 +8,33 @@
 #include "clip.h"
 #include "wide128.h"
 
+/* The polygon's vertices projected as they are, if every one is in front of the
+ * near plane (0 if not). Unclipped, the polygon's screen image lies within
+ * their box; and where clipping then cuts nothing, these are the very points
+ * clip_project would give. */
+static int project_unclipped(const view_xform *v, const clip_poly *p, screen_pt *s)
+{
+    for (int i = 0; i < p->n; i++)
+        if (p->v[i].z < VIEW_ZNEAR) return 0;
+    for (int i = 0; i < p->n; i++) s[i] = view_project(v, p->v[i]);
+    return 1;
+}
+
 static void emit(const view_xform *v, clip_poly *p, unsigned mask, const surf_sink *sink, uint8_t colour,
                  uint32_t id, uint32_t seg, render_stats *st)
 {
+    screen_pt s[CLIP_MAX_VERTS];
+    int projected = sink->hidden && p->n <= CLIP_MAX_VERTS - 5 && project_unclipped(v, p, s);
+    if (projected && sink->hidden(sink->ctx, s, p->n)) {
+        st->occluded++;
+        return;
+    }
     if (!clip_polygon(p, v, mask)) {
         st->clipped_away++;
         return;
     }
     if (!(p->cut & (CLIP_TOP | CLIP_BOTTOM))) st->yclip_skipped++;
-    screen_pt s[CLIP_MAX_VERTS];
-    clip_project(v, p, s);
+    if (!projected || p->cut) clip_project(v, p, s);
     st->polygons++;
     sink->polygon(sink->ctx, s, p->n, colour, id, seg);
 }

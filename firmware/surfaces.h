@@ -19,6 +19,12 @@ typedef struct {
      * part of, or SCN_NONE for the floor or ceiling its id names (a sky step has
      * a ceiling's id but is a wall: its seg tells). */
     void (*polygon)(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id, uint32_t seg);
+    /* May be NULL. Asked before clipping, with the polygon's vertices projected
+     * unclipped (clamped to the screen; asked only when every vertex is in
+     * front of the near plane): 1 if the screen box of those points (widened
+     * by a pixel for the rounding of clipped vertices) is already wholly
+     * drawn, and the polygon is dropped unclipped. */
+    int (*hidden)(void *ctx, const screen_pt *pts, int n);
     void *ctx;
 } surf_sink;
 
