@@ -48,6 +48,15 @@
 #endif
 #define CFG_MODE(bit) ((CFG_RENDER_MODES & (bit)) != 0)
 
+/* Mode direct's pools for the faces of the objects met in a frame, and their
+ * edges (direct.c): any size works, larger ones only save recomputing. */
+#ifndef CFG_DIRECT_FACES
+#define CFG_DIRECT_FACES 128
+#endif
+#ifndef CFG_DIRECT_EDGES
+#define CFG_DIRECT_EDGES 512
+#endif
+
 #define CFG_HAS(bit) ((CFG_FEATURES & (bit)) != 0)
 #define CFG_OBJECTS CFG_HAS(SCN_NEED_OBJECTS)
 #define CFG_DOORS CFG_HAS(SCN_NEED_DOORS)
@@ -67,6 +76,8 @@ _Static_assert(CFG_LEAF_VERTS >= 3 && CFG_LEAF_VERTS <= SCN_MAX_LEAF_VERTS, "CFG
 _Static_assert(CFG_MODEL_VERTS >= 1 && CFG_MODEL_VERTS <= SCN_MAX_MODEL_VERTS, "CFG_MODEL_VERTS");
 _Static_assert(CFG_FACE_VERTS >= 1 && CFG_FACE_VERTS <= SCN_MAX_FACE_VERTS, "CFG_FACE_VERTS");
 _Static_assert((CFG_FEATURES & ~SCN_NEED_ALL) == 0, "CFG_FEATURES");
+_Static_assert(CFG_DIRECT_FACES >= 1 && CFG_DIRECT_FACES <= 65535 && CFG_DIRECT_EDGES >= 1 && CFG_DIRECT_EDGES <= 65535,
+               "CFG_DIRECT_FACES, CFG_DIRECT_EDGES");
 _Static_assert((CFG_RENDER_MODES & 7u) != 0 && (CFG_RENDER_MODES & ~7u) == 0, "CFG_RENDER_MODES");
 
 #endif

@@ -10,13 +10,11 @@
 
 #define BACKGROUND_COLOUR 0
 
-/* Pools for the faces of the active objects; a per-scene build may size them. */
-#ifndef DIRECT_FACE_POOL
-#define DIRECT_FACE_POOL 128
-#endif
-#ifndef DIRECT_EDGE_POOL
-#define DIRECT_EDGE_POOL 512
-#endif
+/* Pools for the faces of the active objects (and their edges). An object whose
+ * faces do not fit is worked out again wherever it is needed: slower, never
+ * wrong. A build may size them (build_config.h). */
+#define DIRECT_FACE_POOL CFG_DIRECT_FACES
+#define DIRECT_EDGE_POOL CFG_DIRECT_EDGES
 #define FACE_EDGES CLIP_MAX_VERTS /* a clipped face's edges */
 
 typedef struct {
@@ -33,12 +31,14 @@ typedef struct {
 } dr_face;
 
 typedef struct {
-    uint32_t index;          /* the object (its id) */
+    uint16_t index;          /* the object (its id; SCN_MAX_OBJECTS fits) */
     int16_t x0, x1, y0, y1;  /* screen box of its faces: pixels [x0, x1) x [y0, y1) */
     uint16_t first_face;     /* stored: its faces in the pool */
-    uint16_t nfaces;         /* faces facing the eye and on screen */
-    uint8_t active, stored;
+    uint8_t nfaces;          /* faces facing the eye and on screen (SCN_MAX_MODEL_FACES fits) */
+    uint8_t active : 1, stored : 1;
 } dr_obj;
+
+_Static_assert(SCN_MAX_OBJECTS <= 65536 && SCN_MAX_MODEL_FACES <= 255, "dr_obj's fields");
 
 typedef struct {
     const scene *sc;
@@ -197,8 +197,9 @@ static void activate(dr_state *S, dr_obj *o)
         stored &= (uint32_t)room;
         nf++;
     }
-    o->nfaces = (uint16_t)nf;
-    o->stored = (uint8_t)stored;
+    o->nfaces = (uint8_t)nf;
+    o->stored = stored != 0;
+    if (nf && !stored) S->st->flushes++;
     if (stored) {
         o->first_face = (uint16_t)S->nfaces;
         S->nfaces += nf;
@@ -454,7 +455,7 @@ static void list_objects_in_view(dr_state *S)
     for (uint32_t i = 0; i < w->n; i++) {
         const obj_state *o = &w->objs[i];
         if (o->model >= sc->nmodels || !objd_in_view(sc, o, S->v)) continue;
-        S->objs[S->nobjs++] = (dr_obj){.index = i};
+        S->objs[S->nobjs++] = (dr_obj){.index = (uint16_t)i};
     }
 }
 
