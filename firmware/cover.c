@@ -141,31 +141,3 @@ uint32_t cov_fill(cov_mask *m, const rast_target *t, int y, int x0, int x1, cons
     close_words(m, y, full);
     return drawn;
 }
-
-void cov_claim(cov_mask *m, int y, const uint32_t *r, uint32_t (*claim)[COV_WORDS])
-{
-    uint32_t full = 0;
-    for (int w = 0; w < COV_WORDS; w++) {
-        uint32_t fresh = r[w] & ~m->bits[y][w];
-        if (!fresh) continue;
-        m->bits[y][w] |= fresh;
-        claim[y][w] |= fresh;
-        full |= (uint32_t)(m->bits[y][w] == 0xFFFFFFFFu) << w;
-    }
-    close_words(m, y, full);
-}
-
-void cov_release(cov_mask *m, uint32_t (*claim)[COV_WORDS])
-{
-    for (int y = 0; y < VIEW_H; y++) {
-        uint32_t reopened = 0;
-        for (int w = 0; w < COV_WORDS; w++) {
-            if (!claim[y][w]) continue;
-            m->bits[y][w] &= ~claim[y][w];
-            reopened |= 1u << w;
-        }
-        if (!reopened) continue;
-        if (!m->open[y]) m->full_rows--;
-        m->open[y] = (uint16_t)(m->open[y] | reopened);
-    }
-}

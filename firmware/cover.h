@@ -97,10 +97,4 @@ uint32_t cov_fill(cov_mask *m, const rast_target *t, int y, int x0, int x1, cons
 /* Set [x0, x1) in a row mask of COV_WORDS words. */
 void cov_line_set(uint32_t *line, int x0, int x1);
 
-/* Set the pixels of row mask r on row y without writing them (a later pass
- * will), and record them in claim (a mask of the screen); cov_release clears
- * every claimed pixel again, so that the later pass finds them free. */
-void cov_claim(cov_mask *m, int y, const uint32_t *r, uint32_t (*claim)[COV_WORDS]);
-void cov_release(cov_mask *m, uint32_t (*claim)[COV_WORDS]);
-
 #endif

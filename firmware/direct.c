@@ -31,11 +31,12 @@ typedef struct {
 } dr_face;
 
 typedef struct {
+    int32_t left;            /* west edge of its box, whole units (the list is sorted by it) */
     uint16_t index;          /* the object (its id; SCN_MAX_OBJECTS fits) */
     int16_t x0, x1, y0, y1;  /* screen box of its faces: pixels [x0, x1) x [y0, y1) */
     uint16_t first_face;     /* stored: its faces in the pool */
     uint8_t nfaces;          /* faces facing the eye and on screen (SCN_MAX_MODEL_FACES fits) */
-    uint8_t active : 1, stored : 1;
+    uint8_t active : 1, stored : 1, drew : 1;
 } dr_obj;
 
 _Static_assert(SCN_MAX_OBJECTS <= 65536 && SCN_MAX_MODEL_FACES <= 255, "dr_obj's fields");
@@ -50,11 +51,12 @@ typedef struct {
     cov_mask cov;
     occ_columns occ;
     int use_occ;
-    dr_obj *objs; /* objects in view */
+    dr_obj *objs;     /* objects in view, by the west edge of their boxes */
+    uint16_t *active; /* the ones the walk has met that show faces, as indices into objs */
     uint32_t nobjs, nactive, nfaces, nedges;
+    int32_t reach;    /* the widest box in view, whole units */
     dr_face *faces;
     dr_edge *edges;
-    uint32_t (*claim)[COV_WORDS]; /* pixels the active objects will fill after the walk */
     dr_face scratch_face; /* a face of an object the pools could not hold */
     dr_edge scratch_edges[FACE_EDGES];
 } dr_state;
@@ -75,8 +77,9 @@ uint32_t direct_work_bytes(const scene *s, const world_state *w)
     uint32_t n = object_count(w);
     uint64_t total = align8(sizeof(dr_state));
     if (n)
-        total += align8((uint64_t)n * sizeof(dr_obj)) + align8((uint64_t)DIRECT_FACE_POOL * sizeof(dr_face)) +
-                 align8((uint64_t)DIRECT_EDGE_POOL * sizeof(dr_edge)) + align8(sizeof(uint32_t[VIEW_H][COV_WORDS]));
+        total += align8((uint64_t)n * sizeof(dr_obj)) + align8((uint64_t)n * sizeof(uint16_t)) +
+                 align8((uint64_t)DIRECT_FACE_POOL * sizeof(dr_face)) +
+                 align8((uint64_t)DIRECT_EDGE_POOL * sizeof(dr_edge));
     return total > 0xFFFFFFF0u ? 0 : (uint32_t)total;
 }
 
@@ -152,9 +155,9 @@ static int face_build(const dr_state *S, const dr_obj *o, const view_pt *verts, 
 
 /* Calls visit(S, o, face, its edges, ctx) for each face of the active object o
  * that shows: from the pools, or worked out again into the scratch face. */
-typedef void (*face_visit)(dr_state *S, const dr_obj *o, const dr_face *f, const dr_edge *edges, void *ctx);
+typedef void (*face_visit)(dr_state *S, dr_obj *o, const dr_face *f, const dr_edge *edges, void *ctx);
 
-static void each_face(dr_state *S, const dr_obj *o, face_visit visit, void *ctx)
+static void each_face(dr_state *S, dr_obj *o, face_visit visit, void *ctx)
 {
     if (o->stored) {
         for (uint32_t k = 0; k < o->nfaces; k++) {
@@ -182,8 +185,6 @@ static void activate(dr_state *S, dr_obj *o)
     view_pt verts[CFG_MODEL_VERTS];
     screen_pt box[2] = {{INT32_MAX, INT32_MAX}, {INT32_MIN, INT32_MIN}};
     uint32_t nf = 0, ne = S->nedges, stored = 1;
-    o->active = 1;
-    S->nactive++;
     objd_transform(sc, &S->w->objs[o->index], S->v, verts);
     for (uint32_t fi = m->first_face; fi < m->first_face + m->num_faces; fi++) {
         int room = stored && S->nfaces + nf < DIRECT_FACE_POOL && ne + FACE_EDGES <= DIRECT_EDGE_POOL;
@@ -216,23 +217,69 @@ static void activate(dr_state *S, dr_obj *o)
 
 /* ---- objects against the leaves ---------------------------------------------------- */
 
+/* Is the object wholly behind what is drawn already? Its box (origin +- its
+ * radius, its model's heights) projected: drawn pixels stay drawn, so such an
+ * object can never show and is never set up. */
+static int object_hidden(const dr_state *S, const obj_state *os)
+{
+    const scn_model *m = &S->sc->models[os->model];
+    int32_t zlo = INT32_MAX, zhi = INT32_MIN;
+    for (uint32_t i = 0; i < m->num_verts; i++) {
+        int32_t z = S->sc->mverts[m->first_vert + i].z;
+        if (z < zlo) zlo = z;
+        if (z > zhi) zhi = z;
+    }
+    if (zlo > zhi) return 1;
+    int32_t xs[2] = {os->x - m->radius, os->x + m->radius}, ys[2] = {os->y - m->radius, os->y + m->radius};
+    int32_t zs[2] = {os->z + zlo, os->z + zhi};
+    int32_t xmin = INT32_MAX, xmax = INT32_MIN, ymin = INT32_MAX, ymax = INT32_MIN;
+    for (int c = 0; c < 8; c++) {
+        view_pt p = view_point(S->v, xs[c & 1], ys[(c >> 1) & 1], zs[c >> 2]);
+        if (p.z < VIEW_ZNEAR) return 0; /* reaches past the near plane: no bound this way */
+        screen_pt q = view_project(S->v, p);
+        if (q.x < xmin) xmin = q.x;
+        if (q.x > xmax) xmax = q.x;
+        if (q.y < ymin) ymin = q.y;
+        if (q.y > ymax) ymax = q.y;
+    }
+    return cov_box_covered(&S->cov, rast_first_sample(ymin) - 1, rast_first_sample(ymax) + 1,
+                           rast_first_sample(xmin) - 1, rast_first_sample(xmax) + 1);
+}
+
+/* The first object in the list whose box's west edge is at or east of x. */
+static uint32_t first_at_or_east(const dr_state *S, int32_t x)
+{
+    uint32_t lo = 0, hi = S->nobjs;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (S->objs[mid].left < x) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo;
+}
+
+/* Objects whose box reaches into the leaf become active and are set up, unless
+ * already hidden. Only the stretch of the list whose boxes can reach the leaf's
+ * west-east extent is looked at. */
 static void activate_objects_in(dr_state *S, uint32_t leaf)
 {
     const scn_leaf *f = &S->sc->leaves[leaf];
-    for (uint32_t i = 0; i < S->nobjs; i++) {
+    int32_t box[4];
+    objd_leaf_box(S->sc, f, box);
+    if (box[0] > box[2]) return;
+    int32_t west = (box[0] >> 16) - 2 * S->reach - 1, east = box[2] >> 16;
+    for (uint32_t i = first_at_or_east(S, west); i < S->nobjs && S->objs[i].left <= east; i++) {
         dr_obj *o = &S->objs[i];
-        if (o->active) continue;
-        if (objd_touches_leaf(S->sc, &S->w->objs[o->index], f)) activate(S, o);
+        const obj_state *os = &S->w->objs[o->index];
+        if (o->active || !objd_touches_leaf(S->sc, os, f, box)) continue;
+        o->active = 1; /* looked at once: hidden now stays hidden */
+        if (object_hidden(S, os)) continue;
+        activate(S, o);
+        if (o->nfaces) S->active[S->nactive++] = (uint16_t)i;
     }
 }
 
-/* ---- world polygons -------------------------------------------------------------------- */
-
-typedef struct {
-    uint32_t *keep; /* the row's mask of pixels the world polygon leaves alone */
-    const objd_plane *world;
-    int y, x0, x1;
-} keep_ctx;
+/* ---- which surface is nearer ------------------------------------------------------------ */
 
 /* Set in keep the pixels of [a, b) on row y where surface s is in front of p
  * (objd_front's numbering: 0 the world, 1 + an object's index). 1/z is linear
@@ -256,18 +303,93 @@ static void mark_in_front(uint32_t *keep, const objd_plane *s, int sn, const obj
     else cov_line_set(keep, hi, b);
 }
 
-/* Mark where face f is in front of the world surface on the row. */
-static void keep_face(dr_state *S, const dr_obj *o, const dr_face *f, const dr_edge *edges, void *ctx)
+/* ---- drawing the objects' faces ---------------------------------------------------------- */
+
+typedef struct {
+    const dr_face *self; /* the face being drawn (a copy: the scratch face may be rebuilt) */
+    uint32_t *keep;
+    int y, x0, x1;
+} near_ctx;
+
+/* Mark where another face g is in front of the face being drawn. */
+static void keep_nearer_face(dr_state *S, dr_obj *o, const dr_face *g, const dr_edge *edges, void *ctx)
 {
     (void)o;
-    keep_ctx *k = ctx;
+    near_ctx *k = ctx;
+    if (g->obj == k->self->obj && g->model_face == k->self->model_face) return;
+    int a, b;
+    if (!face_row(g, edges, k->y, &a, &b)) return;
+    if (a < k->x0) a = k->x0;
+    if (b > k->x1) b = k->x1;
+    if (a >= b) return;
+    mark_in_front(k->keep, &g->pl, 1 + (int)g->obj, &k->self->pl, 1 + (int)k->self->obj, VIEW_LOOK(S->v), k->y, a, b);
+}
+
+/* Fill [a, b) of row y with face (a copy: looking at the other faces may rebuild
+ * the scratch face) where it is free, set in mine (NULL: everywhere) and no other
+ * active face is nearer. */
+static void draw_face_row(dr_state *S, dr_obj *o, const dr_face *face, int y, int a, int b, const uint32_t *mine)
+{
+    uint32_t keep[COV_WORDS];
+    for (int w = 0; w < COV_WORDS; w++) keep[w] = mine ? ~mine[w] : 0;
+    near_ctx k = {face, keep, y, a, b};
+    for (uint32_t i = 0; i < S->nactive; i++) {
+        dr_obj *p = &S->objs[S->active[i]];
+        if (p->y0 <= y && p->y1 > y && p->x0 < b && p->x1 > a) each_face(S, p, keep_nearer_face, &k);
+    }
+    if (cov_fill(&S->cov, S->t, y, a, b, keep, face->colour, RAST_ID(RAST_KIND_OBJECT, o->index))) o->drew = 1;
+}
+
+/* After the walk: fill face f's rows where they are still free. */
+static void draw_face(dr_state *S, dr_obj *o, const dr_face *f, const dr_edge *edges, void *ctx)
+{
+    (void)ctx;
+    dr_face face = *f;
+    dr_edge own[FACE_EDGES];
+    for (int i = 0; i < f->nedges; i++) own[i] = edges[i];
+    for (int y = face.top; y < face.bottom; y++) {
+        int a, b;
+        if (face_row(&face, own, y, &a, &b) && !cov_row_full(&S->cov, y)) draw_face_row(S, o, &face, y, a, b, 0);
+    }
+    S->st->object_faces++;
+}
+
+/* Every active object's faces, where still free after the walk. An object
+ * counts as visible when it wrote a pixel, then or during the walk. */
+static void draw_objects(dr_state *S)
+{
+    for (uint32_t i = 0; i < S->nactive; i++) {
+        dr_obj *o = &S->objs[S->active[i]];
+        each_face(S, o, draw_face, 0);
+        if (o->drew) S->st->objects_visible++;
+    }
+}
+
+typedef struct {
+    const objd_plane *world; /* the world surface of the row */
+    int y, x0, x1;
+} row_ctx;
+
+/* During the walk: fill face f on a world row where it is nearer than the world
+ * surface (and the nearest of the active faces). */
+static void draw_face_over_world(dr_state *S, dr_obj *o, const dr_face *f, const dr_edge *edges, void *ctx)
+{
+    row_ctx *k = ctx;
     int a, b;
     if (!face_row(f, edges, k->y, &a, &b)) return;
     if (a < k->x0) a = k->x0;
     if (b > k->x1) b = k->x1;
-    if (a >= b) return;
-    mark_in_front(k->keep, &f->pl, 1 + (int)f->obj, k->world, 0, VIEW_LOOK(S->v), k->y, a, b);
+    if (a >= b || cov_all(&S->cov, k->y, a, b)) return; /* nothing of it left to decide */
+    uint32_t mine[COV_WORDS] = {0};
+    mark_in_front(mine, &f->pl, 1 + (int)f->obj, k->world, 0, VIEW_LOOK(S->v), k->y, a, b);
+    uint32_t any = 0;
+    for (int w = 0; w < COV_WORDS; w++) any |= mine[w];
+    if (!any) return;
+    dr_face face = *f;
+    draw_face_row(S, o, &face, k->y, a, b, mine);
 }
+
+/* ---- world polygons -------------------------------------------------------------------- */
 
 static void world_plane(const dr_state *S, uint32_t id, uint32_t seg, objd_plane *p)
 {
@@ -284,34 +406,28 @@ static void world_plane(const dr_state *S, uint32_t id, uint32_t seg, objd_plane
 /* Active objects whose screen box meets [x0, x1) x [y0, y1). */
 static int objects_meet(const dr_state *S, int x0, int x1, int y0, int y1)
 {
-    for (uint32_t i = 0; i < S->nobjs; i++) {
-        const dr_obj *o = &S->objs[i];
-        if (o->active && o->nfaces && o->x0 < x1 && o->x1 > x0 && o->y0 < y1 && o->y1 > y0) return 1;
+    for (uint32_t i = 0; i < S->nactive; i++) {
+        const dr_obj *o = &S->objs[S->active[i]];
+        if (o->x0 < x1 && o->x1 > x0 && o->y0 < y1 && o->y1 > y0) return 1;
     }
     return 0;
 }
 
-/* A world row with active objects about: where a face is nearer, the pixel is
- * the objects' (the nearest active face's, or a nearer one's of an object met
- * later, but never a world surface's: everything the walk reaches later at
- * that pixel lies behind this one). It is claimed, so that it counts as taken
- * for the walk, and filled after it. */
+/* A world row with active objects about: where a face is nearer than the world
+ * surface, the pixel is the objects', and the nearest active face fills it now.
+ * No object met later can be nearer there: it lies in leaves the walk reaches
+ * later, behind this surface. The world surface fills the rest. */
 static uint32_t fill_row_behind_objects(dr_state *S, int y, int x0, int x1, const objd_plane *world, uint8_t colour,
                                         uint32_t id)
 {
-    uint32_t keep[COV_WORDS] = {0};
-    keep_ctx k = {keep, world, y, x0, x1};
-    int any = 0;
-    for (uint32_t i = 0; i < S->nobjs; i++) {
-        const dr_obj *o = &S->objs[i];
-        if (o->active && o->nfaces && o->y0 <= y && o->y1 > y && o->x0 < x1 && o->x1 > x0) {
-            each_face(S, o, keep_face, &k);
-            any = 1;
-        }
+    row_ctx k = {world, y, x0, x1};
+    for (uint32_t i = 0; i < S->nactive; i++) {
+        dr_obj *o = &S->objs[S->active[i]];
+        if (o->y0 <= y && o->y1 > y && o->x0 < x1 && o->x1 > x0) each_face(S, o, draw_face_over_world, &k);
     }
-    if (any) cov_claim(&S->cov, y, keep, S->claim);
     return cov_fill(&S->cov, S->t, y, x0, x1, 0, colour, id);
 }
+
 
 static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id, uint32_t seg)
 {
@@ -385,78 +501,50 @@ static int visit_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
     return cov_full(&S->cov);
 }
 
-/* ---- objects after the walk ------------------------------------------------------------- */
-
-typedef struct {
-    const dr_face *self; /* the face being drawn (a copy: the scratch face may be rebuilt) */
-    uint32_t *keep;
-    int y, x0, x1;
-} near_ctx;
-
-/* Mark where another face g is in front of the face being drawn. */
-static void keep_nearer_face(dr_state *S, const dr_obj *o, const dr_face *g, const dr_edge *edges, void *ctx)
-{
-    (void)o;
-    near_ctx *k = ctx;
-    if (g->obj == k->self->obj && g->model_face == k->self->model_face) return;
-    int a, b;
-    if (!face_row(g, edges, k->y, &a, &b)) return;
-    if (a < k->x0) a = k->x0;
-    if (b > k->x1) b = k->x1;
-    if (a >= b) return;
-    mark_in_front(k->keep, &g->pl, 1 + (int)g->obj, &k->self->pl, 1 + (int)k->self->obj, VIEW_LOOK(S->v), k->y, a, b);
-}
-
-/* Fill face f's rows where it is free and no other active face is nearer. The
- * face is copied first: looking at the other faces may rebuild the scratch face.
- * ctx: the object's pixel count. */
-static void draw_face(dr_state *S, const dr_obj *o, const dr_face *f, const dr_edge *edges, void *ctx)
-{
-    dr_face face = *f;
-    dr_edge own[FACE_EDGES];
-    for (int i = 0; i < f->nedges; i++) own[i] = edges[i];
-    uint32_t id = RAST_ID(RAST_KIND_OBJECT, o->index);
-    for (int y = face.top; y < face.bottom; y++) {
-        int a, b;
-        if (!face_row(&face, own, y, &a, &b) || cov_row_full(&S->cov, y)) continue;
-        uint32_t keep[COV_WORDS] = {0};
-        near_ctx k = {&face, keep, y, a, b};
-        for (uint32_t i = 0; i < S->nobjs; i++) {
-            const dr_obj *p = &S->objs[i];
-            if (p->active && p->nfaces && p->y0 <= y && p->y1 > y && p->x0 < b && p->x1 > a)
-                each_face(S, p, keep_nearer_face, &k);
-        }
-        *(uint32_t *)ctx += cov_fill(&S->cov, S->t, y, a, b, keep, face.colour, id);
-    }
-    S->st->object_faces++;
-}
-
-/* Every active object's faces, after the claimed pixels are handed back. An
- * object counts as visible when it wrote a pixel. */
-static void draw_objects(dr_state *S)
-{
-    cov_release(&S->cov, S->claim);
-    for (uint32_t i = 0; i < S->nobjs; i++) {
-        const dr_obj *o = &S->objs[i];
-        uint32_t pixels = 0;
-        if (o->active && o->nfaces) each_face(S, o, draw_face, &pixels);
-        if (pixels) S->st->objects_visible++;
-    }
-}
-
 /* ---- the frame ---------------------------------------------------------------------- */
 
+/* Heap order on the west edges (in place: no memory beyond the list). */
+static void sift_down(dr_obj *a, uint32_t i, uint32_t n)
+{
+    for (;;) {
+        uint32_t c = 2 * i + 1;
+        if (c >= n) return;
+        if (c + 1 < n && a[c + 1].left > a[c].left) c++;
+        if (a[c].left <= a[i].left) return;
+        dr_obj t = a[i];
+        a[i] = a[c];
+        a[c] = t;
+        i = c;
+    }
+}
+
+static void sort_by_west_edge(dr_obj *a, uint32_t n)
+{
+    for (uint32_t i = n / 2; i-- > 0;) sift_down(a, i, n);
+    for (uint32_t end = n; end-- > 1;) {
+        dr_obj t = a[0];
+        a[0] = a[end];
+        a[end] = t;
+        sift_down(a, 0, end);
+    }
+}
+
+/* The objects in the view frustum, sorted by the west edges of their boxes. */
 static void list_objects_in_view(dr_state *S)
 {
     const scene *sc = S->sc;
     const world_state *w = S->w;
     S->nobjs = S->nactive = S->nfaces = S->nedges = 0;
+    S->reach = 0;
     if (!CFG_OBJECTS || !w || !w->objs) return;
     for (uint32_t i = 0; i < w->n; i++) {
         const obj_state *o = &w->objs[i];
         if (o->model >= sc->nmodels || !objd_in_view(sc, o, S->v)) continue;
-        S->objs[S->nobjs++] = (dr_obj){.index = (uint16_t)i};
+        int32_t r = (sc->models[o->model].radius >> 16) + 1; /* whole units, rounded up */
+        if (r > S->reach) S->reach = r;
+        S->objs[S->nobjs++] = (dr_obj){.left = (int32_t)((o->x >> 16) - r), .index = (uint16_t)i};
     }
+    sort_by_west_edge(S->objs, S->nobjs);
 }
 
 void direct_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t,
@@ -474,11 +562,11 @@ void direct_render(const scene *sc, const world_state *w, const view_xform *v, c
     uint32_t n = object_count(w);
     S->objs = (dr_obj *)(void *)mem;
     mem += n ? align8((uint64_t)n * sizeof(dr_obj)) : 0;
+    S->active = (uint16_t *)(void *)mem;
+    mem += n ? align8((uint64_t)n * sizeof(uint16_t)) : 0;
     S->faces = (dr_face *)(void *)mem;
     mem += n ? align8((uint64_t)DIRECT_FACE_POOL * sizeof(dr_face)) : 0;
     S->edges = (dr_edge *)(void *)mem;
-    mem += n ? align8((uint64_t)DIRECT_EDGE_POOL * sizeof(dr_edge)) : 0;
-    S->claim = (uint32_t(*)[COV_WORDS])(void *)mem;
     S->sc = sc;
     S->w = w;
     S->v = v;
@@ -491,9 +579,6 @@ void direct_render(const scene *sc, const world_state *w, const view_xform *v, c
     occ_reset(&S->occ);
     list_objects_in_view(S);
     st->object_pass = S->nobjs != 0;
-    if (S->nobjs)
-        for (int y = 0; y < VIEW_H; y++)
-            for (int k = 0; k < COV_WORDS; k++) S->claim[y][k] = 0;
     /* solid walls close columns only for an eye inside the world (spans.c says why) */
     S->use_occ = eye_in_world(sc, w, v);
     walk_stats ws;

@@ -194,21 +194,26 @@ int objd_locate(const scene *s, const obj_state *o, const uint32_t *leaf_key, ui
 /* Its bounding box first, then each edge of the leaf as a separating line.
  * Offsets are shifted (edges by 1, corners by 3) so the cross products stay
  * below 2^61 (offsets below 2^32.03 raw, as in objd_locate). */
-int objd_touches_leaf(const scene *sc, const obj_state *o, const scn_leaf *f)
+void objd_leaf_box(const scene *sc, const scn_leaf *f, int32_t box[4])
+{
+    const scn_vertex *p = &sc->pverts[f->first_pvert];
+    box[0] = box[1] = INT32_MAX;
+    box[2] = box[3] = INT32_MIN;
+    for (uint32_t i = 0; i < f->num_pverts; i++) {
+        if (p[i].x < box[0]) box[0] = p[i].x;
+        if (p[i].y < box[1]) box[1] = p[i].y;
+        if (p[i].x > box[2]) box[2] = p[i].x;
+        if (p[i].y > box[3]) box[3] = p[i].y;
+    }
+}
+
+int objd_touches_leaf(const scene *sc, const obj_state *o, const scn_leaf *f, const int32_t box[4])
 {
     int64_t r = sc->models[o->model].radius;
     int64_t bx0 = (int64_t)o->x - r, by0 = (int64_t)o->y - r, bx1 = (int64_t)o->x + r, by1 = (int64_t)o->y + r;
     const scn_vertex *p = &sc->pverts[f->first_pvert];
     uint32_t n = f->num_pverts;
-    if (n < 3) return 0;
-    int64_t x0 = INT64_MAX, x1 = INT64_MIN, y0 = INT64_MAX, y1 = INT64_MIN;
-    for (uint32_t i = 0; i < n; i++) {
-        if (p[i].x < x0) x0 = p[i].x;
-        if (p[i].x > x1) x1 = p[i].x;
-        if (p[i].y < y0) y0 = p[i].y;
-        if (p[i].y > y1) y1 = p[i].y;
-    }
-    if (x0 > bx1 || x1 < bx0 || y0 > by1 || y1 < by0) return 0;
+    if (n < 3 || box[0] > bx1 || box[2] < bx0 || box[1] > by1 || box[3] < by0) return 0;
     for (uint32_t i = 0; i < n; i++) {
         const scn_vertex *a = &p[i], *b = &p[i + 1 == n ? 0 : i + 1];
         int64_t dx = fx_asr64((int64_t)b->x - a->x, 1), dy = fx_asr64((int64_t)b->y - a->y, 1);

@@ -80,11 +80,14 @@ int objd_front(const objd_plane *s, int s_obj, const objd_plane *p, int p_obj, i
  * the object, so world surfaces beyond kmin are all sorted by 1/z. */
 int objd_locate(const scene *s, const obj_state *o, const uint32_t *leaf_key, uint32_t *kmin, uint32_t *kmax);
 
+/* The bounding box of the leaf's floor polygon: xmin, ymin, xmax, ymax. */
+void objd_leaf_box(const scene *s, const scn_leaf *f, int32_t box[4]);
+
 /* Does the object's box (origin +- its model's radius) reach into the leaf's
- * convex floor polygon? A box within the rounding of an edge counts as
- * touching: the renderers that ask (direct, painter) only take an object in a
- * leaf early by it. */
-int objd_touches_leaf(const scene *s, const obj_state *o, const scn_leaf *f);
+ * convex floor polygon (box: objd_leaf_box's)? A box within the rounding of an
+ * edge counts as touching: the renderers that ask (direct, painter) only take
+ * an object in a leaf early by it. */
+int objd_touches_leaf(const scene *s, const obj_state *o, const scn_leaf *f, const int32_t box[4]);
 
 /* 0 if the object's bounding cylinder is wholly outside the near, left or right plane. */
 int objd_in_view(const scene *s, const obj_state *o, const view_xform *v);

@@ -62,10 +62,13 @@ static int place_objects(void *ctx, uint32_t leaf, unsigned clip_mask)
 {
     painter *p = ctx;
     (void)clip_mask;
+    const scn_leaf *f = &p->sc->leaves[leaf];
+    int32_t box[4];
+    objd_leaf_box(p->sc, f, box);
     p->visits++;
     for (uint32_t k = 0; k < p->nobjs && p->unplaced; k++) {
         pt_order *o = &p->objs[k];
-        if (o->key || !objd_touches_leaf(p->sc, &p->w->objs[o->index], &p->sc->leaves[leaf])) continue;
+        if (o->key || !objd_touches_leaf(p->sc, &p->w->objs[o->index], f, box)) continue;
         o->key = p->visits;
         o->leaf = leaf;
         p->unplaced--;
