@@ -61,6 +61,9 @@ $(1)/display: $(call objs,$(1)/obj,host/display.c host/png.c firmware/crc32.c $(
 # test_planar brings its own fake VGA target (hal_target_*): only fb.c and perf.c beside it
 $(1)/test_planar: $(call objs,$(1)/obj,tests/unit/test_planar.c $(HAL_SRC))
 	$$(CC) $(2) $$^ -o $$@ -lcmocka
+# test_copybuf too (a linear target with no system-memory buffer of its own)
+$(1)/test_copybuf: $(call objs,$(1)/obj,tests/unit/test_copybuf.c $(HAL_SRC))
+	$$(CC) $(2) $$^ -o $$@ -lcmocka
 $(1)/test_%: $(call objs,$(1)/obj,tests/unit/test_%.c) $(call objs,$(1)/obj,$(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC) $(sort $(LINK_SRC) $(UNIT_EXTRA)))
 	$$(CC) $(2) $$^ -o $$@ -lcmocka -lm
 endef
