@@ -21,7 +21,8 @@
 #          does not fit is refused with one line giving the RAM it needs. Up to 4 MB
 #          the RAM is SSRAM2/3 at 0x20000000, beyond that (benches of big work
 #          areas) PSRAM at 0x21000000, up to 16 MB.
-#          STACK_BYTES (default 8192): the stack (the firmware reports its high-water mark).
+#          STACK_BYTES (default 8192, with FULL=1 12288): the stack (the firmware
+#          reports its high-water mark).
 #   make run-firmware [UART=FILE|stdio] [RUN_ARGS="--frames 10 ..."]
 #       runs it in qemu-system-arm; the UART (the frame stream) goes to
 #       build/arm/uart.bin (or stdout with UART=stdio), the firmware's messages
@@ -44,7 +45,10 @@ RUN_ARGS ?=
 FULL     ?=
 FW_MODES ?= direct
 RAM_BYTES ?= 200000
-STACK_BYTES ?= 8192
+# The stack: the walks keep a stack of the tree's depth (CFG_MAX_DEPTH: the scene's
+# in a build for it, 255 in a FULL=1 build). Measured high-water marks (hal/mps2/README.md):
+# at most 4,016 bytes on the Freedoom maps built for the scene, 6,776 with FULL=1.
+STACK_BYTES ?= $(if $(FULL),12288,8192)
 # SSRAM2/3 is 4 MB (mirrored above it); more RAM than that is PSRAM's 16 MB.
 MPS2_SSRAM_BYTES := 4194304
 MPS2_RAM_ORIGIN := $(shell [ '$(RAM_BYTES)' -gt $(MPS2_SSRAM_BYTES) ] 2>/dev/null && echo 0x21000000 || echo 0x20000000)
@@ -161,14 +165,14 @@ $(ARM_OUT)/fw_scene.o: $(ARM_OUT)/gen/fw_scene.c
 
 # The link. When the image does not fit in RAM_BYTES, it is linked once more
 # with room to spare, only to read how much RAM it needs (mps2.ld's __ram_need
-# and the parts of it), and the build is refused with that figure.
+# and the parts of it), and the build is refused with that figure (and no image).
 $(ARM_OUT)/firmware.elf: $(ARM_OBJS) hal/mps2/mps2.ld $(ARM_OUT)/config
 	@if ! $(ARMCC) $(ARM_CFLAGS) $(call mps2_ld,$(MPS2_RAM_ORIGIN),$(RAM_BYTES)) -Wl,-Map=$(ARM_OUT)/firmware.map \
 	    $(ARM_OBJS) -lgcc -o $@.tmp 2> $@.err; then \
 	  if $(ARMCC) $(ARM_CFLAGS) $(call mps2_ld,0x20000000,0x40000000) $(ARM_OBJS) -lgcc -o $@.fit 2>/dev/null; then \
 	    $(ARMNM) $@.fit | awk -v scene='$(SCENE)' -v have=$(RAM_BYTES) -f tools/ram_need.awk; \
-	    rm -f $@.fit $@.err $@.tmp; exit 1; \
-	  fi; cat $@.err; rm -f $@.err $@.tmp; exit 1; \
+	    rm -f $@ $@.fit $@.err $@.tmp; exit 1; \
+	  fi; cat $@.err; rm -f $@ $@.err $@.tmp; exit 1; \
 	fi; cat $@.err; rm -f $@.err
 	@helpers=$$($(ARMNM) $@.tmp | awk '{print $$NF}' | grep -E $(ARM_FLOAT_HELPERS)); \
 	if [ -n "$$helpers" ]; then echo "mps2: the firmware links floating-point helpers (it must be integer-only):"; \

@@ -288,6 +288,7 @@ def test_build_that_does_not_fit_is_refused():
     assert status == 0, log
     proc = make("firmware", f"ARM_OUT={out}", "STREAM=raw", f"RAM_BYTES={need - 8}", ok=False)
     assert proc.returncode != 0 and f"needs {need:,} bytes of RAM" in proc.stdout + proc.stderr
+    assert not elf.exists()  # the image that fitted before is gone
 
 
 def test_map12_fits_in_200000_bytes_and_matches_the_host_renderer(tmp_path):
