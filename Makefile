@@ -61,6 +61,9 @@ $(1)/display: $(call objs,$(1)/obj,host/display.c host/png.c firmware/crc32.c $(
 # test_planar brings its own fake VGA target (hal_target_*): only fb.c and perf.c beside it
 $(1)/test_planar: $(call objs,$(1)/obj,tests/unit/test_planar.c $(HAL_SRC))
 	$$(CC) $(2) $$^ -o $$@ -lcmocka
+# test_copybuf too (a linear target with no system-memory buffer of its own)
+$(1)/test_copybuf: $(call objs,$(1)/obj,tests/unit/test_copybuf.c $(HAL_SRC))
+	$$(CC) $(2) $$^ -o $$@ -lcmocka
 $(1)/test_%: $(call objs,$(1)/obj,tests/unit/test_%.c) $(call objs,$(1)/obj,$(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC) $(sort $(LINK_SRC) $(UNIT_EXTRA)))
 	$$(CC) $(2) $$^ -o $$@ -lcmocka -lm
 endef
@@ -107,15 +110,16 @@ help:
 	@echo "make bench      instructions per frame (callgrind), overdraw, VRAM writes, bus cycles on 20 views;"
 	@echo "                Cortex-M3 instructions per frame (bench-m3); link faults (bench-faults);"
 	@echo "                the PC kernel's write counters per present mode (bench-pcvga);"
-	@echo "                firmware flash and RAM, full against built for one scene (bench-size)"
+	@echo "                firmware flash and RAM of four scenes against the board's 200,000 bytes (bench-size)"
 	@echo "make scene-host SCENE=...  build/scene/NAME/render, emu built for one scene (docs/needs.md)"
 	@echo "make fuzz       each libFuzzer harness (tests/fuzz) for FUZZ_TIME seconds (default 60), FUZZ=names;"
 	@echo "                make fuzz-smoke (part of make test): seeds and kept crashes once, 3 s each"
 	@echo "make bench-link the frame link's bytes per frame and encoder cost"
 	@echo "make firmware   build/arm/firmware.elf for QEMU mps2-an385, built for its scene (SCENE=, FULL=1,"
-	@echo "                CAMPATH=); make run-firmware"
+	@echo "                CAMPATH=, FW_MODES=direct,...); all its RAM within RAM_BYTES=200000 or refused;"
+	@echo "                make run-firmware"
 	@echo "make pcvga      build/pcvga/kernel.elf: the bare PC kernel (multiboot, VGA mode 13h) for"
-	@echo "                qemu-system-i386 (SCENE=, FULL=1, CAMPATH=); make run-pcvga [RUN_ARGS=...];"
+	@echo "                qemu-system-i386 (SCENE=, FULL=1, CAMPATH=, PC_MODES=); make run-pcvga [RUN_ARGS=...];"
 	@echo "                make bench-pcvga (write counters per present mode)"
 	@echo "make flash      IMAGE=x.dfu DEVICE=VID:PID (or LOOPBACK=1): USB DFU download"
 	@echo "make bench-bsp  bspc over all 68 Freedoom maps per strategy, beside zdbsp and glbsp"

@@ -18,13 +18,44 @@ static uint32_t align8(uint64_t n)
     return (uint32_t)((n + 7u) & ~(uint64_t)7u);
 }
 
+static uint32_t door_count(const scene *s)
+{
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < s->nsectors; i++) n += (s->sectors[i].flags & SCN_SECTOR_DOOR) != 0;
+    return n;
+}
+
+static uint32_t bit_words(uint32_t bits)
+{
+    return bits / 32u + (bits % 32u != 0);
+}
+
+/* Bytes of each part of the state, in the order obj_init lays them out. */
+static uint32_t objs_bytes(const scene *s)
+{
+    return CFG_OBJECTS ? align8((uint64_t)s->nobjects * sizeof(obj_state)) : 0;
+}
+
+static uint32_t ceil_bytes(const scene *s)
+{
+    return CFG_DOORS ? align8((uint64_t)s->nsectors * sizeof(fx_t)) : 0;
+}
+
+static uint32_t doors_bytes(const scene *s)
+{
+    return CFG_DOORS ? align8((uint64_t)door_count(s) * sizeof(obj_door)) : 0;
+}
+
+static uint32_t near_bytes(const scene *s)
+{
+    return CFG_DOORS ? align8((uint64_t)bit_words(s->nsectors) * sizeof(uint32_t)) : 0;
+}
+
 uint32_t obj_state_bytes(const scene *s)
 {
     /* at most 4096 objects and far fewer sectors than 2^26: no overflow. A build
      * without objects or without doors keeps no state for them. */
-    return (CFG_OBJECTS ? align8((uint64_t)s->nobjects * sizeof(obj_state)) : 0) +
-           (CFG_DOORS ? align8((uint64_t)s->nsectors * sizeof(fx_t)) + align8((uint64_t)s->nsectors * sizeof(obj_door))
-                      : 0);
+    return objs_bytes(s) + ceil_bytes(s) + doors_bytes(s) + near_bytes(s);
 }
 
 static int64_t floor_div(int64_t a, int64_t b)
@@ -74,21 +105,23 @@ int obj_init(world_state *w, const scene *s, void *mem, uint32_t bytes)
 {
     if (!mem || bytes < obj_state_bytes(s)) return -1;
     uint8_t *p = mem;
-    *w = (world_state){0, 0, 0, 0};
+    *w = (world_state){0};
     if (CFG_OBJECTS) {
         w->objs = (obj_state *)(void *)p;
-        p += align8((uint64_t)s->nobjects * sizeof(obj_state));
+        p += objs_bytes(s);
         w->n = s->nobjects;
         for (uint32_t i = 0; i < s->nobjects; i++) place(&w->objs[i], &s->objects[i], 0);
     }
     if (CFG_DOORS) {
         w->ceil = (fx_t *)(void *)p;
-        p += align8((uint64_t)s->nsectors * sizeof(fx_t));
+        p += ceil_bytes(s);
         w->doors = (obj_door *)(void *)p;
-        for (uint32_t i = 0; i < s->nsectors; i++) {
-            w->ceil[i] = s->sectors[i].ceil_h;
-            w->doors[i] = (obj_door){0, 0, 0};
-        }
+        p += doors_bytes(s);
+        w->near = (uint32_t *)(void *)p;
+        w->ndoors = door_count(s);
+        for (uint32_t i = 0; i < s->nsectors; i++) w->ceil[i] = s->sectors[i].ceil_h;
+        for (uint32_t k = 0; k < w->ndoors; k++) w->doors[k] = (obj_door){0, 0, 0, 0};
+        for (uint32_t k = 0; k < bit_words(s->nsectors); k++) w->near[k] = 0;
     }
     return 0;
 }
@@ -140,7 +173,7 @@ static void door_step(obj_door *d, uint32_t full, int triggered, uint32_t dt)
             d->travel_ms += step;
         } else if (d->opening && d->wait_ms > 0) {
             step = d->wait_ms < dt ? d->wait_ms : dt;
-            d->wait_ms -= step;
+            d->wait_ms = (uint16_t)(d->wait_ms - step);
         } else if (d->travel_ms > 0) {
             d->opening = 0;
             step = d->travel_ms < dt ? d->travel_ms : dt;
@@ -159,32 +192,28 @@ void obj_update(world_state *w, const scene *s, uint32_t t_ms, uint32_t dt_ms, f
     uint32_t n = w->n < s->nobjects ? w->n : s->nobjects;
     if (CFG_OBJECTS && w->objs)
         for (uint32_t i = 0; i < n; i++) place(&w->objs[i], &s->objects[i], t_ms);
-    if (!CFG_DOORS || !w->ceil || !w->doors) return;
+    if (!CFG_DOORS || !w->ceil || !w->doors || !w->near || w->ndoors == 0) return;
     /* which doors the player triggers: its sector, and every wall of a door within reach */
+    uint32_t *near = w->near;
+    for (uint32_t k = 0; k < bit_words(s->nsectors); k++) near[k] = 0;
     uint32_t under = scene_sector_at(s, px, py);
     int64_t gx = fx_asr64(px, GRID_SHIFT), gy = fx_asr64(py, GRID_SHIFT);
-    int any = 0;
-    for (uint32_t i = 0; i < s->nsectors; i++) {
-        w->doors[i].opening &= 1u; /* bit 1 below marks "triggered this call" */
-        any |= (s->sectors[i].flags & SCN_SECTOR_DOOR) != 0;
-    }
-    if (!any) return;
-    if (under != SCN_NONE) w->doors[under].opening |= 2u;
+    if (under != SCN_NONE) near[under / 32u] |= 1u << (under % 32u);
     for (uint32_t i = 0; i < s->nlines; i++) {
         const scn_line *ln = &s->lines[i];
         for (int k = 0; k < 2; k++) {
             uint32_t sec = ln->sector[k];
-            if (sec == SCN_NONE || !(s->sectors[sec].flags & SCN_SECTOR_DOOR) || (w->doors[sec].opening & 2u))
+            if (sec == SCN_NONE || !(s->sectors[sec].flags & SCN_SECTOR_DOOR) || (near[sec / 32u] >> (sec % 32u) & 1u))
                 continue;
-            if (near_wall(s, ln, gx, gy)) w->doors[sec].opening |= 2u;
+            if (near_wall(s, ln, gx, gy)) near[sec / 32u] |= 1u << (sec % 32u);
         }
     }
+    obj_door *d = w->doors; /* the door sectors' motion, in sector order */
     for (uint32_t i = 0; i < s->nsectors; i++) {
         const scn_sector *sec = &s->sectors[i];
         if (!(sec->flags & SCN_SECTOR_DOOR)) continue;
-        obj_door *d = &w->doors[i];
-        int triggered = (d->opening & 2u) != 0;
-        d->opening &= 1u;
+        if (d == w->doors + w->ndoors) break; /* a state made for another scene */
+        int triggered = (near[i / 32u] >> (i % 32u)) & 1u;
         uint32_t full = door_travel_ms(sec);
         if (d->travel_ms > full) d->travel_ms = full;
         door_step(d, full, triggered, dt_ms);
@@ -192,5 +221,6 @@ void obj_update(world_state *w, const scene *s, uint32_t t_ms, uint32_t dt_ms, f
         int64_t rise = (int64_t)d->travel_ms * DOOR_RAW_PER_S / 1000;
         int64_t range = (int64_t)sec->open_h - sec->ceil_h;
         w->ceil[i] = (fx_t)(sec->ceil_h + (rise < range ? rise : range));
+        d++;
     }
 }

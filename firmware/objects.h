@@ -21,22 +21,29 @@ typedef struct {
 } obj_state;
 
 /* A door's motion, kept as times so that the ceiling depends on the sum of the
- * frame times only, not on how they were split into frames. */
+ * frame times only, not on how they were split into frames. 8 bytes: a scene
+ * keeps one per door sector. */
 typedef struct {
-    uint32_t travel_ms; /* time spent rising from closed, 0 .. the door's full travel */
-    uint32_t wait_ms;   /* time it will still stay fully open */
-    uint32_t opening;   /* 1 rising or open, 0 closing or closed */
+    uint32_t travel_ms; /* time spent rising from closed, 0 .. the door's full travel (< 2^18) */
+    uint16_t wait_ms;   /* time it will still stay fully open, 0 .. OBJ_DOOR_WAIT_MS */
+    uint8_t opening;    /* 1 rising or open, 0 closing or closed */
+    uint8_t unused;
 } obj_door;
+
+_Static_assert(OBJ_DOOR_WAIT_MS <= 0xFFFFu, "obj_door.wait_ms");
 
 typedef struct {
     obj_state *objs;   /* n objects, drawn with ids RAST_ID(RAST_KIND_OBJECT, i) */
     uint32_t n;
     fx_t *ceil;        /* current ceiling of every sector (nsectors entries), or NULL: as compiled */
-    obj_door *doors;   /* motion of every sector's door (nsectors entries; unused for non-doors),
+    obj_door *doors;   /* motion of each door sector, in sector order (ndoors entries),
                         * or NULL: obj_update leaves the ceilings alone */
+    uint32_t *near;    /* obj_update's scratch: one bit per sector, "triggered now" */
+    uint32_t ndoors;
 } world_state;
 
-/* Bytes of RAM the state of a scene needs (objects, ceilings, doors); a multiple of 8. */
+/* Bytes of RAM the state of a scene needs (objects, every sector's ceiling, the
+ * door sectors' motion, a bit per sector); a multiple of 8. */
 uint32_t obj_state_bytes(const scene *s);
 
 /* Point w at mem (obj_state_bytes(s) bytes, 4-byte aligned) and set every object

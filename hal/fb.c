@@ -54,6 +54,18 @@ static int shown_index(void)
     return hal_target_display_start() ? 1 : 0;
 }
 
+/* Where the copy modes draw: the target's own system-memory buffer, or, on a
+ * target that keeps none (hal/mps2, whose RAM holds the two pages and little
+ * more), the page the display does not show. That page is free in the copy
+ * modes: the present copies into the shown one and never moves the display
+ * start. Its writes still count as system-memory writes, so the counters of a
+ * frame do not depend on where the buffer lives. */
+static uint8_t *copy_buffer(void)
+{
+    uint8_t *own = hal_target_sysmem();
+    return own ? own : hal_target_vram(1 - shown_index());
+}
+
 hal_surface hal_begin_frame(hal_present_mode m)
 {
     hal_surface s = { NULL, 0, 0 };
@@ -62,7 +74,7 @@ hal_surface hal_begin_frame(hal_present_mode m)
         s.in_vram = 1;
         s.planar = hal_target_vram_planar() ? 1 : 0;
     } else if (m == HAL_PRESENT_COPY8 || m == HAL_PRESENT_COPY16 || m == HAL_PRESENT_COPY32) {
-        s.pixels = hal_target_sysmem();
+        s.pixels = copy_buffer();
         s.in_vram = 0;
     }
     return s; /* unknown mode: pixels NULL, hal_fill_span ignores it */
@@ -213,7 +225,7 @@ void hal_present(hal_present_mode m)
         return;
     }
     shown = hal_target_vram(shown_index());
-    src = hal_target_sysmem();
+    src = copy_buffer();
     if (shown == NULL || src == NULL)
         return;
     if (m == HAL_PRESENT_COPY8)

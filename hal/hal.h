@@ -131,7 +131,10 @@ void hal_frame_done(void);    /* the engine finished a frame: show it, stream it
 
 /* ---- what each target provides to the shared code ------------------------ */
 uint8_t *hal_target_vram(int page);        /* page 0 or 1, HAL_PAGE_BYTES each */
-uint8_t *hal_target_sysmem(void);          /* the system-memory back buffer */
+/* The system-memory back buffer of the copy modes, or NULL: the target keeps
+ * none, and the copy modes draw into the VRAM page the display does not show
+ * (which needs two distinct linear pages). */
+uint8_t *hal_target_sysmem(void);
 uint8_t *hal_target_palette(void);         /* HAL_PALETTE_BYTES */
 void hal_target_set_display_start(int page);
 int hal_target_display_start(void);

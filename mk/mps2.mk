@@ -2,15 +2,27 @@
 # instruction-counting QEMU plugin (tools/qemu_plugin), and how to run them.
 #
 #   make firmware [SCENE=...] [FULL=1] [CAMPATH=default|map01] [WORK_BYTES=N] [STREAM=framelink|raw] [ARM_OUT=DIR]
+#                 [FW_MODES=direct|LIST] [RAM_BYTES=N] [STACK_BYTES=N]
 #       -> $(ARM_OUT)/firmware.elf (default build/arm/firmware.elf): the scene
 #          (text scene, WAD map "file.wad:MAP01" or a compiled .bsc, default
-#          tests/scenes/default.scene) compiled by build/bspc and built in, the
-#          work area sized from it by build/render (or WORK_BYTES), and a camera
-#          path (default: map01 for a MAP01 scene, else default).
+#          tests/scenes/default.scene) compiled by build/bspc and built in (in
+#          flash, read in place), the work area sized from it by the firmware
+#          itself (or WORK_BYTES), and a camera path (default: map01 for a MAP01
+#          scene, else default).
 #          The renderer is built for that scene (docs/needs.md): only the
 #          features it needs, fixed buffers sized to its proven bounds
 #          ($(ARM_OUT)/scene_config.h, written by bspc --config). FULL=1 builds
 #          every feature in, as for any scene.
+#          FW_MODES: the render modes compiled in, separated by commas (mk/modes.mk;
+#          default direct, the mode whose work area the screen bounds; FULL=1 does
+#          not change it: e.g. FW_MODES=direct,spans,painter RAM_BYTES=16777216).
+#          RAM_BYTES (default 200,000): all of the firmware's RAM - stack, both VRAM
+#          pages, palette, .data, .bss, work area (hal/mps2/mps2.ld). A build that
+#          does not fit is refused with one line giving the RAM it needs. Up to 4 MB
+#          the RAM is SSRAM2/3 at 0x20000000, beyond that (benches of big work
+#          areas) PSRAM at 0x21000000, up to 16 MB.
+#          STACK_BYTES (default 8192, with FULL=1 12288): the stack (the firmware
+#          reports its high-water mark).
 #   make run-firmware [UART=FILE|stdio] [RUN_ARGS="--frames 10 ..."]
 #       runs it in qemu-system-arm; the UART (the frame stream) goes to
 #       build/arm/uart.bin (or stdout with UART=stdio), the firmware's messages
@@ -30,6 +42,22 @@ WORK_BYTES ?=
 QEMU_ARM ?= qemu-system-arm
 UART     ?= $(ARM_OUT)/uart.bin
 RUN_ARGS ?=
+FULL     ?=
+FW_MODES ?= direct
+RAM_BYTES ?= 200000
+# The stack: the walks keep a stack of the tree's depth (CFG_MAX_DEPTH: the scene's
+# in a build for it, 255 in a FULL=1 build). Measured high-water marks (hal/mps2/README.md):
+# at most 4,016 bytes on the Freedoom maps built for the scene, 6,776 with FULL=1.
+STACK_BYTES ?= $(if $(FULL),12288,8192)
+# SSRAM2/3 is 4 MB (mirrored above it); more RAM than that is PSRAM's 16 MB.
+MPS2_SSRAM_BYTES := 4194304
+MPS2_RAM_ORIGIN := $(shell [ '$(RAM_BYTES)' -gt $(MPS2_SSRAM_BYTES) ] 2>/dev/null && echo 0x21000000 || echo 0x20000000)
+ifneq ($(shell [ '$(RAM_BYTES)' -ge 1 ] 2>/dev/null && [ '$(RAM_BYTES)' -le 16777216 ] 2>/dev/null && echo ok),ok)
+$(error mk/mps2.mk: RAM_BYTES=$(RAM_BYTES): a number of bytes, at most 16,777,216)
+endif
+# The link: mps2.ld with the RAM's place and size and the stack's size.
+mps2_ld = -T hal/mps2/mps2.ld -Wl,--gc-sections -Wl,--defsym=MPS2_RAM_ORIGIN=$(1) -Wl,--defsym=MPS2_RAM_BYTES=$(2) \
+          -Wl,--defsym=MPS2_STACK_BYTES=$(STACK_BYTES)
 
 ARMNM    := arm-none-eabi-nm
 ARMSIZE  := arm-none-eabi-size
@@ -50,11 +78,11 @@ ARM_CFLAGS := -std=c11 -O2 -g -mcpu=cortex-m3 -mthumb -mfloat-abi=soft -ffreesta
               $(WARN) -Ifirmware -Ihal -Ihal/mps2 -Ihal/bare -Ihal/serial
 ARM_SRC  := $(FW_SRC) $(HAL_SRC) $(MPS2_SRC) $(MPS2_LINK_SRC)
 # Objects of a FULL=1 build do not depend on the scene: its ARM_OBJ may be
-# shared by several ARM_OUTs. A build for one scene compiles them for it.
-FULL     ?=
+# shared by several ARM_OUTs (with the same FW_MODES). A build for one scene
+# compiles them for it.
 ARM_OBJ  ?= $(ARM_OUT)/obj
-ARM_SCENE_DEF := $(if $(FULL),,-DSCENE_CONFIG='"$(abspath $(ARM_OUT)/scene_config.h)"')
-ARM_CONFIG_DEP := $(if $(FULL),,$(ARM_OUT)/scene_config.h)
+ARM_SCENE_DEF := $(if $(FULL),,-DSCENE_CONFIG='"$(abspath $(ARM_OUT)/scene_config.h)"') $(call render_modes_def,$(FW_MODES))
+ARM_CONFIG_DEP := $(if $(FULL),,$(ARM_OUT)/scene_config.h) $(ARM_OBJ)/modes
 ARM_OBJS := $(patsubst %.c,$(ARM_OBJ)/%.o,$(ARM_SRC)) $(ARM_OUT)/fw_scene.o
 # The soft-float helpers (as in tools/check_nofloat.sh) that may not be linked in.
 ARM_FLOAT_HELPERS := '^__aeabi_([fd]|[a-z]*2[fd]$$)|^__(add|sub|mul|div|neg|fix|fixuns|float|floatun|extend|trunc|cmp|eq|ne|lt|le|gt|ge|unord|pow|powi)[sdtx]f[0-9]?$$'
@@ -76,15 +104,21 @@ $(ARM_OBJ)/%.o: %.c $(GEN)/fx_tables.c $(ARM_CONFIG_DEP)
 	@mkdir -p $(@D)
 	$(ARMCC) $(ARM_CFLAGS) $(ARM_SCENE_DEF) -MMD -MP -c $< -o $@
 
+# The render modes the objects were compiled with; rewritten only when they change.
+$(ARM_OBJ)/modes: FORCE
+	@mkdir -p $(@D)
+	@echo '$(call render_modes_def,$(FW_MODES))' | cmp -s - $@ || echo '$(call render_modes_def,$(FW_MODES))' > $@
+
 # What the scene needs, as a C header (mk/scene.mk's recipe).
 $(ARM_OUT)/scene_config.h: $(ARM_OUT)/scene.bsc $(BUILD)/bspc
 	$(call scene_config_recipe,$<,$@,mps2)
 
-# What the built-in part depends on; rewritten only when it changes.
+# What the built-in part and the link depend on; rewritten only when it changes.
+ARM_CONFIG_LINE = SCENE=$(SCENE) CAMPATH=$(CAMPATH) WORK_BYTES=$(WORK_BYTES) STREAM=$(STREAM) FULL=$(FULL) \
+                  FW_MODES=$(FW_MODES) RAM_BYTES=$(RAM_BYTES) STACK_BYTES=$(STACK_BYTES)
 $(ARM_OUT)/config: FORCE
 	@mkdir -p $(@D)
-	@echo 'SCENE=$(SCENE) CAMPATH=$(CAMPATH) WORK_BYTES=$(WORK_BYTES) STREAM=$(STREAM) FULL=$(FULL)' | cmp -s - $@ || \
-	  echo 'SCENE=$(SCENE) CAMPATH=$(CAMPATH) WORK_BYTES=$(WORK_BYTES) STREAM=$(STREAM) FULL=$(FULL)' > $@
+	@echo '$(ARM_CONFIG_LINE)' | cmp -s - $@ || echo '$(ARM_CONFIG_LINE)' > $@
 
 $(ARM_OUT)/scene.bsc: $(ARM_OUT)/config $(BUILD)/bspc $(wildcard $(firstword $(subst :, ,$(SCENE))))
 	$(call scene_bsc_recipe,$@,mps2)
@@ -97,7 +131,7 @@ define fw_scene_c
 	{ $(BUILD)/bin2c fw_scene $< && \
 	  echo "const char fw_scene_name[] = \"$$name\";" && \
 	  echo "const char fw_campath_name[] = \"$(CAMPATH)\";" && \
-	  echo "/* the work area: $$n bytes at 0x21020000 in PSRAM (hal/mps2/mps2.ld) */" && \
+	  echo "/* the work area: $$n bytes in RAM (section .work, hal/mps2/mps2.ld) */" && \
 	  echo "_Alignas(8) uint8_t fw_work[$$n > 0 ? $$n : 1] __attribute__((section(\".work\")));" && \
 	  echo "const uint32_t fw_work_bytes = $${n}u;"; } > $(1).tmp && mv $(1).tmp $(1)
 endef
@@ -106,13 +140,14 @@ endef
 # layouts, this build's features), as the firmware itself works it out: a
 # sizing image with no work area is run once under QEMU and says how much it
 # needs. WORK_BYTES= overrides. A scene the firmware refuses gets none: the
-# firmware then refuses it at start with the loader's message.
+# firmware then refuses it at start with the loader's message. The sizing image
+# links with all of SSRAM2/3 as its RAM, so that it runs whatever RAM_BYTES is.
 $(ARM_OUT)/gen/fw_sizer.c: $(ARM_OUT)/scene.bsc $(BUILD)/bin2c
 	$(call fw_scene_c,$@,0)
 $(ARM_OUT)/fw_sizer.o: $(ARM_OUT)/gen/fw_sizer.c
 	$(ARMCC) $(ARM_CFLAGS) -c $< -o $@
 $(ARM_OUT)/sizer.elf: $(filter-out $(ARM_OUT)/fw_scene.o,$(ARM_OBJS)) $(ARM_OUT)/fw_sizer.o hal/mps2/mps2.ld
-	$(ARMCC) $(ARM_CFLAGS) -T hal/mps2/mps2.ld -Wl,--gc-sections $(filter %.o,$^) -lgcc -o $@
+	$(ARMCC) $(ARM_CFLAGS) $(call mps2_ld,0x20000000,$(MPS2_SSRAM_BYTES)) $(filter %.o,$^) -lgcc -o $@
 $(ARM_OUT)/work_bytes: $(ARM_OUT)/sizer.elf $(ARM_OUT)/config
 	@if [ -n '$(WORK_BYTES)' ]; then echo '$(WORK_BYTES)' > $@; \
 	elif n=$$(timeout 60 $(QEMU_ARM) -M mps2-an385 -nographic -monitor none -semihosting-config enable=on,target=native \
@@ -128,15 +163,24 @@ $(ARM_OUT)/fw_scene.o: $(ARM_OUT)/gen/fw_scene.c
 	@mkdir -p $(@D)
 	$(ARMCC) $(ARM_CFLAGS) -c $< -o $@
 
+# The link. When the image does not fit in RAM_BYTES, it is linked once more
+# with room to spare, only to read how much RAM it needs (mps2.ld's __ram_need
+# and the parts of it), and the build is refused with that figure (and no image).
 $(ARM_OUT)/firmware.elf: $(ARM_OBJS) hal/mps2/mps2.ld $(ARM_OUT)/config
-	$(ARMCC) $(ARM_CFLAGS) -T hal/mps2/mps2.ld -Wl,--gc-sections -Wl,-Map=$(ARM_OUT)/firmware.map \
-	  $(ARM_OBJS) -lgcc -o $@.tmp
+	@if ! $(ARMCC) $(ARM_CFLAGS) $(call mps2_ld,$(MPS2_RAM_ORIGIN),$(RAM_BYTES)) -Wl,-Map=$(ARM_OUT)/firmware.map \
+	    $(ARM_OBJS) -lgcc -o $@.tmp 2> $@.err; then \
+	  if $(ARMCC) $(ARM_CFLAGS) $(call mps2_ld,0x20000000,0x40000000) $(ARM_OBJS) -lgcc -o $@.fit 2>/dev/null; then \
+	    $(ARMNM) $@.fit | awk -v scene='$(SCENE)' -v have=$(RAM_BYTES) -f tools/ram_need.awk; \
+	    rm -f $@ $@.fit $@.err $@.tmp; exit 1; \
+	  fi; cat $@.err; rm -f $@ $@.err $@.tmp; exit 1; \
+	fi; cat $@.err; rm -f $@.err
 	@helpers=$$($(ARMNM) $@.tmp | awk '{print $$NF}' | grep -E $(ARM_FLOAT_HELPERS)); \
 	if [ -n "$$helpers" ]; then echo "mps2: the firmware links floating-point helpers (it must be integer-only):"; \
 	  echo "$$helpers" | sed 's/^/    /'; rm -f $@.tmp; exit 1; fi
 	@mv $@.tmp $@
 	@$(ARMSIZE) $@ | sed 's/^/mps2: /'
-	@echo "mps2: $@: scene $(SCENE), camera path $(CAMPATH), work area $$(cat $(ARM_OUT)/work_bytes) bytes, stream $(STREAM), $(if $(FULL),every feature,built for the scene)"
+	@$(ARMNM) $@ | awk -v have=$(RAM_BYTES) -v report=1 -f tools/ram_need.awk
+	@echo "mps2: $@: scene $(SCENE), camera path $(CAMPATH), work area $$(cat $(ARM_OUT)/work_bytes) bytes, render modes $(FW_MODES), stream $(STREAM), $(if $(FULL),every feature,built for the scene)"
 
 # ---- running it -----------------------------------------------------------------
 # -nographic would put the UART and QEMU's monitor together on stdio, where a

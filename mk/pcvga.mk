@@ -1,10 +1,12 @@
 # pcvga.mk - the renderer as a bare PC kernel on the VGA (hal/pcvga): a 32-bit
 # multiboot image that QEMU's qemu-system-i386 boots with -kernel.
 #
-#   make pcvga [SCENE=...] [FULL=1] [CAMPATH=default|map01] [PC_OUT=DIR]
+#   make pcvga [SCENE=...] [FULL=1] [CAMPATH=default|map01] [PC_OUT=DIR] [PC_MODES=LIST]
 #       -> $(PC_OUT)/kernel.elf (default build/pcvga/kernel.elf): the scene
 #          compiled by build/bspc and built in (as for make firmware), the
 #          renderer built for it (FULL=1: every feature), a camera path.
+#          PC_MODES: the render modes compiled in, separated by commas
+#          (mk/modes.mk; default every mode: the PC has memory to spare).
 #   make run-pcvga [RUN_ARGS="--present copy32 ..."] [PC_DISPLAY=sdl|gtk|none]
 #       runs it in qemu-system-i386 with a window where a display exists (else
 #       headless); COM1 (the kernel's log) on the terminal; QEMU's exit status is
@@ -22,6 +24,7 @@ PC_OBJ   ?= $(PC_OUT)/obj
 QEMU_PC  ?= qemu-system-i386
 PC_CC    ?= $(CC)
 PC_MEM   ?= 64
+PC_MODES ?= $(RENDER_MODES_ALL)
 
 PCVGA_SRC := $(sort $(wildcard hal/pcvga/*.c)) $(BARE_SRC)
 PCVGA_ASM := $(sort $(wildcard hal/pcvga/*.S))
@@ -30,8 +33,8 @@ PC_CFLAGS := -std=c11 -O2 -g -m32 -march=i686 -ffreestanding -nostdlib -fno-pic 
              -fno-tree-loop-distribute-patterns -ffunction-sections -fdata-sections \
              $(WARN) -Ifirmware -Ihal -Ihal/pcvga -Ihal/bare
 PC_SRC    := $(FW_SRC) $(HAL_SRC) $(PCVGA_SRC)
-PC_SCENE_DEF  := $(if $(FULL),,-DSCENE_CONFIG='"$(abspath $(PC_OUT)/scene_config.h)"')
-PC_CONFIG_DEP := $(if $(FULL),,$(PC_OUT)/scene_config.h)
+PC_SCENE_DEF  := $(if $(FULL),,-DSCENE_CONFIG='"$(abspath $(PC_OUT)/scene_config.h)"') $(call render_modes_def,$(PC_MODES))
+PC_CONFIG_DEP := $(if $(FULL),,$(PC_OUT)/scene_config.h) $(PC_OBJ)/modes
 PC_OBJS   := $(patsubst %.c,$(PC_OBJ)/%.o,$(PC_SRC)) $(patsubst %.S,$(PC_OBJ)/%.o,$(PCVGA_ASM)) $(PC_OUT)/fw_scene.o
 # libgcc's floating-point helpers for i386 (soft-float entry points and conversions).
 PC_FLOAT_HELPERS := '^__(add|sub|mul|div|neg|fix|fixuns|float|floatun|extend|trunc|cmp|eq|ne|lt|le|gt|ge|unord|pow|powi)[sdtx]f[0-9]?$$'
@@ -51,6 +54,11 @@ $(PC_OBJ)/%.o: %.c $(GEN)/fx_tables.c $(PC_CONFIG_DEP)
 $(PC_OBJ)/%.o: %.S
 	@mkdir -p $(@D)
 	$(PC_CC) -m32 -c $< -o $@
+
+# The render modes the objects were compiled with; rewritten only when they change.
+$(PC_OBJ)/modes: FORCE
+	@mkdir -p $(@D)
+	@echo '$(call render_modes_def,$(PC_MODES))' | cmp -s - $@ || echo '$(call render_modes_def,$(PC_MODES))' > $@
 
 $(PC_OUT)/config: FORCE
 	@mkdir -p $(@D)

@@ -2,11 +2,15 @@
 exits 0 through semihosting, streams frames the host renders bit for bit alike, refuses a
 damaged built-in scene or too small a work area with a message on the UART and a non-zero
 exit status, reports faults, and the instruction-counting plugin gives per-frame counts.
+The largest Freedoom map builds within the board's 200,000 bytes of RAM, with its scene left
+in flash, and renders what build/render renders; a build that does not fit is refused at
+build time with the RAM it needs.
 
 Builds go through make (mk/mps2.mk); variants go to their own ARM_OUT folders under build/.
 """
 import json
 import os
+import re
 import select
 import shutil
 import struct
@@ -20,7 +24,7 @@ from conftest import BUILD, ROOT
 from linkrig import Firmware
 
 sys.path.insert(0, str(ROOT / "tools"))
-from armelf import symbol  # noqa: E402
+from armelf import symbol, symbols  # noqa: E402
 from fxtext import fx_text  # noqa: E402
 
 QEMU = shutil.which("qemu-system-arm")
@@ -30,10 +34,11 @@ pytestmark = pytest.mark.skipif(QEMU is None, reason="qemu-system-arm missing: r
 EXIT_SCENE, EXIT_FAULT, EXIT_WORK = 2, 3, 4
 
 
-def make(*args):
+def make(*args, ok=True):
     proc = subprocess.run(["make", "-s", "-j2", "--no-print-directory", *args], cwd=ROOT, capture_output=True,
                           text=True, timeout=300)
-    assert proc.returncode == 0, proc.stdout + proc.stderr
+    if ok:
+        assert proc.returncode == 0, proc.stdout + proc.stderr
     return proc
 
 
@@ -237,3 +242,85 @@ def test_pty_started_paused_loses_nothing(raw_firmware, tmp_path):
     assert data.startswith(b"firmware: mps2-an385")
     frames, _ = raw_frames(data)
     assert len(frames) == 3 and all(zlib.crc32(p) == info["crc32"] for info, p in frames)
+
+
+BOARD_RAM = 200_000  # the goal: all of the firmware's RAM on a small microcontroller
+ROM_END = 0x400000   # hal/mps2/mps2.ld: flash is the first 4 MB
+REFUSAL = re.compile(r"^firmware: (\S+) needs ([0-9,]+) bytes of RAM \(stack ([0-9,]+), VRAM pages and palette "
+                     r"([0-9,]+), data and bss ([0-9,]+), work area ([0-9,]+)\); the board has ([0-9,]+) \(RAM_BYTES\)$")
+
+
+def number(text):
+    return int(text.replace(",", ""))
+
+
+def ram_parts(elf):
+    """The image's RAM from its symbols (hal/mps2/mps2.ld): the total and its parts."""
+    a = {k: v[0] for k, v in symbols(elf).items()}
+    return dict(need=a["__ram_need"], stack=a["__stack_top"] - a["__stack_limit"],
+                display=a["__display_end"] - a["mps2_vram0"], data_bss=a["__work_start"] - a["__display_end"],
+                work=a["__work_end"] - a["__work_start"], origin=a["__stack_limit"])
+
+
+def test_build_that_does_not_fit_is_refused():
+    """RAM_BYTES lowered below what the default scene's firmware needs: make fails with one line
+    giving the RAM it needs and its parts, and no image. That figure is exact: with RAM_BYTES set
+    to it the build links (and runs), 8 bytes fewer and it is refused again."""
+    out = BUILD / "firmware-test" / "arm-tight"
+    shutil.rmtree(out, ignore_errors=True)
+    proc = make("firmware", f"ARM_OUT={out}", "STREAM=raw", "RAM_BYTES=150000", ok=False)
+    assert proc.returncode != 0
+    lines = [ln for ln in (proc.stdout + proc.stderr).splitlines() if ln.startswith("firmware:")]
+    assert len(lines) == 1, proc.stdout + proc.stderr
+    m = REFUSAL.match(lines[0])
+    assert m, lines[0]
+    assert m.group(1) == "tests/scenes/default.scene" and m.group(7) == "150,000"
+    need, parts = number(m.group(2)), [number(g) for g in m.group(3, 4, 5, 6)]
+    assert need == sum(parts) and need > 150_000, lines[0]
+    assert number(m.group(4)) == 2 * 64000 + 768 + 4
+    assert not (out / "firmware.elf").exists()
+    assert "region" not in proc.stdout + proc.stderr  # the linker's own words are not shown
+
+    elf = build(out, "STREAM=raw", f"RAM_BYTES={need}")
+    ram = ram_parts(elf)
+    assert ram["need"] == need and [ram["stack"], ram["display"], ram["data_bss"], ram["work"]] == parts
+    status, log, _ = qemu(elf, out / "uart.bin", "--frames 2")
+    assert status == 0, log
+    proc = make("firmware", f"ARM_OUT={out}", "STREAM=raw", f"RAM_BYTES={need - 8}", ok=False)
+    assert proc.returncode != 0 and f"needs {need:,} bytes of RAM" in proc.stdout + proc.stderr
+    assert not elf.exists()  # the image that fitted before is gone
+
+
+def test_map12_fits_in_200000_bytes_and_matches_the_host_renderer(tmp_path):
+    """freedoom2.wad:MAP12, the largest Freedoom map: `make firmware` links it with all of its RAM
+    (stack, both pages, palette, data, bss, work area) within 200,000 bytes, the scene stays in
+    flash (read in place: .data holds no copy of it), and a short run under QEMU along the camera
+    path, in flip and in copy32 mode, streams frames bit-identical to build/render's from the same
+    cameras, with a stack high-water mark well inside the stack."""
+    out = BUILD / "firmware-test" / "arm-map12"
+    proc = make("firmware", "SCENE=freedoom2.wad:MAP12", f"ARM_OUT={out}", "STREAM=raw", f"RAM_BYTES={BOARD_RAM}",
+                ok=False)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    elf = out / "firmware.elf"
+    ram = ram_parts(elf)
+    assert ram["need"] <= BOARD_RAM and ram["origin"] == 0x20000000, ram
+    blob = (out / "scene.bsc").read_bytes()
+    addr, size = symbols(elf)["fw_scene"]
+    assert size == len(blob) and addr + size <= ROM_END
+    assert ram["data_bss"] < 32_768  # no room for a copy of the 1.3 MB scene
+    for present, frames in (("flip", 8), ("copy32", 3)):
+        status, log, uart = qemu(elf, tmp_path / f"{present}.bin", f"--frames {frames} --present {present}",
+                                 timeout=300)
+        assert status == 0, log
+        mode = re.search(r"; mode (\w+), present", log).group(1)
+        used, stack = map(int, re.search(r"stack used (\d+) of (\d+) bytes", log).groups())
+        assert stack == ram["stack"] and used <= stack * 3 // 4, log
+        shown, _ = raw_frames(uart)
+        assert len(shown) == frames
+        for info, pixels in shown:
+            assert zlib.crc32(pixels) == info["crc32"]
+            cam = [fx_text(info["x"]), fx_text(info["y"]), fx_text(info["z"])]
+            ref = subprocess.run([str(BUILD / "render"), str(out / "scene.bsc"), "--at", ",".join(cam),
+                                  "--angle", fx_text(info["angle"]), "--look", str(info["look"]), "--mode", mode,
+                                  "--present", present], capture_output=True, text=True, check=True)
+            assert int(json.loads(ref.stdout)["crc32"], 16) == info["crc32"], (present, info)

@@ -207,7 +207,7 @@ def test_scene_build_is_smaller(tmp_path):
     for full in ("", "1"):
         out = "build/" + ("arm-needs-full" if full else "arm-needs-scene")
         subprocess.run(["make", "-s", "--no-print-directory", "-j4", "firmware", f"ARM_OUT={out}",
-                        f"FULL={full}"], cwd=ROOT, check=True, capture_output=True, timeout=900)
+                        f"FULL={full}", "RAM_BYTES=16777216"], cwd=ROOT, check=True, capture_output=True, timeout=900)
         sec = armelf.sections(ROOT / out / "firmware.elf")
         sizes[bool(full)] = sec[".text"] + sec.get(".rodata", 0)
     assert sizes[False] < sizes[True], sizes

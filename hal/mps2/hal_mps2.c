@@ -6,8 +6,6 @@
 #include "tick.h"
 #include "uart.h"
 
-static _Alignas(4) uint8_t sysmem[HAL_PAGE_BYTES];
-
 static struct {
     const campath *path;
     uint32_t frame;
@@ -18,9 +16,10 @@ uint8_t *hal_target_vram(int page)
     return page ? mps2_vram1 : mps2_vram0;
 }
 
+/* no buffer of its own: the copy modes draw into the hidden page (hal/fb.c) */
 uint8_t *hal_target_sysmem(void)
 {
-    return sysmem;
+    return 0;
 }
 
 uint8_t *hal_target_palette(void)

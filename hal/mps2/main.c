@@ -11,9 +11,10 @@
  * 4 the scene needs more work memory than the build has; 5 bad run-time
  * options (args.h); 6 the frame link failed.
  *
- * The build (mk/mps2.mk) generates the scene file: the compiled scene blob,
- * its name, the camera path's name and the work area (in section .work, at
- * 0x21020000 in PSRAM) sized from the scene by build/render.
+ * The build (mk/mps2.mk) generates the scene file: the compiled scene blob
+ * (read in place from flash), its name, the camera path's name and the work
+ * area (section .work in RAM, hal/mps2/mps2.ld) sized for the scene by a
+ * sizing image of this firmware.
  */
 #include <stdint.h>
 
@@ -114,9 +115,10 @@ int main(void)
      * console only: text between its messages would cost the receiver a bad
      * message. Errors before that point go to both. */
     if (!args.no_stream && !stream_text_ok()) log_set_sinks(LOG_TO_SEMIHOST);
-    log_printf("firmware: mps2-an385 Cortex-M3; scene %s (%u bytes, work %u of %u bytes); %s %u frames; "
-               "mode %s, present %s; stream %s\n",
+    log_printf("firmware: mps2-an385 Cortex-M3; scene %s (%u bytes, work %u of %u bytes, world state %u); "
+               "%s %u frames; mode %s, present %s; stream %s\n",
                fw_scene_name, (unsigned)fw_scene_len, (unsigned)need, (unsigned)fw_work_bytes,
+               (unsigned)obj_state_bytes(&e.sc),
                fixed_view ? "fixed view," : path->name, (unsigned)frames, render_mode_name(e.mode),
                hal_present_name(e.present), args.no_stream ? "off" : stream_kind());
 
@@ -150,8 +152,9 @@ int main(void)
     if (args.linger_ms > 0 && !args.no_tick)
         for (uint32_t start = hal_ticks_ms(); hal_ticks_ms() - start < (uint32_t)args.linger_ms;) {
         }
-    uint32_t stack = (uint32_t)((uintptr_t)__stack_top - (uintptr_t)__stack_limit);
-    log_printf("firmware: done, %u frames in %u ms (SysTick); stack used %u of %u bytes\n", (unsigned)frames,
-               (unsigned)ms, (unsigned)(stack - mps2_stack_unused()), (unsigned)stack);
+    uint32_t stack = (uint32_t)((uintptr_t)__stack_top - (uintptr_t)__stack_limit), unused = mps2_stack_unused();
+    log_printf("firmware: done, %u frames in %u ms (SysTick); stack used %u of %u bytes%s\n", (unsigned)frames,
+               (unsigned)ms, (unsigned)(stack - unused), (unsigned)stack,
+               unused ? "" : " (all of it: it may have overflowed; rebuild with a larger STACK_BYTES)");
     return FW_EXIT_OK;
 }

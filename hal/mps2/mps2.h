@@ -2,36 +2,25 @@
  * QEMU models it (qemu-system-arm -M mps2-an385; hw/arm/mps2.c; checked with
  * `info mtree` on QEMU 7.2). Memory map and the few core registers used here.
  *
- *   0x00000000 - 0x003FFFFF  SSRAM1, 4 MB      "ROM": vectors, code, constants, the scene
- *                                               (QEMU -kernel loads the ELF here; it is
- *                                               RAM in QEMU, treated as flash)
- *   0x20000000 - 0x203FFFFF  SSRAM2/3, 4 MB    "RAM": .data, .bss, the system-memory
- *                                               back buffer, the stack (at the top)
- *   0x21000000 - 0x21FFFFFF  PSRAM, 16 MB      display memory and the renderer's work area:
- *     0x21000000  VRAM page 0        64,000 bytes (320 x 200, pitch 320)
- *     0x2100FA00  VRAM page 1        64,000 bytes
- *     0x2101F400  palette            768 bytes, 256 x (r, g, b), 8 bits per gun
- *     0x2101F700  display start      32-bit register: the page shown (0 or 1)
- *     0x21020000  work area          sized at build time from the scene (mk/mps2.mk)
+ *   0x00000000 - 0x003FFFFF  SSRAM1, 4 MB    "ROM" (flash): vectors, code, constants, the
+ *                                            scene (QEMU -kernel loads the ELF here; it
+ *                                            is RAM in QEMU, treated as flash)
+ *   0x20000000 - ...         SSRAM2/3        "RAM": the first MPS2_RAM_BYTES (default
+ *                                            200,000) only: the stack, both VRAM pages,
+ *                                            the palette, the display-start register,
+ *                                            .data, .bss and the work area (mps2.ld)
  *   0x40004000  UART0 (CMSDK APB UART): the frame link
  *   0xE000E010  SysTick; 0xE000ED00 System Control Block
  *
  * QEMU maps nothing useful at the board's real VGA window (0x41000000: an
- * unimplemented-device stub), so the VRAM pages are plain PSRAM at fixed,
- * linker-exported addresses (mps2.ld) that a debugger or QEMU's monitor
- * (`xp /16xb 0x21000000`) can read.
+ * unimplemented-device stub), so the VRAM pages are plain RAM, exported by
+ * the linker (mps2_vram0, ...) for a debugger or QEMU's monitor
+ * (`xp /16xb ADDR` with the address from arm-none-eabi-nm).
  */
 #ifndef MPS2_H
 #define MPS2_H
 
 #include <stdint.h>
-
-#define MPS2_VRAM0_ADDR 0x21000000u
-#define MPS2_VRAM1_ADDR 0x2100FA00u
-#define MPS2_PALETTE_ADDR 0x2101F400u
-#define MPS2_DISPSTART_ADDR 0x2101F700u
-#define MPS2_WORK_ADDR 0x21020000u
-#define MPS2_PSRAM_END 0x22000000u
 
 /* System clock of the AN385 image in QEMU: 25 MHz (SYSCLK; the 1 MHz REFCLK is
  * the other SysTick source). */

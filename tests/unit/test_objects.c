@@ -857,9 +857,44 @@ static void test_door_motion(void **state)
     for (int i = 0; i < 50; i++) obj_update(&b, &l.s, 0, 101, U(128), U(100));
     obj_update(&w, &l.s, 0, 5050, U(128), U(100));
     assert_int_equal(w.ceil[g], b.ceil[g]);
-    assert_int_equal(w.doors[g].travel_ms, b.doors[g].travel_ms);
+    assert_int_equal(w.ndoors, 1);
+    assert_int_equal(w.doors[0].travel_ms, b.doors[0].travel_ms); /* the only door's motion */
 #undef STEP
     free(mem2);
+    free(mem);
+    unload(&l);
+}
+
+/* The state keeps motion for door sectors only, in sector order: with doors at
+ * sectors a (0), b (1) and gap (3), a player in a and near the gap moves those
+ * two and leaves b closed, whatever slot each door has. */
+static void test_door_slots(void **state)
+{
+    (void)state;
+    loaded l;
+    load_text(&l, TWO_ROOMS);
+    uint32_t g = make_door(&l);
+    uint32_t a = sector_named(&l, U(128), U(100)), b = sector_named(&l, U(128), U(400));
+    assert_true(a < b && b < g);
+    scn_sector *sa = (scn_sector *)(void *)&l.s.sectors[a], *sb = (scn_sector *)(void *)&l.s.sectors[b];
+    sa->flags |= SCN_SECTOR_DOOR;
+    sa->open_h = U(200);
+    sb->flags |= SCN_SECTOR_DOOR;
+    sb->open_h = U(200);
+    uint32_t bytes = obj_state_bytes(&l.s);
+    /* ceilings of the 5 sectors (24 bytes), 3 door records (24), one word of bits (8) */
+    assert_int_equal(bytes, 24 + 3 * sizeof(obj_door) + 8);
+    uint8_t *mem = malloc(bytes);
+    world_state w;
+    assert_int_equal(obj_init(&w, &l.s, mem, bytes), 0);
+    assert_int_equal(w.ndoors, 3);
+    for (uint32_t t = 100; t <= 500; t += 100) obj_update(&w, &l.s, t, 100, U(128), U(193));
+    assert_int_equal(w.ceil[a], U(128 + 64));
+    assert_int_equal(w.ceil[g], U(64));
+    assert_int_equal(w.ceil[b], U(128));
+    assert_int_equal(w.doors[0].travel_ms, 500);
+    assert_int_equal(w.doors[1].travel_ms, 0);
+    assert_int_equal(w.doors[2].travel_ms, 500);
     free(mem);
     unload(&l);
 }
@@ -962,8 +997,8 @@ int main(void)
         cmocka_unit_test(test_interpenetrating),  cmocka_unit_test(test_wide_products),
         cmocka_unit_test(test_inverse_depth_order), cmocka_unit_test(test_painter),
         cmocka_unit_test(test_work_bound),        cmocka_unit_test(test_paths),
-        cmocka_unit_test(test_door_motion),       cmocka_unit_test(test_door_collision),
-        cmocka_unit_test(test_engine),
+        cmocka_unit_test(test_door_motion),       cmocka_unit_test(test_door_slots),
+        cmocka_unit_test(test_door_collision),    cmocka_unit_test(test_engine),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

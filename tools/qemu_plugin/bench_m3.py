@@ -70,7 +70,8 @@ def main():
     for v in views:
         name = v["scene"].replace(":", "_").replace("/", "_")
         out_dir = BUILD / "bench-m3" / name
-        make("firmware", f"SCENE={v['scene']}", f"ARM_OUT={out_dir}", f"ARM_OBJ={obj}", "STREAM=raw", "FULL=1")
+        make("firmware", f"SCENE={v['scene']}", f"ARM_OUT={out_dir}", f"ARM_OBJ={obj}", "STREAM=raw", "FULL=1",
+             "FW_MODES=direct,spans,painter", "RAM_BYTES=16777216")
         elf = out_dir / "firmware.elf"
         counts, log = count(elf, ["--at", v["at"], "--angle", v["angle"], "--mode", opt.mode,
                                   "--frames", str(opt.frames), "--no-stream", "--no-tick"], out_dir / "insns.txt")
