@@ -33,13 +33,14 @@ typedef struct {
 typedef struct {
     int32_t left;            /* west edge of its box, whole units (the list is sorted by it) */
     uint16_t index;          /* the object (its id; SCN_MAX_OBJECTS fits) */
-    int16_t x0, x1, y0, y1;  /* screen box of its faces: pixels [x0, x1) x [y0, y1) */
+    uint16_t x0, x1;         /* screen box of its faces: pixels [x0, x1) x [y0, y1) */
+    uint8_t y0, y1;
     uint16_t first_face;     /* stored: its faces in the pool */
     uint8_t nfaces;          /* faces facing the eye and on screen (SCN_MAX_MODEL_FACES fits) */
     uint8_t active : 1, stored : 1, drew : 1;
 } dr_obj;
 
-_Static_assert(SCN_MAX_OBJECTS <= 65536 && SCN_MAX_MODEL_FACES <= 255, "dr_obj's fields");
+_Static_assert(SCN_MAX_OBJECTS <= 65536 && SCN_MAX_MODEL_FACES <= 255 && VIEW_H <= 255, "dr_obj's fields");
 
 typedef struct {
     const scene *sc;
@@ -209,10 +210,10 @@ static void activate(dr_state *S, dr_obj *o)
     if (!nf) return;
     int x0 = rast_first_sample(box[0].x) - 1, x1 = rast_first_sample(box[1].x) + 1;
     int y0 = rast_first_sample(box[0].y) - 1, y1 = rast_first_sample(box[1].y) + 1;
-    o->x0 = (int16_t)(x0 < 0 ? 0 : x0);
-    o->x1 = (int16_t)(x1 > VIEW_W ? VIEW_W : x1);
-    o->y0 = (int16_t)(y0 < 0 ? 0 : y0);
-    o->y1 = (int16_t)(y1 > VIEW_H ? VIEW_H : y1);
+    o->x0 = (uint16_t)(x0 < 0 ? 0 : x0);
+    o->x1 = (uint16_t)(x1 > VIEW_W ? VIEW_W : x1);
+    o->y0 = (uint8_t)(y0 < 0 ? 0 : y0);
+    o->y1 = (uint8_t)(y1 > VIEW_H ? VIEW_H : y1);
 }
 
 /* ---- objects against the leaves ---------------------------------------------------- */

@@ -44,6 +44,11 @@ UART     ?= $(ARM_OUT)/uart.bin
 RUN_ARGS ?=
 FULL     ?=
 FW_MODES ?= direct
+# Mode direct's face pools (firmware/build_config.h): small on the board; objects
+# beyond them are worked out again where needed, never dropped.
+DIRECT_FACES ?= 16
+DIRECT_EDGES ?= 96
+FW_DEFS = $(call render_modes_def,$(FW_MODES)) -DCFG_DIRECT_FACES=$(DIRECT_FACES)u -DCFG_DIRECT_EDGES=$(DIRECT_EDGES)u
 RAM_BYTES ?= 200000
 # The stack: the walks keep a stack of the tree's depth (CFG_MAX_DEPTH: the scene's
 # in a build for it, 255 in a FULL=1 build). Measured high-water marks (hal/mps2/README.md):
@@ -81,7 +86,7 @@ ARM_SRC  := $(FW_SRC) $(HAL_SRC) $(MPS2_SRC) $(MPS2_LINK_SRC)
 # shared by several ARM_OUTs (with the same FW_MODES). A build for one scene
 # compiles them for it.
 ARM_OBJ  ?= $(ARM_OUT)/obj
-ARM_SCENE_DEF := $(if $(FULL),,-DSCENE_CONFIG='"$(abspath $(ARM_OUT)/scene_config.h)"') $(call render_modes_def,$(FW_MODES))
+ARM_SCENE_DEF := $(if $(FULL),,-DSCENE_CONFIG='"$(abspath $(ARM_OUT)/scene_config.h)"') $(FW_DEFS)
 ARM_CONFIG_DEP := $(if $(FULL),,$(ARM_OUT)/scene_config.h) $(ARM_OBJ)/modes
 ARM_OBJS := $(patsubst %.c,$(ARM_OBJ)/%.o,$(ARM_SRC)) $(ARM_OUT)/fw_scene.o
 # The soft-float helpers (as in tools/check_nofloat.sh) that may not be linked in.
@@ -107,7 +112,7 @@ $(ARM_OBJ)/%.o: %.c $(GEN)/fx_tables.c $(ARM_CONFIG_DEP)
 # The render modes the objects were compiled with; rewritten only when they change.
 $(ARM_OBJ)/modes: FORCE
 	@mkdir -p $(@D)
-	@echo '$(call render_modes_def,$(FW_MODES))' | cmp -s - $@ || echo '$(call render_modes_def,$(FW_MODES))' > $@
+	@echo '$(FW_DEFS)' | cmp -s - $@ || echo '$(FW_DEFS)' > $@
 
 # What the scene needs, as a C header (mk/scene.mk's recipe).
 $(ARM_OUT)/scene_config.h: $(ARM_OUT)/scene.bsc $(BUILD)/bspc
