@@ -3,7 +3,8 @@
 tests/bench_views.json, per render mode, the world alone and with things.
 
 Instructions per frame of build/render: valgrind's callgrind counts instructions, so a figure
-repeats exactly from run to run. Per view, mode and world (--no-objects) or things:
+repeats from run to run to within a few
+instructions per frame (the C library's paths vary slightly with where things are loaded). Per view, mode and world (--no-objects) or things:
 (Ir of --repeat N+1 - Ir of --repeat 1) / N (N = --frames, default 10), which leaves out loading
 the scene, the first frame and writing the output. Scenes are compiled once to build/bench/ first
 so that callgrind does not also measure the compiler.
@@ -206,6 +207,11 @@ def summary_table(views, modes, res):
         stats[m] = {"world": w, "things": t, "map01_things_minus_world": d}
         lines.append(f"| {m} | {w['median']:,.0f} | {w['p95']:,.0f} | {w['max']:,.0f} | {t['median']:,.0f} | "
                      f"{t['p95']:,.0f} | {t['max']:,.0f} | {'-' if d is None else f'{d:+,.0f}'} |")
+    starts = [i for i, v in enumerate(views) if v["set"] == "bench"]
+    if starts and len(starts) < len(views):
+        lines += ["", f"The {len(starts)} bench views alone (player starts), median world alone / with things: " + "; ".join(
+            f"{m} {statistics.median(res[(i, m, 'world')][0] for i in starts):,.0f} / "
+            f"{statistics.median(res[(i, m, 'things')][0] for i in starts):,.0f}" for m in modes) + "."]
     return lines, stats
 
 
