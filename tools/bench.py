@@ -3,8 +3,8 @@
 tests/bench_views.json, per render mode, the world alone and with things.
 
 Instructions per frame of build/render: valgrind's callgrind counts instructions, so a figure
-repeats from run to run to within a few
-instructions per frame (the C library's paths vary slightly with where things are loaded). Per view, mode and world (--no-objects) or things:
+repeats from run to run to within a few instructions per frame (the C library's paths vary slightly
+with where things are loaded). Per view, mode and world (--no-objects) or things:
 (Ir of --repeat N+1 - Ir of --repeat 1) / N (N = --frames, default 10), which leaves out loading
 the scene, the first frame and writing the output. Scenes are compiled once to build/bench/ first
 so that callgrind does not also measure the compiler.
