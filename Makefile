@@ -107,8 +107,10 @@ help:
 	@echo "make            build build/bspc, build/render, build/emu (and check: no floating point)"
 	@echo "make run        walk the built-in scene in a window (headless: fly-through PNGs)"
 	@echo "make test       deps, build, unit tests and pytest, with ASan and UBSan"
-	@echo "make bench      instructions per frame (callgrind), overdraw, VRAM writes, bus cycles on 20 views;"
-	@echo "                Cortex-M3 instructions per frame (bench-m3); link faults (bench-faults);"
+	@echo "make bench      instructions per frame (callgrind, x86-64) per render mode, world alone and with"
+	@echo "                things: median, p95, max and the stages of the frame over the bench and open views"
+	@echo "                (tests/bench_views.json), overdraw, VRAM writes, bus cycles -> build/bench.md and"
+	@echo "                docs/benchmarks.md; the same on the Cortex-M3 (bench-m3); link faults (bench-faults);"
 	@echo "                the PC kernel's write counters per present mode (bench-pcvga);"
 	@echo "                firmware flash and RAM of four scenes against the board's 200,000 bytes (bench-size)"
 	@echo "make scene-host SCENE=...  build/scene/NAME/render, emu built for one scene (docs/needs.md)"
@@ -153,8 +155,10 @@ test: deps
 bench-bsp: deps $(BUILD)/bspc
 	$(PY) tools/bench_bsp.py
 
+# BENCH_ARGS: e.g. --frames 10 (the N of (repeat N+1 - repeat 1)/N), -j 1, --views K
+BENCH_ARGS ?=
 bench: deps $(BUILD)/bspc $(BUILD)/render
-	$(PY) tools/bench.py
+	$(PY) tools/bench.py $(BENCH_ARGS)
 
 bench: bench-faults bench-size
 bench-faults: deps firmware

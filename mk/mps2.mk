@@ -28,8 +28,10 @@
 #       build/arm/uart.bin (or stdout with UART=stdio), the firmware's messages
 #       (semihosting) to the terminal; QEMU's exit status is the firmware's.
 #   make insn-plugin  -> build/insn_count.so
-#   make bench-m3     instructions per frame on the Cortex-M3 for the 20 bench views
-#                     (tools/qemu_plugin/bench_m3.py -> build/bench-m3.md); make bench runs it too
+#   make bench-m3 [BENCH_M3_ARGS=...]  instructions per frame on the Cortex-M3 per render mode,
+#                     world alone and with things, and the stages of the frame, for the bench and
+#                     open views (tools/qemu_plugin/bench_m3.py -> build/bench-m3.md and
+#                     docs/benchmarks.md); make bench runs it too
 #   make count-m3 [SCENE=...] [RUN_ARGS=...]  per-frame counts of the firmware as built
 #
 # Integer-only: compiled soft-float (-mfloat-abi=soft), and the link fails if
@@ -205,8 +207,9 @@ $(BUILD)/insn_count.so: tools/qemu_plugin/insn_count.c tools/qemu_plugin/qemu_pl
 
 insn-plugin: $(BUILD)/insn_count.so
 
-bench-m3: $(BUILD)/bspc $(BUILD)/render $(BUILD)/insn_count.so
-	$(PY) tools/qemu_plugin/bench_m3.py
+BENCH_M3_ARGS ?=
+bench-m3: deps $(BUILD)/bspc $(BUILD)/render $(BUILD)/bin2c $(BUILD)/insn_count.so
+	$(PY) tools/qemu_plugin/bench_m3.py $(BENCH_M3_ARGS)
 
 # make bench reports the Cortex-M3 figures too.
 bench: bench-m3

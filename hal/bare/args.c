@@ -114,18 +114,20 @@ int args_parse(fw_args *a, char *line, unsigned offered, char *err, int errsize)
     a->x = a->y = a->z = a->angle_deg = 0;
     a->look = 0;
     a->mode = a->present = -1;
-    a->no_stream = a->no_tick = a->fault = a->wait = 0;
+    a->no_stream = a->no_tick = a->fault = a->wait = a->no_objects = 0;
     a->acks = ARGS_ACKS_AUTO;
     for (int i = 1; i < n; i++) { /* words[0]: the program */
         const char *o = words[i];
         char *val = i + 1 < n ? words[i + 1] : 0;
         unsigned needs = option_feature(o);
         if (needs && !(offered & needs)) return fail(err, errsize, "option '%s' is not available on this target", o);
-        if (same(o, "--no-stream") || same(o, "--no-tick") || same(o, "--fault") || same(o, "--wait")) {
-            *(same(o, "--no-stream") ? &a->no_stream
-              : same(o, "--no-tick") ? &a->no_tick
-              : same(o, "--wait")    ? &a->wait
-                                     : &a->fault) = 1;
+        if (same(o, "--no-stream") || same(o, "--no-tick") || same(o, "--fault") || same(o, "--wait") ||
+            same(o, "--no-objects")) {
+            *(same(o, "--no-stream")    ? &a->no_stream
+              : same(o, "--no-tick")    ? &a->no_tick
+              : same(o, "--wait")       ? &a->wait
+              : same(o, "--no-objects") ? &a->no_objects
+                                        : &a->fault) = 1;
             continue;
         }
         if (!val) return fail(err, errsize, "%s: missing value", o);

@@ -3,7 +3,7 @@
 
 int fixed_view_wanted(const fw_args *a)
 {
-    return a->have_at || a->have_angle || a->look != 0;
+    return a->have_at || a->have_angle || a->look != 0 || a->no_objects;
 }
 
 void fixed_view_apply(engine *e, const fw_args *a)
@@ -13,6 +13,7 @@ void fixed_view_apply(engine *e, const fw_args *a)
         e->cam.view.y = a->y;
     }
     if (a->have_angle) e->cam.view.angle_deg = a->angle_deg;
+    if (a->no_objects) e->world.n = 0;
     e->cam.view.look = a->look;
     if (a->have_z) {
         e->cam.view.z = a->z;

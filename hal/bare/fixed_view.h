@@ -9,7 +9,8 @@
 
 int fixed_view_wanted(const fw_args *a); /* nonzero: the options ask for a fixed view */
 /* The eye at --at (default: the player start), Z as given or the floor under
- * the eye + 41, --angle (default: the start's), --look. */
+ * the eye + 41, --angle (default: the start's), --look; no objects with
+ * --no-objects. */
 void fixed_view_apply(engine *e, const fw_args *a);
 
 #endif

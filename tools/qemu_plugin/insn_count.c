@@ -8,6 +8,14 @@
  *   eng_step() - so "render" below is input + camera + render + present + the
  *   frame-done hook, and "total" adds streaming the frame over the UART.
  * out: where the per-frame counts go at exit (default: QEMU's log, stderr).
+ * profile=FILE (optional): also where the instructions inside the frames were:
+ *   every block gets a callback that counts its runs while a frame is open
+ *   (between a begin and the next end mark), and at exit FILE gets one line
+ *   "0xADDR runs" per guest instruction address run inside frames, summed over
+ *   all frames (tools/bench_profile.py turns addresses into stages). A block's
+ *   callback comes before its instructions, so the block holding the begin mark
+ *   is left out and the one holding the end mark counted whole: a few
+ *   instructions of the marker functions per frame.
  *
  * Every translated block adds its instruction count to one 64-bit counter with
  * an inline TCG add (no call per block). When a marker instruction runs, a
@@ -45,6 +53,17 @@ typedef struct {
 static frame_rec *frames;
 static size_t nframes, capframes;
 
+/* profile= : each translated block's instruction addresses and its runs in frames */
+typedef struct prof_tb {
+    struct prof_tb *next;
+    uint64_t runs;
+    size_t n;
+    uint32_t pc[];
+} prof_tb;
+static char *prof_path;
+static prof_tb *prof_list;
+static int in_frame;
+
 static void on_mark(unsigned int vcpu, void *udata)
 {
     (void)vcpu;
@@ -62,9 +81,51 @@ static void on_mark(unsigned int vcpu, void *udata)
         frames[nframes].begin = now;
         frames[nframes].end = 0;
         nframes++;
+        in_frame = 1;
     } else if (nframes > 0 && frames[nframes - 1].end == 0) {
         frames[nframes - 1].end = now;
+        in_frame = 0;
     }
+}
+
+static void on_tb_exec(unsigned int vcpu, void *udata)
+{
+    (void)vcpu;
+    if (in_frame) ((prof_tb *)udata)->runs++;
+}
+
+/* A record of the block's instruction addresses, whose runs on_tb_exec counts. */
+static void profile_tb(struct qemu_plugin_tb *tb, size_t n)
+{
+    prof_tb *p = malloc(sizeof *p + n * sizeof p->pc[0]);
+    if (!p) return;
+    p->runs = 0;
+    p->n = n;
+    for (size_t i = 0; i < n; i++) p->pc[i] = (uint32_t)qemu_plugin_insn_vaddr(qemu_plugin_tb_get_insn(tb, i));
+    p->next = prof_list;
+    prof_list = p;
+    qemu_plugin_register_vcpu_tb_exec_cb(tb, on_tb_exec, QEMU_PLUGIN_CB_NO_REGS, p);
+}
+
+static void write_profile(void)
+{
+    FILE *f = fopen(prof_path, "w");
+    if (!f) {
+        char msg[512];
+        snprintf(msg, sizeof msg, "insn_count: %s: cannot write: %s\n", prof_path, strerror(errno));
+        qemu_plugin_outs(msg);
+    } else {
+        fprintf(f, "# insn_count profile: guest instruction address, runs inside frames (%zu frames)\n", nframes);
+        for (prof_tb *p = prof_list; p; p = p->next)
+            for (size_t i = 0; p->runs && i < p->n; i++) fprintf(f, "%#x %llu\n", (unsigned)p->pc[i], (unsigned long long)p->runs);
+        fclose(f);
+    }
+    while (prof_list) {
+        prof_tb *p = prof_list;
+        prof_list = p->next;
+        free(p);
+    }
+    free(prof_path);
 }
 
 static void on_tb_trans(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
@@ -72,6 +133,7 @@ static void on_tb_trans(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
     (void)id;
     size_t n = qemu_plugin_tb_n_insns(tb);
     qemu_plugin_register_vcpu_tb_exec_inline(tb, QEMU_PLUGIN_INLINE_ADD_U64, &insns, n);
+    if (prof_path) profile_tb(tb, n);
     for (size_t i = 0; i < n; i++) {
         struct qemu_plugin_insn *insn = qemu_plugin_tb_get_insn(tb, i);
         uint64_t pc = qemu_plugin_insn_vaddr(insn) & ~(uint64_t)1;
@@ -121,6 +183,7 @@ static void report_at_exit(qemu_plugin_id_t id, void *udata)
     free(buf);
     free(frames);
     free(out_path);
+    if (prof_path) write_profile();
 }
 
 static int parse_addr(const char *s, uint64_t *out)
@@ -147,12 +210,15 @@ QEMU_PLUGIN_EXPORT int qemu_plugin_install(qemu_plugin_id_t id, const qemu_info_
         } else if (!strncmp(a, "out=", 4)) {
             free(out_path);
             out_path = strdup(a + 4);
+        } else if (!strncmp(a, "profile=", 8)) {
+            free(prof_path);
+            prof_path = strdup(a + 8);
         } else {
             goto bad;
         }
         continue;
     bad:
-        fprintf(stderr, "insn_count: bad argument '%s' (expected begin=ADDR, end=ADDR, out=FILE)\n", a);
+        fprintf(stderr, "insn_count: bad argument '%s' (expected begin=ADDR, end=ADDR, out=FILE, profile=FILE)\n", a);
         return -1;
     }
     qemu_plugin_register_vcpu_tb_trans_cb(id, on_tb_trans);

@@ -1,0 +1,145 @@
+"""The benchmark tools (tools/bench.py, tools/bench_profile.py, tools/bench_doc.py) on small
+inputs: the modes come from build/render, a frame's stages add up to its instructions, inlined
+helpers count for their caller, the percentile, the document keeps the section it was not given;
+and the firmware's --no-objects draws build/render's --no-objects frame."""
+import json
+import os
+import shutil
+import stat
+import subprocess
+import sys
+
+import pytest
+
+from conftest import BUILD, ROOT
+
+sys.path.insert(0, str(ROOT / "tools"))
+import bench  # noqa: E402
+import bench_doc  # noqa: E402
+import bench_profile as bp  # noqa: E402
+
+
+def fake_render(tmp_path, modes, help_text):
+    """A stand-in for build/render that prints help_text and accepts --mode M for M in modes."""
+    path = tmp_path / "render"
+    path.write_text("#!/bin/sh\n"
+                    f"if [ \"$1\" = --mode ]; then case \"$2\" in {'|'.join(modes)}) ;; *) exit 1;; esac; fi\n"
+                    f"cat <<'EOF'\n{help_text}\nEOF\n")
+    path.chmod(path.stat().st_mode | stat.S_IEXEC)
+    return path
+
+
+def test_modes_are_those_render_names_and_accepts(tmp_path, monkeypatch):
+    monkeypatch.delenv("BENCH_MODES", raising=False)
+    help_text = ("usage: render SCENE\n  --angle DEG        view angle, default 0\n"
+                 "  --mode MODE        direct (the default: front to back), spans (zero\n"
+                 "                     overdraw) or painter (back to front)\n"
+                 "  --present P        flip | copy8")
+    fake = fake_render(tmp_path, ["direct", "spans", "painter"], help_text)
+    assert bench.render_modes(fake) == ["direct", "spans", "painter"]
+    # words of other options' paragraphs are not modes even when accepted
+    fake = fake_render(tmp_path, ["spans", "painter", "flip"], help_text)
+    assert bench.render_modes(fake) == ["spans", "painter"]
+    monkeypatch.setenv("BENCH_MODES", "painter")
+    assert bench.render_modes(fake) == ["painter"]
+
+
+def test_modes_of_the_built_renderer(monkeypatch):
+    monkeypatch.delenv("BENCH_MODES", raising=False)
+    modes = bench.render_modes(BUILD / "render")
+    assert {"spans", "painter"} <= set(modes)
+    for m in modes:
+        assert subprocess.run([str(BUILD / "render"), "--mode", m, "--help"], capture_output=True).returncode == 0
+
+
+def test_p95_nearest_rank():
+    assert bench.p95(list(range(1, 21))) == 19
+    assert bench.p95(list(range(100, 0, -1))) == 95
+    assert bench.p95([7]) == 7
+    s = bench.summary([3, 1, 2, 10])
+    assert (s["median"], s["p95"], s["max"]) == (2.5, 10, 10)
+
+
+def test_inlined_helpers_count_for_their_caller():
+    chain = [("w128_mul", "firmware/wide128.h"), ("objd_front", "firmware/obj_draw.c")]
+    assert bp.function_of(chain) == ("objd_front", "firmware/obj_draw.c")
+    assert bp.stage_of(*bp.function_of(chain)) == bp.OBJECTS
+    # an inlined .c function keeps its own stage: coverage inlined into add_polygon
+    assert bp.stage_of(*bp.function_of([("cover", "firmware/spans.c"), ("add_polygon", "firmware/spans.c")])) == bp.COVER
+    # no inline record: the outermost function, in the file it was seen in elsewhere
+    assert bp.function_of([("objd_front", "firmware/wide128.h")], {"objd_front": "firmware/obj_draw.c"}) == \
+        ("objd_front", "firmware/obj_draw.c")
+    assert bp.stage_of("clip_plane.isra.0", "firmware/clip.c") == bp.XFORM
+    assert bp.stage_of("__aeabi_ldivmod", "??") == bp.ARITH
+    assert bp.stage_of("brand_new", "firmware/brand_new.c") == bp.OTHER
+    assert bp.Profile({("brand_new", "firmware/brand_new.c"): 5, ("scan_line", "firmware/spans.c"): 7}).unclassified() == \
+        {("brand_new", "firmware/brand_new.c"): 5}
+
+
+@pytest.mark.skipif(shutil.which("valgrind") is None, reason="valgrind missing: run make deps")
+def test_stages_add_up_to_the_frame(tmp_path):
+    scene = tmp_path / "objects.bsc"
+    subprocess.run([str(BUILD / "bspc"), str(ROOT / "tests/scenes/objects.scene"), "-o", str(scene)], check=True,
+                   capture_output=True)
+    view = {"at": "128,192", "angle": "0"}
+    for mode in bench.render_modes():
+        ir, prof = bench.frame_profile(scene, view, mode, 2)
+        assert ir > 10_000
+        assert abs(prof.total() - ir) < 1, mode
+        stages = prof.stages()
+        assert abs(sum(stages.values()) - ir) < 1
+        assert set(stages) <= set(bp.STAGES)
+        assert stages[bp.FILL] > 0 and stages[bp.XFORM] > 0 and stages[bp.OBJECTS] > 0, (mode, stages)
+        # the exact difference: the same as callgrind's totals alone
+        assert ir == (bench.instructions(scene, view, mode, 3) - bench.instructions(scene, view, mode, 1)) / 2
+
+
+def test_document_keeps_the_other_section(tmp_path, monkeypatch):
+    doc, x86, m3 = tmp_path / "benchmarks.md", tmp_path / "bench.md", tmp_path / "bench-m3.md"
+    monkeypatch.setattr(bench_doc, "DOC", doc)
+    monkeypatch.setattr(bench_doc, "SECTIONS", {"x86": ("x86", "make bench", "tools/bench.py", x86),
+                                                "m3": ("M3", "make bench-m3", "m3.py", m3)})
+    x86.write_text("x86 figures one\n")
+    bench_doc.write("x86")
+    assert "x86 figures one" in doc.read_text() and "Not run yet: `make bench-m3`" in doc.read_text()
+    m3.write_text("m3 figures\n")
+    x86.unlink()
+    bench_doc.write("m3")
+    text = doc.read_text()
+    assert "x86 figures one" in text and "m3 figures" in text and "Not run yet" not in text
+
+
+QEMU = shutil.which("qemu-system-arm")
+
+
+@pytest.mark.skipif(QEMU is None, reason="qemu-system-arm missing: run make deps")
+def test_firmware_no_objects_draws_the_world_alone(tmp_path):
+    out = BUILD / "test-bench-noobj"
+    proc = subprocess.run(["make", "-s", "-j2", "--no-print-directory", "firmware", "SCENE=tests/scenes/objects.scene",
+                           f"ARM_OUT={out}", "STREAM=raw", "FULL=1"], cwd=ROOT, capture_output=True, text=True,
+                          timeout=600)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    elf = out / "firmware.elf"
+    view = ["--at", "128,192", "--angle", "0"]
+
+    def host(*extra):
+        p = subprocess.run([str(BUILD / "render"), str(out / "scene.bsc"), *view, *extra], capture_output=True,
+                           text=True, check=True)
+        return int(json.loads(p.stdout)["crc32"], 16)
+
+    def firmware(*extra):
+        uart = tmp_path / "uart.bin"
+        p = subprocess.run([QEMU, "-M", "mps2-an385", "-nographic", "-monitor", "none", "-semihosting-config",
+                            "enable=on,target=native", "-kernel", str(elf), "-serial", f"file:{uart}",
+                            "-append", " ".join([*view, "--frames", "1", *extra])],
+                           capture_output=True, timeout=120)
+        assert p.returncode == 0, p.stderr
+        sys.path.insert(0, str(ROOT / "tests"))
+        from test_firmware import raw_frames
+        frames, _ = raw_frames(uart.read_bytes())
+        return frames[0][0]["crc32"]
+
+    alone, things = host("--no-objects"), host()
+    assert alone != things                  # objects are in view: the option has something to leave out
+    assert firmware("--no-objects") == alone
+    assert firmware() == things
