@@ -9,8 +9,9 @@ arithmetic helpers inlined everywhere (fixed.h, wide128.h: their instructions co
 function they were inlined into), so inlining does not move work between stages. Code without
 debug information keeps the symbol name callgrind or addr2line gives it.
 
-The stage of a function: STAGE_OF_FUNCTION by name (for files whose functions belong to
-different stages), else STAGE_OF_FILE by its source file, else "other". A function that lands in
+The stage of a function: STAGE_OF_FILE_FUNCTION by file and name, then STAGE_OF_FUNCTION by name
+(for files whose functions belong to different stages), else STAGE_OF_FILE by its source file,
+else "other". A function that lands in
 "other" without being listed is reported as unclassified by name, so a new file or function shows
 up in the figures instead of hiding; add it to the tables below.
 """
@@ -40,6 +41,9 @@ STAGE_OF_FILE = {
     "firmware/view.h": XFORM,
     "firmware/surfaces.c": XFORM,
     "firmware/occlusion.c": COVER,
+    "firmware/cover.c": COVER,
+    "firmware/cover.h": COVER,
+    "firmware/direct.c": OBJECTS,    # but for the functions STAGE_OF_FILE_FUNCTION names
     "firmware/raster.c": SCAN,
     "firmware/raster.h": SCAN,
     "firmware/obj_draw.c": OBJECTS,
@@ -53,6 +57,19 @@ STAGE_OF_FILE = {
     "firmware/camera.c": OTHER,
     "host/render.c": OTHER,
     "hal/null/hal_null.c": OTHER,
+}
+
+# Names that more than one file uses (the modes' own visit_leaf, add_polygon).
+STAGE_OF_FILE_FUNCTION = {
+    # direct.c: the pixel mask (cover.c) does its coverage; the rows are its scan
+    ("firmware/direct.c", "visit_leaf"): WALK,
+    ("firmware/direct.c", "add_polygon"): SCAN,
+    ("firmware/direct.c", "box_hidden"): COVER,
+    ("firmware/direct.c", "direct_render"): OTHER,
+    ("firmware/direct.c", "direct_work_bytes"): OTHER,
+    ("firmware/direct.c", "align8"): OTHER,
+    ("firmware/direct.c", "object_count"): OTHER,
+    ("firmware/painter.c", "place_objects"): OBJECTS,
 }
 
 STAGE_OF_FUNCTION = {
@@ -136,6 +153,8 @@ def function_of(chain, home=None):
 
 def stage_of(func, path):
     base = func.split(".")[0]        # clip_plane.isra.0, wall_part.part.0: the source function
+    if (path, base) in STAGE_OF_FILE_FUNCTION:
+        return STAGE_OF_FILE_FUNCTION[(path, base)]
     if base in STAGE_OF_FUNCTION:
         return STAGE_OF_FUNCTION[base]
     if path in STAGE_OF_FILE:
@@ -146,7 +165,9 @@ def stage_of(func, path):
 
 
 def known(func, path):
-    return func.split(".")[0] in STAGE_OF_FUNCTION or path in STAGE_OF_FILE or ARITH_SYMBOL.match(func)
+    base = func.split(".")[0]
+    return (path, base) in STAGE_OF_FILE_FUNCTION or base in STAGE_OF_FUNCTION or path in STAGE_OF_FILE or \
+        ARITH_SYMBOL.match(func)
 
 
 class Profile:
