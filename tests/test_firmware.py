@@ -268,15 +268,15 @@ def test_build_that_does_not_fit_is_refused():
     to it the build links (and runs), 8 bytes fewer and it is refused again."""
     out = BUILD / "firmware-test" / "arm-tight"
     shutil.rmtree(out, ignore_errors=True)
-    proc = make("firmware", f"ARM_OUT={out}", "STREAM=raw", "RAM_BYTES=150000", ok=False)
+    proc = make("firmware", f"ARM_OUT={out}", "STREAM=raw", "RAM_BYTES=140000", ok=False)
     assert proc.returncode != 0
     lines = [ln for ln in (proc.stdout + proc.stderr).splitlines() if ln.startswith("firmware:")]
     assert len(lines) == 1, proc.stdout + proc.stderr
     m = REFUSAL.match(lines[0])
     assert m, lines[0]
-    assert m.group(1) == "tests/scenes/default.scene" and m.group(7) == "150,000"
+    assert m.group(1) == "tests/scenes/default.scene" and m.group(7) == "140,000"
     need, parts = number(m.group(2)), [number(g) for g in m.group(3, 4, 5, 6)]
-    assert need == sum(parts) and need > 150_000, lines[0]
+    assert need == sum(parts) and need > 140_000, lines[0]
     assert number(m.group(4)) == 2 * 64000 + 768 + 4
     assert not (out / "firmware.elf").exists()
     assert "region" not in proc.stdout + proc.stderr  # the linker's own words are not shown
