@@ -10,7 +10,7 @@ import sys
 import numpy as np
 import pytest
 
-from conftest import BUILD, ROOT, SAN_ENV, render, run
+from conftest import BUILD, RENDER_MODES, ROOT, SAN_ENV, render, run
 
 sys.path.insert(0, str(ROOT / "tools"))
 import accuracy  # noqa: E402
@@ -72,7 +72,7 @@ def ids_of(binary, tmp_path, mode):
     return json.loads(proc.stdout), accuracy.read_ids(out)
 
 
-@pytest.mark.parametrize("mode", ["spans", "painter"])
+@pytest.mark.parametrize("mode", RENDER_MODES)
 def test_default_is_exact_and_a_coarse_knob_is_not(mode, tmp_path):
     plain = render(VIEW["scene"], "--mode", mode, at=VIEW["at"], angle=VIEW["angle"], sanitized=False)
     default_json, default_ids = ids_of(knob_render("default", sanitized=False), tmp_path, mode)
@@ -85,7 +85,7 @@ def test_default_is_exact_and_a_coarse_knob_is_not(mode, tmp_path):
     assert accuracy.edge_displacement(ref, coarse_ids) > accuracy.edge_displacement(ref, default_ids)
     # whole-pixel vertices still leave no gap and no pixel drawn twice
     assert int(np.count_nonzero((coarse_ids >> 24) == 0)) == 0
-    if mode == "spans":
+    if mode != "painter":
         assert coarse_json["overdraw"] == 1.0 and coarse_json["pixels_written"] == 64000
 
 

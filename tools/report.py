@@ -306,17 +306,19 @@ def write_markdown(path, points, per_scene, views, configs, png_name, no_ir):
         lines += ["", f"Failed renders (counted as every pixel differing, displacement 320): {len(failed)}: "
                   + "; ".join(f"{c}/{m} {n}" for c, m, n in failed[:20]) + ("; ..." if len(failed) > 20 else "")]
     if per_scene:
+        shown = [m for m in MODES if any(m in row for row in per_scene.values())]
         lines += [
             "",
             f"## Extreme scenes, configuration {DEFAULT}",
             "",
             "Worst share of differing pixels and worst edge displacement over each scene's views.",
             "",
-            "| scene | views | " + " | ".join(f"{m} worst differ | {m} worst edge px" for m in MODES) + " |",
-            "|---|---:|" + "---:|---:|" * len(MODES),
+            "| scene | views | " + " | ".join(f"{m} worst differ | {m} worst edge px" for m in shown) + " |",
+            "|---|---:|" + "---:|---:|" * len(shown),
         ]
         for scene, row in per_scene.items():
-            cells = " | ".join(f"{pct(row[m]['differ'], 2)} | {row[m]['edge']}" for m in MODES)
+            cells = " | ".join(f"{pct(row[m]['differ'], 2)} | {row[m]['edge']}" if m in row else "— | —"
+                               for m in shown)
             lines.append(f"| {scene} | {row['views']} | {cells} |")
     lines += ["", "Configurations (mk/report.mk): " +
               "; ".join(f"{c} = {configs[c] or '(no flags)'}" for c in configs) + "."]
