@@ -26,6 +26,28 @@ static int side_of(int64_t px, int64_t py, int64_t dx_raw, int64_t dy_raw, int64
     return cross > slack ? 1 : (cross < -slack ? -1 : 0);
 }
 
+int eye_clearly_in_front(const view_xform *v, const scn_vertex *a, const scn_vertex *b)
+{
+    int64_t dx = fx_asr64((int64_t)b->x - a->x, 1), dy = fx_asr64((int64_t)b->y - a->y, 1);
+    int64_t ex = fx_asr64(v->cx - a->x, 3), ey = fx_asr64(v->cy - a->y, 3);
+    int64_t len = abs64(dx) + abs64(dy) + 2;
+    int64_t slack = len + abs64(ex) + abs64(ey) + EYE_WALL_MARGIN * len;
+    return dy * ex - dx * ey > slack;
+}
+
+/* 1 if the eye is clearly in front of every one-sided wall of the leaf: an eye
+ * that side_of takes to be on the leaf's edge may lie a little outside the
+ * world, and see into it past the backs of its walls. */
+static int clear_of_walls(const scene *sc, const scn_leaf *f, const view_xform *v)
+{
+    for (uint32_t i = 0; i < f->num_segs; i++) {
+        const scn_seg *g = &sc->segs[f->first_seg + i];
+        if (sc->lines[g->line].sector[g->side ^ 1u] != SCN_NONE) continue;
+        if (!eye_clearly_in_front(v, &sc->verts[g->v1], &sc->verts[g->v2])) return 0;
+    }
+    return 1;
+}
+
 /* 1 if the eye is inside the leaf's floor polygon or on its boundary
  * (counter-clockwise: inside is left of every edge). */
 static int holds(const scene *sc, const scn_leaf *f, int64_t x, int64_t y)
@@ -48,6 +70,7 @@ int eye_in_world(const scene *sc, const world_state *w, const view_xform *v)
         if (n & SCN_LEAF_BIT) {
             const scn_leaf *f = &sc->leaves[n & ~SCN_LEAF_BIT];
             if (f->sector == SCN_NONE || f->num_pverts < 3 || !holds(sc, f, v->cx, v->cy)) return 0;
+            if (!clear_of_walls(sc, f, v)) return 0;
             const scn_sector *sec = &sc->sectors[f->sector];
             if (v->cz <= sec->floor_h || v->cz >= obj_ceil(w, sc, f->sector)) return 0;
             found = 1;

@@ -155,4 +155,7 @@ static inline int32_t view_subpixel(int32_t s)
  * result is clamped to the screen rectangle [0,320] x [0,200] (16.16). */
 screen_pt view_project(const view_xform *v, view_pt p);
 
+/* view_project's x alone. */
+int32_t view_project_x(view_pt p);
+
 #endif
