@@ -26,7 +26,13 @@ static view_pt intersect(view_pt a, int64_t da, view_pt b, int64_t db)
         den >>= 1;
         num >>= 1;
     }
+#if FX_DIV32
+    /* num <= den < 2^31: t <= 2^30 (docs/ranges.md) */
+    uint32_t rem;
+    int64_t t = den ? (int64_t)fx_udiv64_32(num << 30, (uint32_t)den, &rem) : 0;
+#else
     int64_t t = den ? (int64_t)((num << 30) / den) : 0;
+#endif
     view_pt r;
     r.x = a.x + (int32_t)fx_asr64(((int64_t)b.x - a.x) * t, 30);
     r.y = a.y + (int32_t)fx_asr64(((int64_t)b.y - a.y) * t, 30);
