@@ -26,7 +26,13 @@ static view_pt intersect(view_pt a, int64_t da, view_pt b, int64_t db)
         den >>= 1;
         num >>= 1;
     }
+#if FX_DIV32
+    /* num <= den < 2^31: t <= 2^30 (docs/ranges.md) */
+    uint32_t rem;
+    int64_t t = den ? (int64_t)fx_udiv64_32(num << 30, (uint32_t)den, &rem) : 0;
+#else
     int64_t t = den ? (int64_t)((num << 30) / den) : 0;
+#endif
     view_pt r;
     r.x = a.x + (int32_t)fx_asr64(((int64_t)b.x - a.x) * t, 30);
     r.y = a.y + (int32_t)fx_asr64(((int64_t)b.y - a.y) * t, 30);
@@ -75,6 +81,28 @@ int clip_polygon(clip_poly *p, const view_xform *v, unsigned mask)
     for (unsigned plane = 1; plane <= CLIP_BOTTOM && p->n >= 3; plane <<= 1)
         if (mask & plane) clip_plane(p, v, plane);
     return p->n >= 3 ? p->n : 0;
+}
+
+int clip_wall_x(const view_xform *v, view_pt p, view_pt q, unsigned mask, int32_t *xp, int32_t *xq)
+{
+    view_pt e[2] = {p, q};
+    uint8_t on[2] = {0, 0};
+    for (unsigned plane = CLIP_NEAR; plane <= CLIP_RIGHT; plane <<= 1) {
+        if (!(mask & plane)) continue;
+        int64_t d0 = clip_distance(v, e[0], plane), d1 = clip_distance(v, e[1], plane);
+        if (d0 >= 0 && d1 >= 0) continue;
+        if (d0 < 0 && d1 < 0) return 0;
+        /* the quad's edge between the two ends is cut from its inside end, as in clip_plane */
+        int out = d0 < 0 ? 0 : 1;
+        e[out] = out ? intersect(e[0], d0, e[1], d1) : intersect(e[1], d1, e[0], d0);
+        on[out] = (uint8_t)(plane | (on[0] & on[1]));
+    }
+    int32_t x[2];
+    for (int i = 0; i < 2; i++)
+        x[i] = (on[i] & CLIP_RIGHT) ? VIEW_W_FX : (on[i] & CLIP_LEFT) ? 0 : view_project_x(e[i]);
+    *xp = x[0];
+    *xq = x[1];
+    return 1;
 }
 
 void clip_project(const view_xform *v, const clip_poly *p, screen_pt *out)

@@ -40,6 +40,15 @@ int clip_polygon(clip_poly *p, const view_xform *v, unsigned mask);
  * and leave the border pixels uncovered. */
 void clip_project(const view_xform *v, const clip_poly *p, screen_pt *out);
 
+/* The screen x (16.16) of the two vertical edges of a wall standing on the view
+ * points p and q (any height: only x and z are read): p and q clipped against
+ * the near, left and right planes in mask exactly as clip_polygon clips such a
+ * wall's quad (whose vertical edges those planes cut at the same t at every
+ * height), then projected as clip_project projects its vertices. The fill rule
+ * therefore puts the wall's pixels, on every row it covers, in the columns
+ * [rast_first_sample(*xp), rast_first_sample(*xq)). Returns 0 if nothing is left. */
+int clip_wall_x(const view_xform *v, view_pt p, view_pt q, unsigned mask, int32_t *xp, int32_t *xq);
+
 /* Signed distance of a view point from one plane (>= 0 inside), in 18.14 * 2^8 units. */
 int64_t clip_distance(const view_xform *v, view_pt p, unsigned plane);
 

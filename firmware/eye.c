@@ -69,6 +69,15 @@ static int between(int32_t floor_h, int32_t ceil_h, int64_t z)
     return z - floor_h > EYE_MARGIN && (int64_t)ceil_h - z > EYE_MARGIN;
 }
 
+int eye_clearly_in_front(const view_xform *v, const scn_vertex *a, const scn_vertex *b)
+{
+    int64_t dx = fx_asr64((int64_t)b->x - a->x, 1), dy = fx_asr64((int64_t)b->y - a->y, 1);
+    int64_t ex = fx_asr64(v->cx - a->x, 3), ey = fx_asr64(v->cy - a->y, 3);
+    int64_t len = abs64(dx) + abs64(dy) + 2;
+    int64_t slack = len + abs64(ex) + abs64(ey) + EYE_WALL_MARGIN * len;
+    return dy * ex - dx * ey > slack;
+}
+
 /* 1 if the eye is inside the leaf's floor polygon or on its boundary
  * (counter-clockwise: inside is left of every edge). */
 static int holds(const scene *sc, const scn_leaf *f, int64_t x, int64_t y)

@@ -72,6 +72,60 @@ static inline int64_t fx_mul64(int64_t a, int32_t b, unsigned s)
     return fx_asr64(a * (int64_t)b, s);
 }
 
+/* FX_DIV32: 1 where a 64-bit divide is a library call (32-bit cores: the
+ * Cortex-M3's libgcc divide was 12% of its frame), so the per-frame divides
+ * whose quotient provably fits 32 bits go through fx_udiv64_32 and its two
+ * 32-bit hardware divides instead; 0 where the core divides 64 bits in one
+ * instruction. Either way the same quotients (docs/ranges.md). */
+#ifndef FX_DIV32
+#define FX_DIV32 (UINTPTR_MAX <= 0xFFFFFFFFu)
+#endif
+
+/* floor(n / d) for d > 0 and n < d * 2^32 (the quotient fits 32 bits), with two
+ * 32-bit divides (Knuth's algorithm D on 16-bit digits, Hacker's Delight
+ * divlu); *rem gets n - q * d. Outside the contract the result is unspecified
+ * but defined. */
+static inline uint32_t fx_udiv64_32(uint64_t n, uint32_t d, uint32_t *rem)
+{
+    uint32_t u1 = (uint32_t)(n >> 32), u0 = (uint32_t)n;
+    if (d == 0 || u1 >= d) { /* outside the contract */
+        *rem = 0;
+        return 0xFFFFFFFFu;
+    }
+    int s = __builtin_clz(d); /* normalise: the divisor's top bit set */
+    uint32_t v = d << s;
+    uint32_t vn1 = v >> 16, vn0 = v & 0xFFFFu;
+    uint32_t un32 = s ? (u1 << s) | (u0 >> (32 - s)) : u1;
+    uint32_t un10 = u0 << s;
+    uint32_t un1 = un10 >> 16, un0 = un10 & 0xFFFFu;
+    uint32_t q1 = un32 / vn1, rhat = un32 - q1 * vn1;
+    while (q1 >= 0x10000u || q1 * vn0 > ((rhat << 16) | un1)) {
+        q1--;
+        rhat += vn1;
+        if (rhat >= 0x10000u) break;
+    }
+    uint32_t un21 = (un32 << 16) + un1 - q1 * v;
+    uint32_t q0 = un21 / vn1;
+    rhat = un21 - q0 * vn1;
+    while (q0 >= 0x10000u || q0 * vn0 > ((rhat << 16) | un0)) {
+        q0--;
+        rhat += vn1;
+        if (rhat >= 0x10000u) break;
+    }
+    *rem = ((un21 << 16) + un0 - q0 * v) >> s;
+    return (q1 << 16) | q0;
+}
+
+/* floor(n / d) for d > 0 and |floor(n / d)| < 2^31 - 1, by fx_udiv64_32; *rem
+ * gets n - q * d, in [0, d). */
+static inline int32_t fx_floordiv64_32(int64_t n, uint32_t d, uint32_t *rem)
+{
+    if (n >= 0) return (int32_t)fx_udiv64_32((uint64_t)n, d, rem);
+    uint32_t r, q = fx_udiv64_32((uint64_t)0 - (uint64_t)n, d, &r); /* -n = q d + r */
+    *rem = r ? d - r : 0;
+    return r ? -(int32_t)q - 1 : -(int32_t)q;
+}
+
 /* floor(sqrt(v)) for any 64-bit v (bit-by-bit, no division). */
 uint64_t fx_isqrt64(uint64_t v);
 

@@ -32,6 +32,21 @@ int rast_edge_setup(rast_edge *e, int32_t xa, int32_t ya, int32_t xb, int32_t yb
     int64_t dx = (int64_t)xb - xa, dy = (int64_t)yb - ya;
 #if RAST_STEP_BITS == 0
     int64_t num = (((int64_t)row << 16) + 32768 - ya) * dx;
+#if FX_DIV32
+    /* docs/ranges.md: the first sample lies in [ya, yb), so |x| <= |dx| < 2^25;
+     * over more than one row's height, |step| < |dx| too */
+    if (dy > 65536) {
+        uint32_t r;
+        e->x = xa + fx_floordiv64_32(num, (uint32_t)dy, &r);
+        e->rem = (int32_t)r;
+        e->step = fx_floordiv64_32(dx * 65536, (uint32_t)dy, &r);
+        e->srem = (int32_t)r;
+        e->dy = (int32_t)dy;
+        e->row = (int16_t)row;
+        e->end_row = (int16_t)end;
+        return 1;
+    }
+#endif
     int64_t x = floor_div(num, dy);
     int64_t step = floor_div(dx * 65536, dy);
     e->x = (int32_t)(xa + x);

@@ -6,6 +6,8 @@
 #include "surfaces.h"
 
 #include "clip.h"
+#include "eye.h"
+#include "raster.h"
 #include "wide128.h"
 
 /* The polygon's vertices projected as they are, if every one is in front of the
@@ -61,12 +63,18 @@ static void wall_part(const view_xform *v, const scn_vertex *a, const scn_vertex
     emit(v, &p, mask, sink, colour, id, seg, st);
 }
 
-/* A wall with no opening hides everything behind it in the columns it covers.
- * The range it closes is one column narrower at each inner end than its 2-D
- * extent, so rounding can never close a column the wall does not fill. */
-static void close_columns(occ_columns *occ, int x0, int x1)
+/* A wall with no opening hides everything behind it in the columns it covers,
+ * whose other rows the floors, ceilings and walls in front of it fill. Those are
+ * exactly the columns the fill rule gives its vertical edges (clip_wall_x), so
+ * walls that meet at a vertex close neighbouring columns with no gap between. An
+ * eye on or next to the wall's line closes nothing. */
+static void close_columns(const view_xform *v, const scn_vertex *a, const scn_vertex *b, unsigned mask,
+                          occ_columns *occ)
 {
-    occ_close(occ, x0 > 0 ? x0 + 1 : 0, x1 < VIEW_W ? x1 - 1 : VIEW_W);
+    int32_t xa, xb;
+    if (!eye_clearly_in_front(v, a, b)) return;
+    if (!clip_wall_x(v, view_point(v, a->x, a->y, 0), view_point(v, b->x, b->y, 0), mask, &xa, &xb)) return;
+    occ_close(occ, rast_first_sample(xa), rast_first_sample(xb));
 }
 
 /* A sector's ceiling now: obj_ceil's rule, with its test of w made once per leaf
@@ -102,7 +110,7 @@ static void seg_parts(const scene *sc, const fx_t *ceil, const view_xform *v, ui
     const uint8_t *colour = l->color[g->side];
     if (!CFG_TWO_SIDED || back_index == SCN_NONE) {
         wall_part(v, a, b, front->floor_h, front_ceil, mask, sink, colour[SCN_PART_MIDDLE], id, gi, st);
-        if (occ) close_columns(occ, c0, c1);
+        if (occ) close_columns(v, a, b, mask, occ);
         return;
     }
     const scn_sector *back = &sc->sectors[back_index];
@@ -125,7 +133,7 @@ static void seg_parts(const scene *sc, const fx_t *ceil, const view_xform *v, ui
     /* closed door: no opening between the two sectors */
     int32_t top = back_ceil < front_ceil ? back_ceil : front_ceil;
     int32_t bottom = back->floor_h > front->floor_h ? back->floor_h : front->floor_h;
-    if (occ && top <= bottom) close_columns(occ, c0, c1);
+    if (occ && top <= bottom) close_columns(v, a, b, mask, occ);
 }
 
 /* The leaf polygon at height h. Seen from above (floor) a counter-clockwise map

@@ -20,11 +20,17 @@ static int32_t clamp32(int64_t v, int32_t hi)
     return v < 0 ? 0 : (v > hi ? hi : (int32_t)v);
 }
 
+int32_t view_project_x(view_pt p)
+{
+    int32_t z = p.z < VIEW_ZNEAR ? VIEW_ZNEAR : p.z;
+    return view_subpixel(clamp32(((int64_t)VIEW_CX << 16) + view_persp(p.x, z), VIEW_W_FX));
+}
+
 screen_pt view_project(const view_xform *v, view_pt p)
 {
     int32_t z = p.z < VIEW_ZNEAR ? VIEW_ZNEAR : p.z;
     screen_pt s;
-    s.x = view_subpixel(clamp32(((int64_t)VIEW_CX << 16) + view_persp(p.x, z), VIEW_W_FX));
+    s.x = view_project_x(p);
     s.y = view_subpixel(clamp32(((int64_t)(VIEW_CY + VIEW_LOOK(v)) << 16) - view_persp(p.y, z), VIEW_H_FX));
     return s;
 }

@@ -123,7 +123,8 @@ extern const uint32_t view_recip[1 << VIEW_RECIP_BITS];
 
 /* a * VIEW_FOCAL / z in 16.16 pixels, for 1 <= z < 2^31: the perspective divide
  * every projection goes through, so that the polygons and the column estimates
- * of occlusion.c see the same screen positions. */
+ * of occlusion.c see the same screen positions. Both clamp it to the screen; a
+ * quotient of 2^30 or more may come back as 2^30 (its sign kept). */
 static inline int64_t view_persp(int32_t a, int32_t z)
 {
 #if VIEW_RECIP_BITS
@@ -133,6 +134,13 @@ static inline int64_t view_persp(int32_t a, int32_t z)
     uint32_t m = b >= VIEW_RECIP_BITS ? (uint32_t)z >> (b - VIEW_RECIP_BITS) : (uint32_t)z << (VIEW_RECIP_BITS - b);
     int64_t r = view_recip[m - (1u << VIEW_RECIP_BITS)];
     return fx_asr64(fx_asr64((int64_t)a * r, 8) * VIEW_FOCAL, (unsigned)(7 + b));
+#elif FX_DIV32
+    /* A quotient of 2^30 or more is clamped off the screen by every caller
+     * (docs/ranges.md): stop it there, and divide the rest in 32 bits. */
+    uint64_t n = (uint64_t)(a < 0 ? -(int64_t)a : a) * ((uint64_t)VIEW_FOCAL << 16);
+    uint32_t r;
+    int64_t q = n >= (uint64_t)z << 30 ? (int64_t)1 << 30 : (int64_t)fx_udiv64_32(n, (uint32_t)z, &r);
+    return a < 0 ? -q : q;
 #else
     /* |a| < 2^31 and focal * 2^16 < 2^24: the product is below 2^55. */
     return (int64_t)a * ((int64_t)VIEW_FOCAL << 16) / z;
@@ -154,5 +162,8 @@ static inline int32_t view_subpixel(int32_t s)
 /* Project a view point with z >= VIEW_ZNEAR that lies inside the frustum; the
  * result is clamped to the screen rectangle [0,320] x [0,200] (16.16). */
 screen_pt view_project(const view_xform *v, view_pt p);
+
+/* view_project's x alone. */
+int32_t view_project_x(view_pt p);
 
 #endif

@@ -211,6 +211,7 @@ void hal_present(hal_present_mode m)
 {
     uint8_t *shown;
     const uint8_t *src;
+    hal_perf_fold(); /* the frame's span sums into the 64-bit totals */
     switch (m) {
     case HAL_PRESENT_FLIP:
         /* the page just drawn is the hidden one; show it. The next

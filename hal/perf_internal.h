@@ -23,7 +23,12 @@ void hal_perf_add_pixels(uint32_t count);
  * to dest, covering `pixels` pixels with `bytes` = n8 + 2 n16 + 4 n32 bytes (the
  * pixel count on a linear surface, a quarter of it or so on a planar one; the
  * caller knows it without the sum). The same totals as the separate calls, for
- * a fraction of the cost per span. */
+ * a fraction of the cost per span: kept in 32-bit sums until hal_perf_fold.
+ * Contract: pixels <= 320 (one clipped row) and n8 + n16 + n32 <= bytes <= pixels. */
 void hal_perf_add_span(int dest, uint32_t n8, uint32_t n16, uint32_t n32, uint32_t pixels, uint32_t bytes);
+
+/* Add the span sums to the 64-bit totals and the cycle count. hal_present calls
+ * it once per frame; every reader of the counters calls it first. */
+void hal_perf_fold(void);
 
 #endif

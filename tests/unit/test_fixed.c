@@ -100,6 +100,44 @@ static void test_floor_and_shift(void **state)
     assert_int_equal(fx_sat32(-((int64_t)1 << 40)), INT32_MIN);
 }
 
+/* The 32-bit long division (FX_DIV32 targets) against the 64-bit divide, over
+ * divisors of every size and quotients up to 2^32 - 1, both normalisation
+ * corrections included (divisors just above a power of two, dividends just
+ * below a multiple), and its signed floor form. */
+static void test_udiv64_32(void **state)
+{
+    (void)state;
+    uint64_t x = 0x9E3779B97F4A7C15ull;
+    for (uint32_t i = 0; i < 2000000; i++) {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        uint32_t d = (uint32_t)(x >> 32) >> (i % 32);
+        if (i % 5 == 0) d = (1u << (i % 32)) + (uint32_t)(i & 3u) - 1u;
+        if (d == 0) d = 1;
+        uint32_t q = (uint32_t)x >> ((i >> 5) % 32);
+        if (i % 7 == 0) q = 0xFFFFFFFFu - (i & 7u);
+        uint64_t r = (uint64_t)(x % d);
+        if (i % 3 == 0) r = d - 1u;
+        uint64_t n = (uint64_t)q * d + r; /* < d * 2^32 */
+        uint32_t got_r, got_q = fx_udiv64_32(n, d, &got_r);
+        if (got_q != n / d || got_r != n % d) fail_msg("%llu / %u: %u rem %u", (unsigned long long)n, d, got_q, got_r);
+        int64_t sn = (int64_t)(n >> 2) * ((i & 1u) ? -1 : 1);
+        if (d >= 2u && (uint64_t)(sn < 0 ? -sn : sn) / d < 0x7FFFFFFEu) {
+            int64_t want = sn / d - ((sn % (int64_t)d) < 0);
+            int32_t sq = fx_floordiv64_32(sn, d, &got_r);
+            if (sq != want || (int64_t)got_r != sn - want * (int64_t)d)
+                fail_msg("floor %lld / %u: %d rem %u", (long long)sn, d, sq, got_r);
+        }
+    }
+    uint32_t r;
+    assert_int_equal(fx_udiv64_32(0, 7, &r), 0);
+    assert_int_equal(fx_udiv64_32(0xFFFFFFFEFFFFFFFFull, 0xFFFFFFFFu, &r), 0xFFFFFFFFu); /* the largest quotient */
+    assert_int_equal(r, 0xFFFFFFFEu);
+    assert_int_equal(fx_udiv64_32((uint64_t)1 << 32, 1, &r), 0xFFFFFFFFu); /* outside the contract: defined */
+    assert_int_equal(fx_udiv64_32(5, 0, &r), 0xFFFFFFFFu);
+}
+
 static void test_trig(void **state)
 {
     (void)state;
@@ -149,7 +187,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_mul),    cmocka_unit_test(test_div),   cmocka_unit_test(test_recip),
-        cmocka_unit_test(test_floor_and_shift), cmocka_unit_test(test_trig), cmocka_unit_test(test_angles),
+        cmocka_unit_test(test_floor_and_shift), cmocka_unit_test(test_udiv64_32), cmocka_unit_test(test_trig), cmocka_unit_test(test_angles),
     };
     return cmocka_run_group_tests_name("fixed", tests, NULL, NULL);
 }

@@ -341,6 +341,34 @@ static void test_bus_model_cycles(void **state)
     assert_int_equal(hal_perf_event(HAL_EV_WRITES), 2ull * UINT32_MAX);
 }
 
+/* Spans are summed in 32 bits and folded into the 64-bit totals: a change of
+ * bus model or counter selection between spans, and more than 2^32 pixels with
+ * no read or present between, give what per-span 64-bit sums give. */
+static void test_span_sums_fold(void **state)
+{
+    (void)state;
+    hal_surface v = hal_begin_frame(HAL_PRESENT_FLIP);
+    hal_fill_span(&v, 0, 1, 10, 1); /* byte, word, dword, word, byte: 5 transactions */
+    hal_bus_model m = { 13, 3 };
+    hal_perf_set_bus(m);
+    hal_perf_select(0, HAL_EV_WRITES32);
+    hal_fill_span(&v, 1, 0, 320, 1); /* 80 dwords */
+    assert_int_equal(hal_perf_tsc(), 5u * 8u + 80u * 13u);
+    assert_int_equal(hal_perf_read(0), 80);
+    assert_int_equal(hal_perf_event(HAL_EV_WRITES), 85);
+    assert_int_equal(hal_perf_event(HAL_EV_PIXELS), 330);
+    hal_perf_set_bus(default_bus);
+    hal_perf_reset();
+    const uint64_t spans = 13500000; /* 320 pixels each: 4.32e9 > 2^32 */
+    for (uint64_t i = 0; i < spans; i++)
+        hal_perf_add_span(HAL_DEST_SYSMEM, 0, 0, 80, 320, 320);
+    assert_int_equal(hal_perf_event(HAL_EV_PIXELS), spans * 320u);
+    assert_int_equal(hal_perf_event(HAL_EV_BYTES), spans * 320u);
+    assert_int_equal(hal_perf_event(HAL_EV_WRITES32), spans * 80u);
+    assert_int_equal(hal_perf_event(HAL_EV_SYSMEM_WRITES), spans * 80u);
+    assert_int_equal(hal_perf_tsc(), spans * 80u);
+}
+
 static void test_flip_alternates_pages(void **state)
 {
     (void)state;
@@ -458,6 +486,7 @@ int main(void)
         cmocka_unit_test_setup(test_fill_span_clipping, setup),
         cmocka_unit_test_setup(test_programmable_counters, setup),
         cmocka_unit_test_setup(test_bus_model_cycles, setup),
+        cmocka_unit_test_setup(test_span_sums_fold, setup),
         cmocka_unit_test_setup(test_flip_alternates_pages, setup),
         cmocka_unit_test_setup(test_palette_round_trip, setup),
         cmocka_unit_test_setup(test_names, setup),
