@@ -55,8 +55,10 @@ static const world_state *world_of(const engine *e)
 void eng_render(engine *e, uint32_t *ids)
 {
     hal_surface surf = hal_begin_frame(e->present);
-    rast_target t = {&surf, ids};
+    hal_tally tally = {{0, 0, 0}, 0};
+    rast_target t = {&surf, ids, hal_surface_linear(&surf) ? &tally : 0};
     render_frame(&e->sc, world_of(e), &e->cam.view, e->mode, &t, &e->rwork, &e->stats);
+    if (t.tally) hal_add_tally(&surf, &tally);
     hal_present(e->present);
     e->frame++;
 }

@@ -5,14 +5,10 @@
  * compute the same x on every line, whichever renderer walks it. */
 #include "raster.h"
 
-void rast_span(const rast_target *t, int y, int x0, int x1, uint8_t colour, uint32_t id)
+void rast_ids(const rast_target *t, int y, int x0, int x1, uint32_t id)
 {
-    if (x1 <= x0) return;
-    hal_fill_span(t->surf, y, x0, x1 - x0, colour);
-    if (t->ids) {
-        uint32_t *row = t->ids + y * VIEW_W;
-        for (int x = x0; x < x1; x++) row[x] = id;
-    }
+    uint32_t *row = t->ids + y * VIEW_W;
+    for (int x = x0; x < x1; x++) row[x] = id;
 }
 
 /* Floor division for a positive divisor. */

@@ -12,7 +12,8 @@
 
 typedef struct {
     const hal_surface *surf;
-    uint32_t *ids; /* optional surface-id buffer, 320 x 200, or NULL */
+    uint32_t *ids;    /* optional surface-id buffer, 320 x 200, or NULL */
+    hal_tally *tally; /* a linear surface filled straight in, counted here (hal.h), or NULL: through hal_fill_span */
 } rast_target;
 
 /* Surface ids (DESIGN.md): kind << 24 | index. */
@@ -81,8 +82,17 @@ static inline void rast_edge_step(rast_edge *e)
     e->row++;
 }
 
-/* Draw one span [x0, x1) of row y in a colour, with its id. */
-void rast_span(const rast_target *t, int y, int x0, int x1, uint8_t colour, uint32_t id);
+void rast_ids(const rast_target *t, int y, int x0, int x1, uint32_t id);
+
+/* Draw one span [x0, x1) of row y (0 <= x0, x1 <= 320, 0 <= y < 200) in a
+ * colour, with its id. */
+static inline void rast_span(const rast_target *t, int y, int x0, int x1, uint8_t colour, uint32_t id)
+{
+    if (x1 <= x0) return;
+    if (t->tally) hal_fill_linear(t->surf, y, x0, x1 - x0, colour, t->tally);
+    else hal_fill_span(t->surf, y, x0, x1 - x0, colour);
+    if (t->ids) rast_ids(t, y, x0, x1, id);
+}
 
 /* Fill a convex polygon whose vertices run clockwise on screen (y down), inside
  * [0,320] x [0,200]. A polygon that winds the other way (seen from behind, or

@@ -80,45 +80,6 @@ hal_surface hal_begin_frame(hal_present_mode m)
     return s; /* unknown mode: pixels NULL, hal_fill_span ignores it */
 }
 
-/* Write n >= 1 bytes of one value from p: a byte to reach 2-alignment, a word
- * to reach 4-alignment, aligned dwords, then a word and a byte; adds the
- * transactions of each width to w[0..2]. Inlined into both callers, so the
- * counts stay in registers. */
-static inline __attribute__((always_inline)) void fill_run(uint8_t *p, uint32_t n, uint8_t colour, uint32_t w[3])
-{
-    uint16_t c16 = (uint16_t)(colour * 0x0101u);
-    uint32_t c32 = colour * 0x01010101u;
-    if (((uintptr_t)p & 1u) != 0) {
-        *(volatile uint8_t *)p = colour;
-        p += 1;
-        n -= 1;
-        w[0]++;
-    }
-    if (((uintptr_t)p & 2u) != 0 && n >= 2) {
-        *(volatile uint16_t *)(void *)p = c16;
-        p += 2;
-        n -= 2;
-        w[1]++;
-    }
-    uint32_t n32 = n >> 2;
-    volatile uint32_t *d = (volatile uint32_t *)(void *)p;
-    for (uint32_t i = 0; i < n32; i++)
-        d[i] = c32;
-    w[2] += n32;
-    p += n32 * 4u;
-    n &= 3u;
-    if (n >= 2) {
-        *(volatile uint16_t *)(void *)p = c16;
-        p += 2;
-        n -= 2;
-        w[1]++;
-    }
-    if (n != 0) {
-        *(volatile uint8_t *)p = colour;
-        w[0]++;
-    }
-}
-
 /* Pixels [x, x + len) of a planar row: 4-pixel groups, one byte each. A group
  * the span only partly covers is written alone with its pixels' planes; the
  * whole groups between are one run with every plane enabled. Kept out of
@@ -150,7 +111,7 @@ static __attribute__((noinline)) void fill_planar(uint8_t *row, uint32_t x, uint
     }
     if (g0 <= g1) {
         hal_target_plane_mask(0xFu);
-        fill_run(row + g0, g1 - g0 + 1u, colour, w);
+        hal_fill_run(row + g0, g1 - g0 + 1u, colour, w);
     }
     hal_perf_add_span(HAL_DEST_VRAM, w[0], w[1], w[2], len, w[0] + 2u * w[1] + 4u * w[2]);
 }
@@ -175,8 +136,15 @@ void hal_fill_span(const hal_surface *s, int y, int x, int len, uint8_t colour)
         return;
     }
     uint32_t w[3] = { 0, 0, 0 }; /* transactions of 1, 2 and 4 bytes */
-    fill_run(s->pixels + (uint32_t)y * HAL_WIDTH + (uint32_t)x, (uint32_t)len, colour, w);
+    hal_fill_run(s->pixels + (uint32_t)y * HAL_WIDTH + (uint32_t)x, (uint32_t)len, colour, w);
     hal_perf_add_span(s->in_vram ? HAL_DEST_VRAM : HAL_DEST_SYSMEM, w[0], w[1], w[2], (uint32_t)len, (uint32_t)len);
+}
+
+void hal_add_tally(const hal_surface *s, hal_tally *t)
+{
+    if (t->pixels)
+        hal_perf_add_span(s->in_vram ? HAL_DEST_VRAM : HAL_DEST_SYSMEM, t->w[0], t->w[1], t->w[2], t->pixels, t->pixels);
+    *t = (hal_tally){ { 0, 0, 0 }, 0 };
 }
 
 /* The copies: the system-memory buffer and the pages are 4-aligned and

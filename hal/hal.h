@@ -95,6 +95,72 @@ hal_surface hal_begin_frame(hal_present_mode m);
  * counts the bytes the processor wrote, the pixels event the pixels. */
 void hal_fill_span(const hal_surface *s, int y, int x, int len, uint8_t colour);
 
+/* Write n >= 1 bytes of one value from p: a byte to reach 2-alignment, a word
+ * to reach 4-alignment, aligned dwords, then a word and a byte; adds the
+ * transactions of each width to w[0..2]. Inlined into its callers, so the
+ * counts stay in registers. */
+static inline __attribute__((always_inline)) void hal_fill_run(uint8_t *p, uint32_t n, uint8_t colour, uint32_t w[3])
+{
+    uint16_t c16 = (uint16_t)(colour * 0x0101u);
+    uint32_t c32 = colour * 0x01010101u;
+    if (((uintptr_t)p & 1u) != 0) {
+        *(volatile uint8_t *)p = colour;
+        p += 1;
+        n -= 1;
+        w[0]++;
+    }
+    if (((uintptr_t)p & 2u) != 0 && n >= 2) {
+        *(volatile uint16_t *)(void *)p = c16;
+        p += 2;
+        n -= 2;
+        w[1]++;
+    }
+    uint32_t n32 = n >> 2;
+    volatile uint32_t *d = (volatile uint32_t *)(void *)p;
+    for (uint32_t i = 0; i < n32; i++)
+        d[i] = c32;
+    w[2] += n32;
+    p += n32 * 4u;
+    n &= 3u;
+    if (n >= 2) {
+        *(volatile uint16_t *)(void *)p = c16;
+        p += 2;
+        n -= 2;
+        w[1]++;
+    }
+    if (n != 0) {
+        *(volatile uint8_t *)p = colour;
+        w[0]++;
+    }
+}
+
+/* Spans filled straight into a linear surface, counted here and added to the
+ * counters at once (hal_add_tally): the renderer's fill loop pays no call and
+ * no 64-bit sum per span, and every counter ends as hal_fill_span would leave it. */
+typedef struct {
+    uint32_t w[3];   /* transactions of 1, 2 and 4 bytes */
+    uint32_t pixels; /* = bytes */
+} hal_tally;
+
+/* 1 if s can be filled with hal_fill_linear: a linear page or buffer. */
+static inline int hal_surface_linear(const hal_surface *s)
+{
+    return s->pixels != 0 && !s->planar;
+}
+
+/* Pixels [x, x + len) of row y of a linear surface, with the writes
+ * hal_fill_span makes, counted into t. The caller keeps 0 <= y < 200, 0 <= x,
+ * 1 <= len and x + len <= 320. */
+static inline __attribute__((always_inline)) void hal_fill_linear(const hal_surface *s, int y, int x, int len,
+                                                                 uint8_t colour, hal_tally *t)
+{
+    hal_fill_run(s->pixels + (uint32_t)y * HAL_WIDTH + (uint32_t)x, (uint32_t)len, colour, t->w);
+    t->pixels += (uint32_t)len;
+}
+
+/* Add what t counted for spans into s to the counters, and clear it. */
+void hal_add_tally(const hal_surface *s, hal_tally *t);
+
 /* Finish a frame: flip the display start to the drawn page, or copy the
  * system-memory buffer to the shown VRAM page with the chosen width (counted). */
 void hal_present(hal_present_mode m);
