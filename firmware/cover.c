@@ -77,8 +77,10 @@ static inline void close_words(cov_mask *m, int y, uint32_t full)
     if (!m->open[y]) m->full_rows++;
 }
 
-uint32_t cov_fill(cov_mask *m, const rast_target *t, int y, int x0, int x1, const uint32_t *keep, uint8_t colour,
-                  uint32_t id)
+/* cov_fill's work, inlined into it and into cov_fill_rows' loop. */
+static inline __attribute__((always_inline)) uint32_t fill_row(cov_mask *m, const rast_target *t, int y, int x0,
+                                                                int x1, const uint32_t *keep, uint8_t colour,
+                                                                uint32_t id)
 {
     x0 = clamp_w(x0);
     x1 = clamp_w(x1);
@@ -139,5 +141,20 @@ uint32_t cov_fill(cov_mask *m, const rast_target *t, int y, int x0, int x1, cons
     }
     if (run1 > run0) rast_span(t, y, run0, run1, colour, id);
     close_words(m, y, full);
+    return drawn;
+}
+
+uint32_t cov_fill(cov_mask *m, const rast_target *t, int y, int x0, int x1, const uint32_t *keep, uint8_t colour,
+                  uint32_t id)
+{
+    return fill_row(m, t, y, x0, x1, keep, colour, id);
+}
+
+uint32_t cov_fill_rows(cov_mask *m, const rast_target *t, int top, int bottom, const int16_t *lo, const int16_t *hi,
+                       uint8_t colour, uint32_t id)
+{
+    uint32_t drawn = 0;
+    for (int y = top; y < bottom; y++)
+        if (lo[y] < hi[y]) drawn += fill_row(m, t, y, lo[y], hi[y], 0, colour, id);
     return drawn;
 }

@@ -473,8 +473,7 @@ static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, 
         for (int y = top; y < bottom; y++)
             if (lo[y] < hi[y]) drawn += fill_row_behind_objects(S, y, lo[y], hi[y], &world, colour, id);
     } else {
-        for (int y = top; y < bottom; y++)
-            if (lo[y] < hi[y]) drawn += cov_fill(&S->cov, S->t, y, lo[y], hi[y], 0, colour, id);
+        drawn = cov_fill_rows(&S->cov, S->t, top, bottom, lo, hi, colour, id);
     }
     if (!drawn) S->st->occluded++; else S->st->surfaces_drawn++;
 }
