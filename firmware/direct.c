@@ -16,6 +16,9 @@
 #define DIRECT_FACE_POOL CFG_DIRECT_FACES
 #define DIRECT_EDGE_POOL CFG_DIRECT_EDGES
 #define FACE_EDGES CLIP_MAX_VERTS /* a clipped face's edges */
+/* Depths farther apart than this decide "in front" everywhere along every ray
+ * the two share: view depth grows along a ray, and objd_front's ties are closer. */
+#define DEPTH_APART (2 * OBJ_TIE_EPS)
 
 typedef struct {
     rast_edge e;     /* set up at its first row; stepped to any row by edge_x */
@@ -28,6 +31,7 @@ typedef struct {
     uint16_t first_edge; /* into the edge pool (or the scratch face's own) */
     uint8_t nedges, colour;
     uint32_t obj, model_face; /* whose face it is: the object, and the face in the scene's faces */
+    int32_t zmin, zmax;       /* the view depths of its vertices */
 } dr_face;
 
 typedef struct {
@@ -148,6 +152,13 @@ static int face_build(const dr_state *S, const dr_obj *o, const view_pt *verts, 
     f->top = (int16_t)top;
     f->bottom = (int16_t)bottom;
     f->nedges = (uint8_t)ne;
+    const uint32_t *ix = &sc->findex[sc->faces[fi].first_index];
+    f->zmin = INT32_MAX;
+    f->zmax = INT32_MIN;
+    for (uint32_t k = 0; k < sc->faces[fi].num_index; k++) {
+        if (verts[ix[k]].z < f->zmin) f->zmin = verts[ix[k]].z;
+        if (verts[ix[k]].z > f->zmax) f->zmax = verts[ix[k]].z;
+    }
     f->colour = sc->faces[fi].colour;
     f->obj = o->index;
     f->model_face = fi;
@@ -188,15 +199,16 @@ static void activate(dr_state *S, dr_obj *o)
     uint32_t nf = 0, ne = S->nedges, stored = 1;
     objd_transform(sc, &S->w->objs[o->index], S->v, verts);
     for (uint32_t fi = m->first_face; fi < m->first_face + m->num_faces; fi++) {
-        int room = stored && S->nfaces + nf < DIRECT_FACE_POOL && ne + FACE_EDGES <= DIRECT_EDGE_POOL;
-        dr_face *f = room ? &S->faces[S->nfaces + nf] : &S->scratch_face;
-        dr_edge *e = room ? &S->edges[ne] : S->scratch_edges;
-        if (!face_build(S, o, verts, fi, f, e, box)) continue;
-        if (room) {
+        dr_face *f = &S->scratch_face;
+        if (!face_build(S, o, verts, fi, f, S->scratch_edges, box)) continue;
+        /* into the pools if the face and its own edges fit */
+        stored &= (uint32_t)(S->nfaces + nf < DIRECT_FACE_POOL && ne + f->nedges <= DIRECT_EDGE_POOL);
+        if (stored) {
             f->first_edge = (uint16_t)ne;
+            for (int i = 0; i < f->nedges; i++) S->edges[ne + (uint32_t)i] = S->scratch_edges[i];
+            S->faces[S->nfaces + nf] = *f;
             ne += f->nedges;
         }
-        stored &= (uint32_t)room;
         nf++;
     }
     o->nfaces = (uint8_t)nf;
@@ -322,8 +334,9 @@ static void keep_nearer_face(dr_state *S, dr_obj *o, const dr_face *g, const dr_
     if (!face_row(g, edges, k->y, &a, &b)) return;
     if (a < k->x0) a = k->x0;
     if (b > k->x1) b = k->x1;
-    if (a >= b) return;
-    mark_in_front(k->keep, &g->pl, 1 + (int)g->obj, &k->self->pl, 1 + (int)k->self->obj, VIEW_LOOK(S->v), k->y, a, b);
+    if (a >= b || g->zmin > k->self->zmax + DEPTH_APART) return; /* g lies wholly behind */
+    if (g->zmax + DEPTH_APART < k->self->zmin) cov_line_set(k->keep, a, b); /* wholly in front */
+    else mark_in_front(k->keep, &g->pl, 1 + (int)g->obj, &k->self->pl, 1 + (int)k->self->obj, VIEW_LOOK(S->v), k->y, a, b);
 }
 
 /* Fill [a, b) of row y with face (a copy: looking at the other faces may rebuild
@@ -368,8 +381,10 @@ static void draw_objects(dr_state *S)
 
 typedef struct {
     const objd_plane *world; /* the world surface of the row */
+    int32_t zmin, zmax;      /* and the view depths it spans */
     int y, x0, x1;
 } row_ctx;
+
 
 /* During the walk: fill face f on a world row where it is nearer than the world
  * surface (and the nearest of the active faces). */
@@ -381,8 +396,10 @@ static void draw_face_over_world(dr_state *S, dr_obj *o, const dr_face *f, const
     if (a < k->x0) a = k->x0;
     if (b > k->x1) b = k->x1;
     if (a >= b || cov_all(&S->cov, k->y, a, b)) return; /* nothing of it left to decide */
+    if (k->zmax + DEPTH_APART < f->zmin) return; /* the world surface is nearer all over */
     uint32_t mine[COV_WORDS] = {0};
-    mark_in_front(mine, &f->pl, 1 + (int)f->obj, k->world, 0, VIEW_LOOK(S->v), k->y, a, b);
+    if (k->zmin > f->zmax + DEPTH_APART) cov_line_set(mine, a, b); /* the face is nearer all over */
+    else mark_in_front(mine, &f->pl, 1 + (int)f->obj, k->world, 0, VIEW_LOOK(S->v), k->y, a, b);
     uint32_t any = 0;
     for (int w = 0; w < COV_WORDS; w++) any |= mine[w];
     if (!any) return;
@@ -418,10 +435,10 @@ static int objects_meet(const dr_state *S, int x0, int x1, int y0, int y1)
  * surface, the pixel is the objects', and the nearest active face fills it now.
  * No object met later can be nearer there: it lies in leaves the walk reaches
  * later, behind this surface. The world surface fills the rest. */
-static uint32_t fill_row_behind_objects(dr_state *S, int y, int x0, int x1, const objd_plane *world, uint8_t colour,
-                                        uint32_t id)
+static uint32_t fill_row_behind_objects(dr_state *S, int y, int x0, int x1, const objd_plane *world, int32_t zmin,
+                                        int32_t zmax, uint8_t colour, uint32_t id)
 {
-    row_ctx k = {world, y, x0, x1};
+    row_ctx k = {world, zmin, zmax, y, x0, x1};
     for (uint32_t i = 0; i < S->nactive; i++) {
         dr_obj *o = &S->objs[S->active[i]];
         if (o->y0 <= y && o->y1 > y && o->x0 < x1 && o->x1 > x0) each_face(S, o, draw_face_over_world, &k);
@@ -430,7 +447,8 @@ static uint32_t fill_row_behind_objects(dr_state *S, int y, int x0, int x1, cons
 }
 
 
-static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id, uint32_t seg)
+static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id, uint32_t seg,
+                        int32_t zmin, int32_t zmax)
 {
     dr_state *S = ctx;
     int32_t xmin = INT32_MAX, xmax = INT32_MIN, ymin = INT32_MAX, ymax = INT32_MIN;
@@ -471,7 +489,7 @@ static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, 
         objd_plane world;
         world_plane(S, id, seg, &world);
         for (int y = top; y < bottom; y++)
-            if (lo[y] < hi[y]) drawn += fill_row_behind_objects(S, y, lo[y], hi[y], &world, colour, id);
+            if (lo[y] < hi[y]) drawn += fill_row_behind_objects(S, y, lo[y], hi[y], &world, zmin, zmax, colour, id);
     } else {
         drawn = cov_fill_rows(&S->cov, S->t, top, bottom, lo, hi, colour, id);
     }

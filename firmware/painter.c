@@ -47,9 +47,12 @@ uint32_t painter_work_bytes(const scene *s, const world_state *w)
     return (uint32_t)(2u * (uint64_t)n * sizeof(pt_order));
 }
 
-static void fill_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id, uint32_t seg)
+static void fill_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id, uint32_t seg,
+                         int32_t zmin, int32_t zmax)
 {
     (void)seg;
+    (void)zmin;
+    (void)zmax;
     const painter *p = ctx;
     rast_convex(p->t, pts, n, colour, id);
 }

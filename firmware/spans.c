@@ -239,8 +239,11 @@ static sp_surf *add_surface(span_state *S, const screen_pt *pts, int n, uint8_t 
 
 static void draw_batch(span_state *S, int final);
 
-static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id, uint32_t seg)
+static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id, uint32_t seg,
+                        int32_t zmin, int32_t zmax)
 {
+    (void)zmin;
+    (void)zmax;
     span_state *S = ctx;
     if (box_covered(S, pts, n)) {
         S->st->occluded++;

@@ -38,7 +38,12 @@ static void emit(const view_xform *v, clip_poly *p, unsigned mask, const surf_si
     if (!(p->cut & (CLIP_TOP | CLIP_BOTTOM))) st->yclip_skipped++;
     if (!projected || p->cut) clip_project(v, p, s);
     st->polygons++;
-    sink->polygon(sink->ctx, s, p->n, colour, id, seg);
+    int32_t zmin = p->v[0].z, zmax = p->v[0].z;
+    for (int i = 1; i < p->n; i++) {
+        if (p->v[i].z < zmin) zmin = p->v[i].z;
+        if (p->v[i].z > zmax) zmax = p->v[i].z;
+    }
+    sink->polygon(sink->ctx, s, p->n, colour, id, seg, zmin, zmax);
 }
 
 /* Front-facing: the eye strictly on the right of a -> b (edge-on is culled).
