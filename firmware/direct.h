@@ -9,13 +9,16 @@
  * walls close screen columns as in the other modes (occlusion.h), and the walk
  * stops when every column is closed or every line is full.
  *
- * Objects (docs/objects.md). The objects in view are listed before the walk.
- * An object becomes active when the walk reaches the first leaf its box
- * touches: from then on, every world polygon row leaves alone the pixels where
- * one of the active objects' faces is nearer (1/z, obj_draw.h's objd_front), and
- * after the walk the faces fill what is still free, nearest face first at each
- * pixel. World surfaces reached before the object's first leaf are in front of
- * it by the tree's order; those after it are sorted against it by 1/z.
+ * Objects (docs/objects.md). The objects in view are listed before the walk,
+ * sorted by the west edges of their boxes. An object becomes active when the
+ * walk reaches the first leaf its box touches (unless it is already hidden
+ * there): from then on, on every world polygon row the nearest active face
+ * takes the pixels where a face is nearer than the world surface (1/z,
+ * obj_draw.h's objd_front), at once, since nothing the walk reaches later can
+ * be nearer there; after the walk the faces fill what is still free, the
+ * nearest face at each pixel. World surfaces reached before the object's first
+ * leaf are in front of it by the tree's order; those after it are sorted
+ * against it by 1/z.
  *
  * Memory: a fixed part bounded by the screen (the mask, closed columns) and a
  * part per object of the world state (at most every object is in view), plus
