@@ -24,6 +24,7 @@ typedef struct {
     int32_t depth; /* view z of the origin (objects) or the centroid (faces) */
     uint32_t index;
     uint32_t leaf; /* objects: that leaf */
+    int32_t left;  /* objects: the west edge of the box, whole units (the first walk's order) */
 } pt_order;
 
 typedef struct {
@@ -37,11 +38,12 @@ typedef struct {
     uint32_t nobjs, at;
     uint32_t visits;      /* first walk: leaves visited so far */
     uint32_t unplaced;    /* first walk: objects whose leaf is not found yet */
+    int32_t reach;        /* first walk: the widest box, whole units */
 } painter;
 
 uint32_t painter_work_bytes(const scene *s, const world_state *w)
 {
-    /* the objects' order and a merge buffer: 2 * 4096 * 16 bytes at most */
+    /* the objects' order and a merge buffer: 2 * 4096 * 20 bytes at most */
     (void)s;
     uint32_t n = (CFG_OBJECTS && w && w->objs) ? w->n : 0;
     return (uint32_t)(2u * (uint64_t)n * sizeof(pt_order));
@@ -60,7 +62,9 @@ static void fill_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour,
 static void draw_object(const scene *sc, uint32_t i, const obj_state *o, const view_xform *v, const rast_target *t,
                         render_stats *st);
 
-/* First walk, front to back: each object's nearest leaf is the first it touches. */
+/* First walk, front to back: each object's nearest leaf is the first it touches.
+ * The objects are in west-edge order, so a leaf looks only at those whose boxes
+ * can reach its west-east extent. */
 static int place_objects(void *ctx, uint32_t leaf, unsigned clip_mask)
 {
     painter *p = ctx;
@@ -69,7 +73,15 @@ static int place_objects(void *ctx, uint32_t leaf, unsigned clip_mask)
     int32_t box[4];
     objd_leaf_box(p->sc, f, box);
     p->visits++;
-    for (uint32_t k = 0; k < p->nobjs && p->unplaced; k++) {
+    if (box[0] > box[2]) return 0;
+    int32_t west = (box[0] >> 16) - 2 * p->reach - 1, east = box[2] >> 16;
+    uint32_t lo = 0, hi = p->nobjs;
+    while (lo < hi) { /* the first object whose west edge is at or east of west */
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (p->objs[mid].left < west) lo = mid + 1;
+        else hi = mid;
+    }
+    for (uint32_t k = lo; k < p->nobjs && p->objs[k].left <= east; k++) {
         pt_order *o = &p->objs[k];
         if (o->key || !objd_touches_leaf(p->sc, &p->w->objs[o->index], f, box)) continue;
         o->key = p->visits;
@@ -100,13 +112,20 @@ static int before(const pt_order *a, const pt_order *b)
     return a->depth != b->depth ? a->depth > b->depth : a->index < b->index;
 }
 
-static void sort_far_first(pt_order *a, pt_order *tmp, uint32_t n)
+/* The first walk's order: by the boxes' west edges. */
+static int west_of(const pt_order *a, const pt_order *b)
+{
+    return a->left < b->left;
+}
+
+/* Merge sort, stable: b goes before a where less(b, a). */
+static void sort_by(pt_order *a, pt_order *tmp, uint32_t n, int (*less)(const pt_order *, const pt_order *))
 {
     for (uint32_t width = 1; width < n; width *= 2) {
         for (uint32_t lo = 0; lo < n; lo += 2 * width) {
             uint32_t mid = lo + width < n ? lo + width : n, hi = lo + 2 * width < n ? lo + 2 * width : n;
             uint32_t i = lo, j = mid, k = lo;
-            while (i < mid && j < hi) tmp[k++] = before(&a[j], &a[i]) ? a[j++] : a[i++];
+            while (i < mid && j < hi) tmp[k++] = less(&a[j], &a[i]) ? a[j++] : a[i++];
             while (i < mid) tmp[k++] = a[i++];
             while (j < hi) tmp[k++] = a[j++];
         }
@@ -163,15 +182,18 @@ void painter_render(const scene *sc, const world_state *w, const view_xform *v, 
         for (uint32_t i = 0; i < nobj; i++) {
             const obj_state *o = &w->objs[i];
             if (o->model >= sc->nmodels || !objd_in_view(sc, o, v)) continue;
-            order[n++] = (pt_order){0, objd_depth(o, v), i, 0};
+            int32_t r = (sc->models[o->model].radius >> 16) + 1; /* whole units, rounded up */
+            if (r > p.reach) p.reach = r;
+            order[n++] = (pt_order){0, objd_depth(o, v), i, 0, (int32_t)((o->x >> 16) - r)};
         }
+        sort_by(order, tmp, n, west_of);
         p.objs = order;
         p.nobjs = p.unplaced = n;
         if (n) walk_tree(sc, v, WALK_FRONT_TO_BACK, place_objects, &p, 0, &ws);
         uint32_t placed = 0; /* objects in no visited leaf are not drawn */
         for (uint32_t k = 0; k < n; k++)
             if (order[k].key) order[placed++] = order[k];
-        sort_far_first(order, tmp, placed);
+        sort_by(order, tmp, placed, before);
         st->objects_visible = placed;
         p.nobjs = placed;
     }
