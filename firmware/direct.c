@@ -188,6 +188,36 @@ static void each_face(dr_state *S, dr_obj *o, face_visit visit, void *ctx)
             visit(S, o, &S->scratch_face, S->scratch_edges, ctx);
 }
 
+/* Room in the pools: an active object whose screen box is wholly drawn can show
+ * nothing more, so it leaves the active list and its faces leave the pools; the
+ * faces of the others are packed down (the list is in the pools' order). */
+static void reclaim(dr_state *S)
+{
+    uint32_t na = 0, nf = 0, ne = 0;
+    for (uint32_t i = 0; i < S->nactive; i++) {
+        dr_obj *o = &S->objs[S->active[i]];
+        if (cov_box_covered(&S->cov, o->y0, o->y1, o->x0, o->x1)) {
+            o->nfaces = 0;
+            o->stored = 0;
+            continue;
+        }
+        S->active[na++] = S->active[i];
+        if (!o->stored) continue;
+        for (uint32_t k = 0; k < o->nfaces; k++) {
+            dr_face f = S->faces[o->first_face + k];
+            for (int e = 0; e < f.nedges; e++) S->edges[ne + (uint32_t)e] = S->edges[f.first_edge + (uint32_t)e];
+            f.first_edge = (uint16_t)ne;
+            ne += f.nedges;
+            S->faces[nf + k] = f;
+        }
+        o->first_face = (uint16_t)nf;
+        nf += o->nfaces;
+    }
+    S->nactive = na;
+    S->nfaces = nf;
+    S->nedges = ne;
+}
+
 /* The object's faces into the pools if they fit (else it is worked out again
  * where needed), and its screen box. */
 static void activate(dr_state *S, dr_obj *o)
@@ -201,7 +231,12 @@ static void activate(dr_state *S, dr_obj *o)
     for (uint32_t fi = m->first_face; fi < m->first_face + m->num_faces; fi++) {
         dr_face *f = &S->scratch_face;
         if (!face_build(S, o, verts, fi, f, S->scratch_edges, box)) continue;
-        /* into the pools if the face and its own edges fit */
+        /* into the pools if the face and its own edges fit, after making room if
+         * the first face does not */
+        if (nf == 0 && !(S->nfaces < DIRECT_FACE_POOL && ne + f->nedges <= DIRECT_EDGE_POOL)) {
+            reclaim(S);
+            ne = S->nedges;
+        }
         stored &= (uint32_t)(S->nfaces + nf < DIRECT_FACE_POOL && ne + f->nedges <= DIRECT_EDGE_POOL);
         if (stored) {
             f->first_edge = (uint16_t)ne;
@@ -351,7 +386,10 @@ static void draw_face_row(dr_state *S, dr_obj *o, const dr_face *face, int y, in
         dr_obj *p = &S->objs[S->active[i]];
         if (p->y0 <= y && p->y1 > y && p->x0 < b && p->x1 > a) each_face(S, p, keep_nearer_face, &k);
     }
-    if (cov_fill(&S->cov, S->t, y, a, b, keep, face->colour, RAST_ID(RAST_KIND_OBJECT, o->index))) o->drew = 1;
+    if (cov_fill(&S->cov, S->t, y, a, b, keep, face->colour, RAST_ID(RAST_KIND_OBJECT, o->index)) && !o->drew) {
+        o->drew = 1;
+        S->st->objects_visible++;
+    }
 }
 
 /* After the walk: fill face f's rows where they are still free. */
@@ -368,15 +406,11 @@ static void draw_face(dr_state *S, dr_obj *o, const dr_face *f, const dr_edge *e
     S->st->object_faces++;
 }
 
-/* Every active object's faces, where still free after the walk. An object
- * counts as visible when it wrote a pixel, then or during the walk. */
+/* Every active object's faces, where still free after the walk. (An object
+ * counts as visible once it writes a pixel, then or during the walk.) */
 static void draw_objects(dr_state *S)
 {
-    for (uint32_t i = 0; i < S->nactive; i++) {
-        dr_obj *o = &S->objs[S->active[i]];
-        each_face(S, o, draw_face, 0);
-        if (o->drew) S->st->objects_visible++;
-    }
+    for (uint32_t i = 0; i < S->nactive; i++) each_face(S, &S->objs[S->active[i]], draw_face, 0);
 }
 
 typedef struct {
