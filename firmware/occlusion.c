@@ -69,9 +69,8 @@ static int column(int32_t sx)
 
 /* Clip the view-space segment p -> q (x, z) to near, left and right with the
  * parametric form; t in 2.30. Returns 0 if nothing is left. */
-int occ_seg_columns(const view_xform *v, int32_t ax, int32_t ay, int32_t bx, int32_t by, int *x0, int *x1)
+int occ_seg_columns(view_pt p, view_pt q, int *x0, int *x1)
 {
-    view_pt p = view_point(v, ax, ay, 0), q = view_point(v, bx, by, 0);
     int64_t t0 = 0, t1 = (int64_t)1 << 30;
     /* plane distances d = A*x + B*z + C for near (z - zn), left (z + x), right (z - x) */
     int64_t dp[3] = {(int64_t)p.z - VIEW_ZNEAR, (int64_t)p.z + p.x, (int64_t)p.z - p.x};

@@ -24,9 +24,10 @@ int occ_full(const occ_columns *o);
 int occ_hidden(const occ_columns *o, int x0, int x1);
 void occ_close(occ_columns *o, int x0, int x1);
 
-/* Columns a map segment a -> b can cover on screen, conservatively (may be wider
- * than the truth). Returns 0 if the segment is wholly outside the view. */
-int occ_seg_columns(const view_xform *v, int32_t ax, int32_t ay, int32_t bx, int32_t by, int *x0, int *x1);
+/* Columns a map segment a -> b, given in view space (its x and z), can cover on
+ * screen, conservatively (may be wider than the truth). Returns 0 if the segment
+ * is wholly outside the view. */
+int occ_seg_columns(view_pt p, view_pt q, int *x0, int *x1);
 
 /* Columns a bounding box (top, bottom, left, right) can cover, conservatively. */
 void occ_box_columns(const view_xform *v, const int32_t box[4], int *x0, int *x1);

@@ -54,17 +54,18 @@ static int faces_eye(const view_xform *v, const scn_vertex *a, const scn_vertex 
     return w128_sign_diff((int64_t)b->x - a->x, v->cy - a->y, (int64_t)b->y - a->y, v->cx - a->x) < 0;
 }
 
-static void wall_part(const view_xform *v, const scn_vertex *a, const scn_vertex *b, int32_t bottom, int32_t top,
-                      unsigned mask, const surf_sink *sink, uint8_t colour, uint32_t id, uint32_t seg,
-                      render_stats *st)
+/* The wall between view points a and b (rotated once per seg) from height
+ * bottom to top. */
+static void wall_part(const view_xform *v, view_pt a, view_pt b, int32_t bottom, int32_t top, unsigned mask,
+                      const surf_sink *sink, uint8_t colour, uint32_t id, uint32_t seg, render_stats *st)
 {
     if (top <= bottom) return;
     clip_poly p;
     p.n = 4;
-    p.v[0] = view_point(v, a->x, a->y, top);
-    p.v[1] = view_point(v, b->x, b->y, top);
-    p.v[2] = view_point(v, b->x, b->y, bottom);
-    p.v[3] = view_point(v, a->x, a->y, bottom);
+    p.v[0] = view_at_height(v, a, top);
+    p.v[1] = view_at_height(v, b, top);
+    p.v[2] = view_at_height(v, b, bottom);
+    p.v[3] = view_at_height(v, a, bottom);
     emit(v, &p, mask, sink, colour, id, seg, st);
 }
 
@@ -73,12 +74,12 @@ static void wall_part(const view_xform *v, const scn_vertex *a, const scn_vertex
  * exactly the columns the fill rule gives its vertical edges (clip_wall_x), so
  * walls that meet at a vertex close neighbouring columns with no gap between. An
  * eye on or next to the wall's line closes nothing. */
-static void close_columns(const view_xform *v, const scn_vertex *a, const scn_vertex *b, unsigned mask,
-                          occ_columns *occ)
+static void close_columns(const view_xform *v, const scn_vertex *a, const scn_vertex *b, view_pt pa, view_pt pb,
+                          unsigned mask, occ_columns *occ)
 {
     int32_t xa, xb;
     if (!eye_clearly_in_front(v, a, b)) return;
-    if (!clip_wall_x(v, view_point(v, a->x, a->y, 0), view_point(v, b->x, b->y, 0), mask, &xa, &xb)) return;
+    if (!clip_wall_x(v, view_at_height(v, pa, 0), view_at_height(v, pb, 0), mask, &xa, &xb)) return;
     occ_close(occ, rast_first_sample(xa), rast_first_sample(xb));
 }
 
@@ -99,9 +100,10 @@ static void seg_parts(const scene *sc, const fx_t *ceil, const view_xform *v, ui
         st->culled++;
         return;
     }
+    view_pt pa = view_point(v, a->x, a->y, 0), pb = view_point(v, b->x, b->y, 0); /* once for every part */
     int c0 = 0, c1 = VIEW_W;
     if (occ) {
-        if (!occ_seg_columns(v, a->x, a->y, b->x, b->y, &c0, &c1) ||
+        if (!occ_seg_columns(pa, pb, &c0, &c1) ||
             occ_hidden(occ, c0 > 0 ? c0 - 1 : 0, c1 < VIEW_W ? c1 + 1 : VIEW_W)) {
             st->occluded++;
             return;
@@ -114,8 +116,8 @@ static void seg_parts(const scene *sc, const fx_t *ceil, const view_xform *v, ui
     uint32_t id = RAST_ID(RAST_KIND_WALL, g->line * 2u + g->side);
     const uint8_t *colour = l->color[g->side];
     if (!CFG_TWO_SIDED || back_index == SCN_NONE) {
-        wall_part(v, a, b, front->floor_h, front_ceil, mask, sink, colour[SCN_PART_MIDDLE], id, gi, st);
-        if (occ) close_columns(v, a, b, mask, occ);
+        wall_part(v, pa, pb, front->floor_h, front_ceil, mask, sink, colour[SCN_PART_MIDDLE], id, gi, st);
+        if (occ) close_columns(v, a, b, pa, pb, mask, occ);
         return;
     }
     const scn_sector *back = &sc->sectors[back_index];
@@ -126,35 +128,30 @@ static void seg_parts(const scene *sc, const fx_t *ceil, const view_xform *v, ui
          * sky. The step is drawn as the front sector's sky ceiling, so the view
          * through it has no hole. */
         if (CFG_SKY && (front->flags & back->flags & SCN_SECTOR_SKY))
-            wall_part(v, a, b, low, front_ceil, mask, sink, front->ceil_color,
+            wall_part(v, pa, pb, low, front_ceil, mask, sink, front->ceil_color,
                       RAST_ID(RAST_KIND_CEILING, front_index), gi, st);
         else
-            wall_part(v, a, b, low, front_ceil, mask, sink, colour[SCN_PART_UPPER], id, gi, st);
+            wall_part(v, pa, pb, low, front_ceil, mask, sink, colour[SCN_PART_UPPER], id, gi, st);
     }
     if (CFG_HEIGHTS && back->floor_h > front->floor_h) {
         int32_t high = back->floor_h < front_ceil ? back->floor_h : front_ceil;
-        wall_part(v, a, b, front->floor_h, high, mask, sink, colour[SCN_PART_LOWER], id, gi, st);
+        wall_part(v, pa, pb, front->floor_h, high, mask, sink, colour[SCN_PART_LOWER], id, gi, st);
     }
     /* closed door: no opening between the two sectors */
     int32_t top = back_ceil < front_ceil ? back_ceil : front_ceil;
     int32_t bottom = back->floor_h > front->floor_h ? back->floor_h : front->floor_h;
-    if (occ && top <= bottom) close_columns(v, a, b, mask, occ);
+    if (occ && top <= bottom) close_columns(v, a, b, pa, pb, mask, occ);
 }
 
 /* The leaf polygon at height h. Seen from above (floor) a counter-clockwise map
  * polygon runs counter-clockwise on screen, so floors are emitted reversed;
  * seen from below (ceiling) it runs clockwise as stored. */
-static void plane(const scene *sc, const view_xform *v, const scn_leaf *f, int32_t h, int reverse, unsigned mask,
+static void plane(const view_xform *v, const view_pt *pts, uint32_t n, int32_t h, int reverse, unsigned mask,
                   const surf_sink *sink, uint8_t colour, uint32_t id, render_stats *st)
 {
     clip_poly p;
-    uint32_t n = f->num_pverts;
-    if (n < 3 || n > CLIP_MAX_VERTS - 5) return; /* degenerate; the loader refuses more than the build's */
     p.n = (int)n;
-    for (uint32_t i = 0; i < n; i++) {
-        const scn_vertex *q = &sc->pverts[f->first_pvert + (reverse ? n - 1 - i : i)];
-        p.v[i] = view_point(v, q->x, q->y, h);
-    }
+    for (uint32_t i = 0; i < n; i++) p.v[i] = view_at_height(v, pts[reverse ? n - 1 - i : i], h);
     emit(v, &p, mask, sink, colour, id, SCN_NONE, st);
 }
 
@@ -166,16 +163,21 @@ void surf_leaf(const scene *sc, const world_state *w, const view_xform *v, uint3
     st->leaves++;
     if (f->sector != SCN_NONE) {
         const scn_sector *sec = &sc->sectors[f->sector];
-        /* a floor or ceiling seen edge-on or from behind: no plane work at all */
-        if (v->cz > sec->floor_h)
-            plane(sc, v, f, sec->floor_h, 1, mask, sink, sec->floor_color, RAST_ID(RAST_KIND_FLOOR, f->sector), st);
-        else
-            st->planes_skipped++;
         int32_t top = ceil_now(sc, ceil, f->sector);
-        if (v->cz < top)
-            plane(sc, v, f, top, 0, mask, sink, sec->ceil_color, RAST_ID(RAST_KIND_CEILING, f->sector), st);
-        else
-            st->planes_skipped++;
+        int floor = v->cz > sec->floor_h, ceiling = v->cz < top; /* edge-on or from behind: no plane work */
+        st->planes_skipped += (uint32_t)!floor + (uint32_t)!ceiling;
+        uint32_t n = f->num_pverts;
+        if (n < 3 || n > CLIP_MAX_VERTS - 5) floor = ceiling = 0; /* degenerate; the loader refuses more than the build's */
+        view_pt pts[CLIP_MAX_VERTS];
+        if (floor || ceiling) /* the leaf polygon rotated once for both */
+            for (uint32_t i = 0; i < n; i++) {
+                const scn_vertex *q = &sc->pverts[f->first_pvert + i];
+                pts[i] = view_point(v, q->x, q->y, 0);
+            }
+        if (floor)
+            plane(v, pts, n, sec->floor_h, 1, mask, sink, sec->floor_color, RAST_ID(RAST_KIND_FLOOR, f->sector), st);
+        if (ceiling)
+            plane(v, pts, n, top, 0, mask, sink, sec->ceil_color, RAST_ID(RAST_KIND_CEILING, f->sector), st);
     }
     for (uint32_t i = 0; i < f->num_segs; i++) seg_parts(sc, ceil, v, f->first_seg + i, mask, sink, occ, st);
 }

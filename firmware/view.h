@@ -100,7 +100,15 @@ typedef struct {
 /* Set up the transform for a camera (clamps the eye into the world box and look). */
 void view_setup(view_xform *v, const camera *cam);
 
-/* World (x, y) at height h (all 16.16) to view space. */
+/* The view height of world height h (16.16): view_point's y. */
+static inline int32_t view_height(const view_xform *v, int32_t h)
+{
+    return (int32_t)fx_asr64((int64_t)h - v->cz, 16 - VIEW_SHIFT);
+}
+
+/* World (x, y) at height h (all 16.16) to view space. A point's x and z do not
+ * depend on h: the polygons of a leaf rotate each map point once and set the
+ * height of each use with view_height. */
 static inline view_pt view_point(const view_xform *v, int32_t wx, int32_t wy, int32_t h)
 {
     int64_t dx = (int64_t)wx - v->cx, dy = (int64_t)wy - v->cy;
@@ -110,7 +118,14 @@ static inline view_pt view_point(const view_xform *v, int32_t wx, int32_t wy, in
      * 16.16 * 2.30 has 46 fraction bits; VIEW_SHIFT of them are kept. */
     p.z = (int32_t)fx_asr64(dx * v->cos + dy * v->sin, 46 - VIEW_SHIFT);
     p.x = (int32_t)fx_asr64(dx * v->sin - dy * v->cos, 46 - VIEW_SHIFT);
-    p.y = (int32_t)fx_asr64((int64_t)h - v->cz, 16 - VIEW_SHIFT);
+    p.y = view_height(v, h);
+    return p;
+}
+
+/* p at height h: the same as view_point(v, x, y, h) for the map point p was rotated from. */
+static inline view_pt view_at_height(const view_xform *v, view_pt p, int32_t h)
+{
+    p.y = view_height(v, h);
     return p;
 }
 
