@@ -419,7 +419,6 @@ typedef struct {
     int y, x0, x1;
 } row_ctx;
 
-
 /* During the walk: fill face f on a world row where it is nearer than the world
  * surface (and the nearest of the active faces). */
 static void draw_face_over_world(dr_state *S, dr_obj *o, const dr_face *f, const dr_edge *edges, void *ctx)
@@ -480,20 +479,12 @@ static uint32_t fill_row_behind_objects(dr_state *S, int y, int x0, int x1, cons
     return cov_fill(&S->cov, S->t, y, x0, x1, 0, colour, id);
 }
 
-
 static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id, uint32_t seg,
                         int32_t zmin, int32_t zmax)
 {
     dr_state *S = ctx;
-    int32_t xmin = INT32_MAX, xmax = INT32_MIN, ymin = INT32_MAX, ymax = INT32_MIN;
-    for (int i = 0; i < n; i++) {
-        if (pts[i].x < xmin) xmin = pts[i].x;
-        if (pts[i].x > xmax) xmax = pts[i].x;
-        if (pts[i].y < ymin) ymin = pts[i].y;
-        if (pts[i].y > ymax) ymax = pts[i].y;
-    }
-    int top = rast_first_sample(ymin), bottom = rast_first_sample(ymax);
-    int c0 = rast_first_sample(xmin), c1 = rast_first_sample(xmax);
+    rast_box box = rast_bounds(pts, n);
+    int top = box.y0, bottom = box.y1, c0 = box.x0, c1 = box.x1;
     if (top < 0) top = 0;
     if (bottom > VIEW_H) bottom = VIEW_H;
     if (top >= bottom || cov_box_covered(&S->cov, top, bottom, c0, c1)) {
@@ -527,22 +518,16 @@ static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, 
     } else {
         drawn = cov_fill_rows(&S->cov, S->t, top, bottom, lo, hi, colour, id);
     }
-    if (!drawn) S->st->occluded++; else S->st->surfaces_drawn++;
+    if (drawn) S->st->surfaces_drawn++;
+    else S->st->occluded++;
 }
 
 /* The sink's question before clipping: is the points' box already drawn? */
 static int box_hidden(void *ctx, const screen_pt *pts, int n)
 {
     const dr_state *S = ctx;
-    int32_t xmin = INT32_MAX, xmax = INT32_MIN, ymin = INT32_MAX, ymax = INT32_MIN;
-    for (int i = 0; i < n; i++) {
-        if (pts[i].x < xmin) xmin = pts[i].x;
-        if (pts[i].x > xmax) xmax = pts[i].x;
-        if (pts[i].y < ymin) ymin = pts[i].y;
-        if (pts[i].y > ymax) ymax = pts[i].y;
-    }
-    return cov_box_covered(&S->cov, rast_first_sample(ymin) - 1, rast_first_sample(ymax) + 1,
-                           rast_first_sample(xmin) - 1, rast_first_sample(xmax) + 1);
+    rast_box b = rast_bounds(pts, n);
+    return cov_box_covered(&S->cov, b.y0 - 1, b.y1 + 1, b.x0 - 1, b.x1 + 1);
 }
 
 static int visit_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)

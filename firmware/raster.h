@@ -84,6 +84,25 @@ static inline void rast_edge_step(rast_edge *e)
 
 void rast_ids(const rast_target *t, int y, int x0, int x1, uint32_t id);
 
+/* The pixels a polygon's screen points can cover, as the fill rule samples
+ * them: columns [x0, x1) and rows [y0, y1) of its bounding box, unclamped. */
+typedef struct {
+    int x0, x1, y0, y1;
+} rast_box;
+
+static inline rast_box rast_bounds(const screen_pt *pts, int n)
+{
+    int32_t xmin = INT32_MAX, xmax = INT32_MIN, ymin = INT32_MAX, ymax = INT32_MIN;
+    for (int i = 0; i < n; i++) {
+        if (pts[i].x < xmin) xmin = pts[i].x;
+        if (pts[i].x > xmax) xmax = pts[i].x;
+        if (pts[i].y < ymin) ymin = pts[i].y;
+        if (pts[i].y > ymax) ymax = pts[i].y;
+    }
+    return (rast_box){rast_first_sample(xmin), rast_first_sample(xmax), rast_first_sample(ymin),
+                      rast_first_sample(ymax)};
+}
+
 /* Draw one span [x0, x1) of row y (0 <= x0, x1 <= 320, 0 <= y < 200) in a
  * colour, with its id. */
 static inline void rast_span(const rast_target *t, int y, int x0, int x1, uint8_t colour, uint32_t id)

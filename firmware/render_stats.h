@@ -17,7 +17,7 @@ typedef struct {
     uint32_t occluded;     /* polygons wholly behind nearer ones (spans: no edges added) */
     uint32_t edges;        /* edges entered into the scan (spans) */
     uint32_t spans;        /* spans emitted (spans) */
-    uint32_t surfaces_drawn; /* surface batches filled (spans) */
+    uint32_t surfaces_drawn; /* spans: surface batches filled; direct: polygons that wrote a pixel */
     uint32_t refused;      /* 1: the work memory given was smaller than the scene needs */
     uint32_t objects_visible; /* objects drawn: in view (spans: and in a leaf the walk visited;
                                * direct: and writing at least one pixel) */

@@ -190,15 +190,8 @@ static int polygon_rows(const screen_pt *pts, int n, int16_t *top_out, int16_t l
  * row it spans? (Exact per-row extents are only worked out when it is not.) */
 static int box_covered(const span_state *S, const screen_pt *pts, int n)
 {
-    int32_t xmin = INT32_MAX, xmax = INT32_MIN, ymin = INT32_MAX, ymax = INT32_MIN;
-    for (int i = 0; i < n; i++) {
-        if (pts[i].x < xmin) xmin = pts[i].x;
-        if (pts[i].x > xmax) xmax = pts[i].x;
-        if (pts[i].y < ymin) ymin = pts[i].y;
-        if (pts[i].y > ymax) ymax = pts[i].y;
-    }
-    int x0 = rast_first_sample(xmin), x1 = rast_first_sample(xmax);
-    int y0 = rast_first_sample(ymin), y1 = rast_first_sample(ymax);
+    rast_box b = rast_bounds(pts, n);
+    int x0 = b.x0, x1 = b.x1, y0 = b.y0, y1 = b.y1;
     if (x0 < 0) x0 = 0;
     if (x1 > VIEW_W) x1 = VIEW_W;
     if (y1 > VIEW_H) y1 = VIEW_H;
