@@ -80,6 +80,7 @@ uint32_t direct_work_bytes(const scene *s, const world_state *w)
 {
     (void)s;
     uint32_t n = object_count(w);
+    if (n > SCN_MAX_OBJECTS) return 0; /* more than the format allows (an object record holds 16 bits): refuse */
     uint64_t total = align8(sizeof(dr_state));
     if (n)
         total += align8((uint64_t)n * sizeof(dr_obj)) + align8((uint64_t)n * sizeof(uint16_t)) +
