@@ -104,8 +104,10 @@ static inline rast_box rast_bounds(const screen_pt *pts, int n)
 }
 
 /* Draw one span [x0, x1) of row y (0 <= x0, x1 <= 320, 0 <= y < 200) in a
- * colour, with its id. */
-static inline void rast_span(const rast_target *t, int y, int x0, int x1, uint8_t colour, uint32_t id)
+ * colour, with its id. Inlined into the fill loops whole (left to itself the
+ * compiler keeps an out-of-line part and pays a call a span). */
+static inline __attribute__((always_inline)) void rast_span(const rast_target *t, int y, int x0, int x1,
+                                                          uint8_t colour, uint32_t id)
 {
     if (x1 <= x0) return;
     if (t->tally) hal_fill_linear(t->surf, y, x0, x1 - x0, colour, t->tally);
