@@ -492,24 +492,8 @@ static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, 
         S->st->occluded++;
         return;
     }
-    /* each row's extent, exactly as the fill rule samples it */
     int16_t lo[VIEW_H], hi[VIEW_H];
-    for (int y = top; y < bottom; y++) {
-        lo[y] = VIEW_W;
-        hi[y] = 0;
-    }
-    for (int i = 0; i < n; i++) {
-        screen_pt a = pts[i], b = pts[(i + 1 == n) ? 0 : i + 1];
-        if (a.y == b.y) continue;
-        int leading = a.y > b.y;
-        rast_edge e;
-        if (!(leading ? rast_edge_setup(&e, b.x, b.y, a.x, a.y) : rast_edge_setup(&e, a.x, a.y, b.x, b.y))) continue;
-        int16_t *side = leading ? lo : hi;
-        for (; e.row < e.end_row; rast_edge_step(&e)) {
-            int col = rast_first_sample(e.x);
-            side[e.row] = (int16_t)(col < 0 ? 0 : (col > VIEW_W ? VIEW_W : col));
-        }
-    }
+    rast_rows(pts, n, top, bottom, lo, hi);
     uint32_t drawn = 0;
     if (CFG_OBJECTS && S->nactive && objects_meet(S, c0, c1, top, bottom)) {
         objd_plane world;

@@ -63,6 +63,26 @@ int rast_edge_setup(rast_edge *e, int32_t xa, int32_t ya, int32_t xb, int32_t yb
     return 1;
 }
 
+void rast_rows(const screen_pt *pts, int n, int top, int bottom, int16_t lo[VIEW_H], int16_t hi[VIEW_H])
+{
+    for (int y = top; y < bottom; y++) {
+        lo[y] = VIEW_W;
+        hi[y] = 0;
+    }
+    for (int i = 0; i < n; i++) {
+        screen_pt a = pts[i], b = pts[(i + 1 == n) ? 0 : i + 1];
+        if (a.y == b.y) continue;
+        int leading = a.y > b.y; /* going up the screen: a left edge */
+        rast_edge e;
+        if (!(leading ? rast_edge_setup(&e, b.x, b.y, a.x, a.y) : rast_edge_setup(&e, a.x, a.y, b.x, b.y))) continue;
+        int16_t *side = leading ? lo : hi;
+        for (; e.row < e.end_row; rast_edge_step(&e)) {
+            int col = rast_first_sample(e.x);
+            side[e.row] = (int16_t)(col < 0 ? 0 : (col > VIEW_W ? VIEW_W : col));
+        }
+    }
+}
+
 /* Record x at every sample row of edge (xa,ya)->(xb,yb), ya < yb, into xs[]. */
 static void walk_edge(int32_t *xs, int32_t xa, int32_t ya, int32_t xb, int32_t yb)
 {

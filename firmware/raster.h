@@ -115,6 +115,12 @@ static inline __attribute__((always_inline)) void rast_span(const rast_target *t
     if (t->ids) rast_ids(t, y, x0, x1, id);
 }
 
+/* The pixels of a convex polygon (clockwise on screen) on each row of [top,
+ * bottom), a sub-range of its rows inside the screen: [lo[y], hi[y]), walked
+ * with the same edge stepping as the fill, so whoever fills the rows fills
+ * exactly its pixels. A row no edge reaches is left empty (lo >= hi). */
+void rast_rows(const screen_pt *pts, int n, int top, int bottom, int16_t lo[VIEW_H], int16_t hi[VIEW_H]);
+
 /* Fill a convex polygon whose vertices run clockwise on screen (y down), inside
  * [0,320] x [0,200]. A polygon that winds the other way (seen from behind, or
  * collapsed by rounding) covers nothing. Returns the pixels drawn. */

@@ -155,33 +155,9 @@ static void insert_sorted(sp_edge **list, sp_edge *e)
  * test it against coverage and then to extend coverage. Returns the rows. */
 static int polygon_rows(const screen_pt *pts, int n, int16_t *top_out, int16_t lo[VIEW_H], int16_t hi[VIEW_H])
 {
-    int32_t ymin = INT32_MAX, ymax = INT32_MIN;
-    for (int i = 0; i < n; i++) {
-        if (pts[i].y < ymin) ymin = pts[i].y;
-        if (pts[i].y > ymax) ymax = pts[i].y;
-    }
-    int top = rast_first_sample(ymin), bottom = rast_first_sample(ymax);
-    if (top < 0) top = 0;
-    if (bottom > VIEW_H) bottom = VIEW_H;
-    for (int y = top; y < bottom; y++) {
-        lo[y] = VIEW_W;
-        hi[y] = 0;
-    }
-    for (int i = 0; i < n; i++) {
-        screen_pt a = pts[i], b = pts[(i + 1 == n) ? 0 : i + 1];
-        if (a.y == b.y) continue;
-        int leading = a.y > b.y;
-        rast_edge e;
-        if (!(leading ? rast_edge_setup(&e, b.x, b.y, a.x, a.y) : rast_edge_setup(&e, a.x, a.y, b.x, b.y)))
-            continue;
-        for (; e.row < e.end_row; rast_edge_step(&e)) {
-            int col = rast_first_sample(e.x);
-            if (col < 0) col = 0;
-            if (col > VIEW_W) col = VIEW_W;
-            if (leading) lo[e.row] = (int16_t)col;
-            else hi[e.row] = (int16_t)col;
-        }
-    }
+    rast_box b = rast_bounds(pts, n);
+    int top = b.y0 < 0 ? 0 : b.y0, bottom = b.y1 > VIEW_H ? VIEW_H : b.y1;
+    rast_rows(pts, n, top, bottom, lo, hi);
     *top_out = (int16_t)top;
     return bottom - top;
 }
