@@ -17,7 +17,6 @@ _Static_assert(!CFG_OBJECTS || CFG_FACE_VERTS + 5 <= CLIP_MAX_VERTS, "a clipped 
 #define NORM_HI ((int64_t)1 << 30)
 #define SIDE_EPS ((int64_t)OBJ_TIE_EPS << 30) /* OBJ_TIE_EPS times a normal's length, about */
 #define TIE_FACTOR (320 / OBJ_TIE_EPS)        /* see objd_front */
-#define STACK_MAX (CFG_MAX_DEPTH + 2)
 
 /* Bits below the leading one, plus one (0 for 0). */
 static int bits(uint64_t v)
@@ -140,60 +139,6 @@ int objd_front(const objd_plane *s, int s_obj, const objd_plane *p, int p_obj, i
 
 /* ---- the object in the tree ------------------------------------------------------ */
 
-int objd_locate(const scene *s, const obj_state *o, const uint32_t *leaf_key, uint32_t *kmin, uint32_t *kmax)
-{
-    const scn_model *m = &s->models[o->model];
-    int64_t x0 = (int64_t)o->x - m->radius, x1 = (int64_t)o->x + m->radius;
-    int64_t y0 = (int64_t)o->y - m->radius, y1 = (int64_t)o->y + m->radius;
-    uint32_t stack[STACK_MAX];
-    uint32_t sp = 0, lo = 0xFFFFFFFFu, hi = 0;
-    int open = 0;
-    if (s->nleaves == 0) return 0;
-    stack[sp++] = s->root;
-    while (sp) {
-        uint32_t n = stack[--sp];
-        if (n & SCN_LEAF_BIT) {
-            uint32_t k = leaf_key[n & ~SCN_LEAF_BIT];
-            if (!k) {
-                open = 1;
-                continue;
-            }
-            if (k < lo) lo = k;
-            if (k > hi) hi = k;
-            continue;
-        }
-        const scn_node *nd = &s->nodes[n];
-        int meet[2];
-        for (int c = 0; c < 2; c++) {
-            const int32_t *bb = nd->bbox[c]; /* top, bottom, left, right */
-            meet[c] = bb[2] <= x1 && bb[3] >= x0 && bb[1] <= y1 && bb[0] >= y0;
-        }
-        if (meet[0] && meet[1]) {
-            /* both boxes: keep the sides of the partition the box reaches. Its
-             * corners' cross products (scene_node_side's arithmetic, whose dropped
-             * bits move a product by less than |dx| + |dy|): offsets below 2^32.03
-             * raw shifted by 3, times a direction below 2^31: < 2^60.03. The
-             * largest and the smallest come from the corners the signs pick. */
-            int64_t slack = (int64_t)w128_uabs(nd->dx) + (int64_t)w128_uabs(nd->dy);
-            int64_t ylo = fx_asr64((nd->dx > 0 ? y0 : y1) - nd->y, 3), yhi = fx_asr64((nd->dx > 0 ? y1 : y0) - nd->y, 3);
-            int64_t xlo = fx_asr64((nd->dy > 0 ? x1 : x0) - nd->x, 3), xhi = fx_asr64((nd->dy > 0 ? x0 : x1) - nd->x, 3);
-            int64_t least = (int64_t)nd->dx * ylo - (int64_t)nd->dy * xlo;
-            int64_t most = (int64_t)nd->dx * yhi - (int64_t)nd->dy * xhi;
-            meet[0] = least <= slack; /* some corner on the front (cross <= 0) */
-            meet[1] = most > -slack;  /* some corner behind */
-        }
-        for (int c = 1; c >= 0; c--)
-            if (meet[c] && sp < STACK_MAX) stack[sp++] = nd->child[c];
-    }
-    if (hi == 0) return 0;
-    *kmin = lo;
-    *kmax = open ? OBJD_KEY_OPEN : hi;
-    return 1;
-}
-
-/* Its bounding box first, then each edge of the leaf as a separating line.
- * Offsets are shifted (edges by 1, corners by 3) so the cross products stay
- * below 2^61 (offsets below 2^32.03 raw, as in objd_locate). */
 void objd_leaf_box(const scene *sc, const scn_leaf *f, int32_t box[4])
 {
     const scn_vertex *p = &sc->pverts[f->first_pvert];
@@ -207,6 +152,10 @@ void objd_leaf_box(const scene *sc, const scn_leaf *f, int32_t box[4])
     }
 }
 
+/* Its bounding box first, then each edge of the leaf as a separating line.
+ * Offsets are shifted (edges by 1, corners by 3) so the cross products stay
+ * below 2^60.03 (box offsets below 2^32.03 raw, shifted by 3; edge directions
+ * below 2^32 raw, shifted by 1). */
 int objd_touches_leaf(const scene *sc, const obj_state *o, const scn_leaf *f, const int32_t box[4])
 {
     int64_t r = sc->models[o->model].radius;

@@ -43,7 +43,9 @@
  * always tie, and surfaces this close cannot be told apart by depth anyway. */
 #define OBJ_TIE_EPS 16
 
-/* Key range of an object with some of its leaves unvisited (see objd_locate). */
+/* The top of the key range of an object's faces in mode spans: open, so that
+ * every world surface from the object's first visited leaf on is sorted
+ * against it by 1/z (docs/objects.md). */
 #define OBJD_KEY_OPEN 0xFFFFFFFEu
 
 typedef struct {
@@ -71,14 +73,6 @@ void objd_plane_wall(const view_xform *v, const scn_vertex *a, const scn_vertex 
  * front. */
 int objd_front(const objd_plane *s, int s_obj, const objd_plane *p, int p_obj, int look, int px, int py);
 
-/* The object's box (its model's radius around the origin) walked through the
- * tree like collision's boxes. leaf_key[leaf] is the key the walk gave a visited
- * leaf, 0 for one it did not visit. Returns 1 if some leaf the box touches was
- * visited, with the smallest and largest of their keys; *kmax is OBJD_KEY_OPEN
- * when the box also touches an unvisited leaf: a part there may lie behind a
- * wall (one closing columns) that the walk reached after every visited leaf of
- * the object, so world surfaces beyond kmin are all sorted by 1/z. */
-int objd_locate(const scene *s, const obj_state *o, const uint32_t *leaf_key, uint32_t *kmin, uint32_t *kmax);
 
 /* The bounding box of the leaf's floor polygon: xmin, ymin, xmax, ymax. */
 void objd_leaf_box(const scene *s, const scn_leaf *f, int32_t box[4]);
