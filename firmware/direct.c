@@ -279,7 +279,10 @@ static int object_hidden(const dr_state *S, const obj_state *os)
         if (z > zhi) zhi = z;
     }
     if (zlo > zhi) return 1;
-    int32_t xs[2] = {os->x - m->radius, os->x + m->radius}, ys[2] = {os->y - m->radius, os->y + m->radius};
+    int64_t r = m->radius, x0 = (int64_t)os->x - r, x1 = (int64_t)os->x + r, y0 = (int64_t)os->y - r,
+            y1 = (int64_t)os->y + r;
+    if (x0 < INT32_MIN || x1 > INT32_MAX || y0 < INT32_MIN || y1 > INT32_MAX) return 0; /* at the box's edge: no test */
+    int32_t xs[2] = {(int32_t)x0, (int32_t)x1}, ys[2] = {(int32_t)y0, (int32_t)y1};
     int32_t zs[2] = {os->z + zlo, os->z + zhi};
     int32_t xmin = INT32_MAX, xmax = INT32_MIN, ymin = INT32_MAX, ymax = INT32_MIN;
     for (int c = 0; c < 8; c++) {
