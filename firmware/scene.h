@@ -23,6 +23,18 @@ typedef struct {
     const uint32_t *findex;
     const scn_object *objects;
     const scn_needs *needs;
+    /* A textured scene's look (docs/textures.md); look is NULL and the counts
+     * 0 in a flat-shaded scene. The loader guarantees: nlights ==
+     * SCN_LIGHT_MAPS, sides[] has 2 * nlines records and planes[] nsectors,
+     * every texture index in them and in look is SCN_TEX_NONE or below
+     * ntextures, and every texture's texels lie inside texels[]. */
+    const scn_look *look;
+    const uint8_t *lights; /* nlights tables of 256 bytes */
+    const scn_texture *textures;
+    const uint8_t *texels;
+    const scn_side *sides;
+    const scn_plane *planes;
+    uint32_t nlights, ntextures, ntexels;
     uint32_t nverts, nsectors, nlines, nsegs, nnodes, nleaves, npverts;
     uint32_t nmodels, nmverts, nfaces, nfindex, nobjects;
     uint32_t root;

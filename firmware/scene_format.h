@@ -16,7 +16,7 @@
 #include <stdint.h>
 
 #define SCN_MAGIC 0x4E435342u /* bytes "BSCN" */
-#define SCN_VERSION 3u
+#define SCN_VERSION 4u
 #define SCN_NONE 0xFFFFFFFFu     /* "no sector" / "no index" */
 #define SCN_LEAF_BIT 0x80000000u /* child index refers to a leaf */
 
@@ -47,6 +47,13 @@ enum scn_section_id {
     SCN_SEC_FINDEX,   /* uint32_t[]: face vertex numbers, relative to the model's first vertex */
     SCN_SEC_OBJECTS,  /* scn_object[]: placed objects */
     SCN_SEC_NEEDS,    /* scn_needs[1]: what the scene needs (docs/needs.md) */
+    /* A textured scene's look (docs/textures.md); every count is 0 in a flat-shaded scene. */
+    SCN_SEC_LOOK,     /* scn_look[1] */
+    SCN_SEC_LIGHTS,   /* light tables: records of 256 bytes (palette index -> palette index), brightest first */
+    SCN_SEC_TEXTURES, /* scn_texture[]: wall textures and flats the scene uses */
+    SCN_SEC_TEXELS,   /* uint8_t[]: the textures' texels (count = bytes; the section is padded to 4) */
+    SCN_SEC_SIDES,    /* scn_side[]: per line side, index line * 2 + side */
+    SCN_SEC_PLANES,   /* scn_plane[]: per sector, its floor and ceiling textures */
     SCN_SEC_COUNT
 };
 
@@ -142,6 +149,51 @@ typedef struct {
     int32_t spin;       /* degrees per second, 16.16 */
 } scn_object;
 
+/* ---- Textures and light (docs/textures.md) ---- */
+
+#define SCN_TEX_NONE 0xFFFFu   /* no texture: the part or plane keeps its flat colour */
+#define SCN_LIGHT_MAPS 32      /* light tables of a textured scene (Doom's COLORMAP 0..31) */
+#define SCN_TEX_MAX_BITS 10    /* a texture is at most 1024 x 1024 texels */
+
+typedef struct {
+    uint32_t sky_tex;   /* scn_texture index of the sky, or SCN_TEX_NONE */
+    uint32_t flags;     /* reserved, 0 */
+} scn_look;
+
+/* A texture of 2^wbits columns of 2^hbits texels, column-major: texel (u, v)
+ * (column u from the left, row v from the top) is
+ * texels[first + ((u & (2^wbits - 1)) << hbits) + (v & (2^hbits - 1))], so
+ * coordinates wrap. Wall textures keep Doom's rule: the columns up to the
+ * largest power of two not above the width (the rest is never shown); a height
+ * that is not a power of two is padded to the next one by repeating rows from
+ * the top. A flat is 64 x 64 with u = map x, v = -map y (Doom's alignment). */
+typedef struct {
+    uint32_t first;          /* first texel in SCN_SEC_TEXELS */
+    uint8_t wbits, hbits;    /* 0 .. SCN_TEX_MAX_BITS */
+    uint8_t colour;          /* palette index nearest the texture's mean colour */
+    uint8_t reserved;        /* 0 */
+} scn_texture;
+
+#define SCN_SIDE_UNPEG_TOP 1u    /* Doom's linedef flag 8: upper texture hangs from the front ceiling */
+#define SCN_SIDE_UNPEG_BOTTOM 2u /* Doom's linedef flag 16: lower from the front ceiling, middle from the floor */
+
+/* How a line side's wall parts are textured. The texture column at map point
+ * P (16.16) is u(P) = ((ux * P.x + uy * P.y) >> 30) + u0: (ux, uy) is the unit
+ * vector along the side (from the line's v1 for side 0, from v2 for side 1),
+ * u0 folds in where that runs from and the side's x offset. */
+typedef struct {
+    int32_t ux, uy;     /* 2.30 */
+    int32_t u0;         /* 16.16 */
+    int32_t row_off;    /* 16.16: the side's y offset (added to every part's texture row) */
+    uint16_t tex[3];    /* [SCN_PART_*]: scn_texture index, or SCN_TEX_NONE */
+    uint8_t flags;      /* SCN_SIDE_* */
+    int8_t light_adj;   /* Doom's fake contrast in light levels: -1 along x (east-west), +1 along y, else 0 */
+} scn_side;
+
+typedef struct {
+    uint16_t floor_tex, ceil_tex; /* scn_texture index, or SCN_TEX_NONE (a sky ceiling: the sky) */
+} scn_plane;
+
 /* What a scene needs of a renderer, written by the compiler's analysis
  * (tools/bspc/needs.c, docs/needs.md). A build compiled for one scene
  * (firmware/build_config.h) leaves out every feature whose bit is clear and
@@ -156,7 +208,8 @@ enum {
     SCN_NEED_SKY = 1u << 4,       /* two sky ceilings meet at a step (Doom's sky rule) */
     SCN_NEED_LOOK = 1u << 5,      /* the camera may look up and down */
     SCN_NEED_YCLIP = 1u << 6,     /* a polygon can cross the top or bottom screen edge */
-    SCN_NEED_ALL = (1u << 7) - 1u
+    SCN_NEED_TEXTURES = 1u << 7,  /* textures, light tables and a sky (docs/textures.md) */
+    SCN_NEED_ALL = (1u << 8) - 1u
 };
 
 typedef struct {
