@@ -88,15 +88,15 @@ static inline int cov_full(const cov_mask *m)
 int cov_box_covered(const cov_mask *m, int y0, int y1, int x0, int x1);
 
 /* Fill the pixels of [x0, x1) on row y that are neither set nor set in keep (a
- * row mask of pixels to leave alone, or NULL) in colour with id, one span per
+ * row mask of pixels to leave alone, or NULL) in its paint with id, one span per
  * run (a free word at a time where it can), and set them. Returns the pixels
  * written. */
-uint32_t cov_fill(cov_mask *m, const rast_target *t, int y, int x0, int x1, const uint32_t *keep, uint8_t colour,
+uint32_t cov_fill(cov_mask *m, const rast_target *t, int y, int x0, int x1, const uint32_t *keep, const tex_paint *paint,
                   uint32_t id);
 
 /* cov_fill for rows [top, bottom) of a polygon, row y from lo[y] to hi[y]. */
 uint32_t cov_fill_rows(cov_mask *m, const rast_target *t, int top, int bottom, const int16_t *lo, const int16_t *hi,
-                       uint8_t colour, uint32_t id);
+                       const tex_paint *paint, uint32_t id);
 
 /* Set [x0, x1) in a row mask of COV_WORDS words. */
 void cov_line_set(uint32_t *line, int x0, int x1);

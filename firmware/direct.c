@@ -390,7 +390,8 @@ static void draw_face_row(dr_state *S, dr_obj *o, const dr_face *face, int y, in
         dr_obj *p = &S->objs[S->active[i]];
         if (p->y0 <= y && p->y1 > y && p->x0 < b && p->x1 > a) each_face(S, p, keep_nearer_face, &k);
     }
-    if (cov_fill(&S->cov, S->t, y, a, b, keep, face->colour, RAST_ID(RAST_KIND_OBJECT, o->index)) && !o->drew) {
+    tex_paint paint = tex_flat(face->colour);
+    if (cov_fill(&S->cov, S->t, y, a, b, keep, &paint, RAST_ID(RAST_KIND_OBJECT, o->index)) && !o->drew) {
         o->drew = 1;
         S->st->objects_visible++;
     }
@@ -473,17 +474,17 @@ static int objects_meet(const dr_state *S, int x0, int x1, int y0, int y1)
  * No object met later can be nearer there: it lies in leaves the walk reaches
  * later, behind this surface. The world surface fills the rest. */
 static uint32_t fill_row_behind_objects(dr_state *S, int y, int x0, int x1, const objd_plane *world, int32_t zmin,
-                                        int32_t zmax, uint8_t colour, uint32_t id)
+                                        int32_t zmax, const tex_paint *paint, uint32_t id)
 {
     row_ctx k = {world, zmin, zmax, y, x0, x1};
     for (uint32_t i = 0; i < S->nactive; i++) {
         dr_obj *o = &S->objs[S->active[i]];
         if (o->y0 <= y && o->y1 > y && o->x0 < x1 && o->x1 > x0) each_face(S, o, draw_face_over_world, &k);
     }
-    return cov_fill(&S->cov, S->t, y, x0, x1, 0, colour, id);
+    return cov_fill(&S->cov, S->t, y, x0, x1, 0, paint, id);
 }
 
-static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id, uint32_t seg,
+static void add_polygon(void *ctx, const screen_pt *pts, int n, const tex_paint *paint, uint32_t id, uint32_t seg,
                         int32_t zmin, int32_t zmax)
 {
     dr_state *S = ctx;
@@ -502,9 +503,9 @@ static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, 
         objd_plane world;
         world_plane(S, id, seg, &world);
         for (int y = top; y < bottom; y++)
-            if (lo[y] < hi[y]) drawn += fill_row_behind_objects(S, y, lo[y], hi[y], &world, zmin, zmax, colour, id);
+            if (lo[y] < hi[y]) drawn += fill_row_behind_objects(S, y, lo[y], hi[y], &world, zmin, zmax, paint, id);
     } else {
-        drawn = cov_fill_rows(&S->cov, S->t, top, bottom, lo, hi, colour, id);
+        drawn = cov_fill_rows(&S->cov, S->t, top, bottom, lo, hi, paint, id);
     }
     if (drawn) S->st->surfaces_drawn++;
     else S->st->occluded++;
@@ -578,7 +579,8 @@ void direct_render(const scene *sc, const world_state *w, const view_xform *v, c
     uint32_t need = direct_work_bytes(sc, w);
     if (!work || need == 0 || work_bytes < need) {
         st->refused = 1; /* the caller did not provide the memory this frame needs */
-        for (int y = 0; y < VIEW_H; y++) rast_span(t, y, 0, VIEW_W, BACKGROUND_COLOUR, RAST_ID(RAST_KIND_NONE, 0));
+        tex_paint background = tex_flat(BACKGROUND_COLOUR);
+        for (int y = 0; y < VIEW_H; y++) rast_span(t, y, 0, VIEW_W, &background, RAST_ID(RAST_KIND_NONE, 0));
         return;
     }
     uint8_t *mem = work;

@@ -49,14 +49,14 @@ uint32_t painter_work_bytes(const scene *s, const world_state *w)
     return (uint32_t)(2u * (uint64_t)n * sizeof(pt_order));
 }
 
-static void fill_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id, uint32_t seg,
+static void fill_polygon(void *ctx, const screen_pt *pts, int n, const tex_paint *paint, uint32_t id, uint32_t seg,
                          int32_t zmin, int32_t zmax)
 {
     (void)seg;
     (void)zmin;
     (void)zmax;
     const painter *p = ctx;
-    rast_convex(p->t, pts, n, colour, id);
+    rast_convex(p->t, pts, n, paint, id);
 }
 
 static void draw_object(const scene *sc, uint32_t i, const obj_state *o, const view_xform *v, const rast_target *t,
@@ -159,7 +159,8 @@ static void draw_object(const scene *sc, uint32_t i, const obj_state *o, const v
         int n = objd_face_screen(sc, m, f, verts, v, pts);
         if (!n) continue;
         st->object_faces++;
-        rast_convex(t, pts, n, sc->faces[f].colour, RAST_ID(RAST_KIND_OBJECT, i));
+        tex_paint paint = tex_flat(sc->faces[f].colour);
+        rast_convex(t, pts, n, &paint, RAST_ID(RAST_KIND_OBJECT, i));
     }
 }
 

@@ -91,7 +91,18 @@ static void walk_edge(int32_t *xs, int32_t xa, int32_t ya, int32_t xb, int32_t y
     for (; e.row < e.end_row; rast_edge_step(&e)) xs[e.row] = e.x;
 }
 
-uint32_t rast_convex(const rast_target *t, const screen_pt *pts, int n, uint8_t colour, uint32_t id)
+#if CFG_TEXTURES
+void rast_textured(const rast_target *t, int y, int x0, int x1, const tex_paint *paint)
+{
+    uint32_t row[VIEW_W / 4]; /* indexed by screen column, aligned as the surface's rows */
+    uint8_t *px = (uint8_t *)row;
+    tex_span(paint, y, x0, x1, px);
+    if (t->tally) hal_put_linear(t->surf, y, x0, x1 - x0, px, t->tally);
+    else hal_put_span(t->surf, y, x0, x1 - x0, px);
+}
+#endif
+
+uint32_t rast_convex(const rast_target *t, const screen_pt *pts, int n, const tex_paint *paint, uint32_t id)
 {
     int32_t left[VIEW_H], right[VIEW_H];
     int32_t ymin = INT32_MAX, ymax = INT32_MIN;
@@ -119,7 +130,7 @@ uint32_t rast_convex(const rast_target *t, const screen_pt *pts, int n, uint8_t 
         if (x0 < 0) x0 = 0;
         if (x1 > VIEW_W) x1 = VIEW_W;
         if (x1 > x0) {
-            rast_span(t, y, x0, x1, colour, id);
+            rast_span(t, y, x0, x1, paint, id);
             drawn += (uint32_t)(x1 - x0);
         }
     }

@@ -8,12 +8,14 @@
 
 #include <stdint.h>
 #include "hal.h"
+#include "texture.h"
 #include "view.h"
 
 typedef struct {
     const hal_surface *surf;
     uint32_t *ids;    /* optional surface-id buffer, 320 x 200, or NULL */
     hal_tally *tally; /* a linear surface filled straight in, counted here (hal.h), or NULL: through hal_fill_span */
+    uint8_t flat;     /* 1: textured paints are drawn in their flat colours (a slow link, say) */
 } rast_target;
 
 /* Surface ids (DESIGN.md): kind << 24 | index. */
@@ -103,15 +105,24 @@ static inline rast_box rast_bounds(const screen_pt *pts, int n)
                       rast_first_sample(ymax)};
 }
 
-/* Draw one span [x0, x1) of row y (0 <= x0, x1 <= 320, 0 <= y < 200) in a
- * colour, with its id. Inlined into the fill loops whole (left to itself the
+#if CFG_TEXTURES
+/* A textured span's pixels, worked out and written (raster.c). */
+void rast_textured(const rast_target *t, int y, int x0, int x1, const tex_paint *paint);
+#endif
+
+/* Draw one span [x0, x1) of row y (0 <= x0, x1 <= 320, 0 <= y < 200) in its
+ * paint, with its id. Inlined into the fill loops whole (left to itself the
  * compiler keeps an out-of-line part and pays a call a span). */
 static inline __attribute__((always_inline)) void rast_span(const rast_target *t, int y, int x0, int x1,
-                                                          uint8_t colour, uint32_t id)
+                                                          const tex_paint *paint, uint32_t id)
 {
     if (x1 <= x0) return;
-    if (t->tally) hal_fill_linear(t->surf, y, x0, x1 - x0, colour, t->tally);
-    else hal_fill_span(t->surf, y, x0, x1 - x0, colour);
+#if CFG_TEXTURES
+    if (paint->kind != TEX_FLAT && !t->flat) rast_textured(t, y, x0, x1, paint);
+    else
+#endif
+    if (t->tally) hal_fill_linear(t->surf, y, x0, x1 - x0, paint->colour, t->tally);
+    else hal_fill_span(t->surf, y, x0, x1 - x0, paint->colour);
     if (t->ids) rast_ids(t, y, x0, x1, id);
 }
 
@@ -124,6 +135,6 @@ void rast_rows(const screen_pt *pts, int n, int top, int bottom, int16_t lo[VIEW
 /* Fill a convex polygon whose vertices run clockwise on screen (y down), inside
  * [0,320] x [0,200]. A polygon that winds the other way (seen from behind, or
  * collapsed by rounding) covers nothing. Returns the pixels drawn. */
-uint32_t rast_convex(const rast_target *t, const screen_pt *pts, int n, uint8_t colour, uint32_t id);
+uint32_t rast_convex(const rast_target *t, const screen_pt *pts, int n, const tex_paint *paint, uint32_t id);
 
 #endif

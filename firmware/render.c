@@ -46,7 +46,8 @@ render_mode render_mode_next(render_mode m)
 
 void render_clear(const rast_target *t, uint8_t colour)
 {
-    for (int y = 0; y < VIEW_H; y++) rast_span(t, y, 0, VIEW_W, colour, RAST_ID(RAST_KIND_NONE, 0));
+    tex_paint paint = tex_flat(colour);
+    for (int y = 0; y < VIEW_H; y++) rast_span(t, y, 0, VIEW_W, &paint, RAST_ID(RAST_KIND_NONE, 0));
 }
 
 static uint32_t max_u32(uint32_t a, uint32_t b)

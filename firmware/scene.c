@@ -55,7 +55,7 @@ static scene_status refuse(scene_error *err, uint32_t item, uint32_t need, uint3
 const char *scene_item_name(uint32_t item)
 {
     static const char *const names[SCENE_ITEM_COUNT] = {
-        "objects", "doors", "two-sided walls", "height changes", "sky steps", "look up/down", "y-clipping",
+        "objects", "doors", "two-sided walls", "height changes", "sky steps", "look up/down", "y-clipping", "textures",
         "edges per frame", "surfaces per frame", "tree depth", "leaf polygon vertices", "model vertices",
         "face vertices",
     };

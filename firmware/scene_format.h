@@ -172,6 +172,8 @@ typedef struct {
     uint8_t wbits, hbits;    /* 0 .. SCN_TEX_MAX_BITS */
     uint8_t colour;          /* palette index nearest the texture's mean colour */
     uint8_t reserved;        /* 0 */
+    uint16_t height;         /* rows as the WAD gives them (<= 2^hbits): Doom's pegging counts these */
+    uint16_t reserved2;      /* 0 */
 } scn_texture;
 
 #define SCN_SIDE_UNPEG_TOP 1u    /* Doom's linedef flag 8: upper texture hangs from the front ceiling */

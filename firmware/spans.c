@@ -29,7 +29,7 @@ typedef struct sp_surf {
     uint8_t object;            /* 1: an object's face */
     uint8_t silent;            /* 1: owns its pixels but fills nothing (see spans_render) */
     int32_t state;             /* leading minus trailing edges seen on this line */
-    uint8_t colour;
+    tex_paint paint;
     struct sp_surf *below;     /* next surface down the stack */
     struct sp_surf *above;
     int32_t span_head;         /* this batch's spans, linked through sp_span.next */
@@ -179,12 +179,12 @@ static int box_covered(const span_state *S, const screen_pt *pts, int n)
 /* ---- edges ---------------------------------------------------------------- */
 
 /* A new surface and its edges (the caller has checked the pools). */
-static sp_surf *add_surface(span_state *S, const screen_pt *pts, int n, uint8_t colour, uint32_t id)
+static sp_surf *add_surface(span_state *S, const screen_pt *pts, int n, const tex_paint *paint, uint32_t id)
 {
     sp_surf *s = &S->surfs[S->nsurfs++];
     s->key = S->key;
     s->id = id;
-    s->colour = colour;
+    s->paint = *paint;
     s->state = 0;
     s->span_head = -1;
     s->next_drawn = 0;
@@ -208,7 +208,7 @@ static sp_surf *add_surface(span_state *S, const screen_pt *pts, int n, uint8_t 
 
 static void draw_batch(span_state *S, int final);
 
-static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, uint32_t id, uint32_t seg,
+static void add_polygon(void *ctx, const screen_pt *pts, int n, const tex_paint *paint, uint32_t id, uint32_t seg,
                         int32_t zmin, int32_t zmax)
 {
     (void)zmin;
@@ -234,7 +234,7 @@ static void add_polygon(void *ctx, const screen_pt *pts, int n, uint8_t colour, 
         S->st->overflow++;
         return;
     }
-    sp_surf *s = add_surface(S, pts, n, colour, id);
+    sp_surf *s = add_surface(S, pts, n, paint, id);
     if (S->world_planes) { /* objects may meet it: how to find its plane if they do */
         s->plane = -1;
         s->seg = seg;
@@ -345,7 +345,8 @@ static void add_objects(span_state *S, int silent)
                 return;
             }
             if (!silent) S->st->object_faces++;
-            sp_surf *s = add_surface(S, pts, n, sc->faces[f].colour, RAST_ID(RAST_KIND_OBJECT, i));
+            tex_paint paint = tex_flat(sc->faces[f].colour);
+            sp_surf *s = add_surface(S, pts, n, &paint, RAST_ID(RAST_KIND_OBJECT, i));
             s->key = S->objs[k].kmin;
             s->kmax = OBJD_KEY_OPEN;
             s->object = 1;
@@ -408,7 +409,7 @@ static void flush_spans(span_state *S)
 {
     for (sp_surf *s = S->drawn_list; s; s = s->next_drawn) {
         for (int32_t i = s->span_head; i >= 0; i = S->spans[i].next)
-            rast_span(S->t, S->spans[i].y, S->spans[i].x0, S->spans[i].x1, s->colour, s->id);
+            rast_span(S->t, S->spans[i].y, S->spans[i].x0, S->spans[i].x1, &s->paint, s->id);
         s->span_head = -1;
         S->st->surfaces_drawn++;
     }
@@ -731,7 +732,7 @@ void spans_render(const scene *sc, const world_state *w, const view_xform *v, co
     S->nspans = 0;
     S->drawn_list = 0;
     S->background = (sp_surf){.key = 0xFFFFFFFFu, .id = RAST_ID(RAST_KIND_NONE, 0), .plane = -1, .seg = SCN_NONE,
-                              .colour = BACKGROUND_COLOUR, .span_head = -1};
+                              .paint = {.kind = TEX_FLAT, .colour = BACKGROUND_COLOUR}, .span_head = -1};
     for (int y = 0; y < VIEW_H; y++) S->new_edges[y] = 0;
     cov_clear(&S->claimed); /* S->drawn: cleared before the first batch that is not the last */
     walk_stats ws;

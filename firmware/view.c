@@ -10,6 +10,7 @@ void view_setup(view_xform *v, const camera *cam)
     v->cy = cam->y < -lim ? -lim : (cam->y > lim ? lim : cam->y);
     v->cz = cam->z < -hlim ? -hlim : (cam->z > hlim ? hlim : cam->z);
     fx_ang_t a = fx_ang_from_deg(cam->angle_deg);
+    v->angle = a;
     v->sin = fx_sin(a);
     v->cos = fx_cos(a);
     v->look = !CFG_LOOK ? 0 : cam->look < -VIEW_LOOK_MAX ? -VIEW_LOOK_MAX : (cam->look > VIEW_LOOK_MAX ? VIEW_LOOK_MAX : cam->look);

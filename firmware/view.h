@@ -84,6 +84,7 @@ typedef struct {
     int64_t cx, cy, cz;  /* eye, 16.16 */
     int32_t sin, cos;    /* of the view angle, 2.30 */
     int32_t look;        /* clamped shear, pixels */
+    fx_ang_t angle;      /* the view angle */
 } view_xform;
 
 typedef struct {

@@ -140,6 +140,39 @@ void hal_fill_span(const hal_surface *s, int y, int x, int len, uint8_t colour)
     hal_perf_add_span(s->in_vram ? HAL_DEST_VRAM : HAL_DEST_SYSMEM, w[0], w[1], w[2], (uint32_t)len, (uint32_t)len);
 }
 
+/* Planar: pixel x is byte x / 4 of plane x % 4. Four passes, one plane each,
+ * so the mask is set four times a span, not once a pixel. */
+static __attribute__((noinline)) void put_planar(uint8_t *prow, uint32_t x, uint32_t len, const uint8_t *row)
+{
+    uint32_t writes = 0;
+    for (uint32_t plane = 0; plane < 4u; plane++) {
+        uint32_t first = x + ((plane - x) & 3u); /* the span's first pixel in this plane */
+        if (first >= x + len)
+            continue;
+        hal_target_plane_mask(1u << plane);
+        for (uint32_t px = first; px < x + len; px += 4u) {
+            *(volatile uint8_t *)(prow + (px >> 2)) = row[px];
+            writes++;
+        }
+    }
+    hal_perf_add_span(HAL_DEST_VRAM, writes, 0, 0, len, writes);
+}
+
+void hal_put_span(const hal_surface *s, int y, int x, int len, const uint8_t *row)
+{
+    if (s == NULL || s->pixels == NULL || row == NULL)
+        return;
+    if (y < 0 || y >= HAL_HEIGHT || len <= 0 || x < 0 || x >= HAL_WIDTH || len > HAL_WIDTH - x)
+        return;
+    if (s->planar) {
+        put_planar(s->pixels + (uint32_t)y * (HAL_WIDTH / 4), (uint32_t)x, (uint32_t)len, row);
+        return;
+    }
+    uint32_t w[3] = { 0, 0, 0 };
+    hal_copy_run(s->pixels + (uint32_t)y * HAL_WIDTH + (uint32_t)x, row, (uint32_t)x, (uint32_t)len, w);
+    hal_perf_add_span(s->in_vram ? HAL_DEST_VRAM : HAL_DEST_SYSMEM, w[0], w[1], w[2], (uint32_t)len, (uint32_t)len);
+}
+
 void hal_add_tally(const hal_surface *s, hal_tally *t)
 {
     if (t->pixels)

@@ -134,6 +134,55 @@ static inline __attribute__((always_inline)) void hal_fill_run(uint8_t *p, uint3
     }
 }
 
+/* Write pixels row[x .. x + len) of one screen row to p (which is pixel x of
+ * that row on a linear surface) with the transactions hal_fill_run makes for
+ * the same span, adding them to w[0..2]. row is 4-aligned like the surface's
+ * rows, so each dword is read aligned. */
+static inline __attribute__((always_inline)) void hal_copy_run(uint8_t *p, const uint8_t *row, uint32_t x, uint32_t n,
+                                                             uint32_t w[3])
+{
+    const uint8_t *q = row + x;
+    if (((uintptr_t)p & 1u) != 0) {
+        *(volatile uint8_t *)p = *q;
+        p += 1;
+        q += 1;
+        n -= 1;
+        w[0]++;
+    }
+    if (((uintptr_t)p & 2u) != 0 && n >= 2) {
+        *(volatile uint16_t *)(void *)p = *(const uint16_t *)(const void *)q;
+        p += 2;
+        q += 2;
+        n -= 2;
+        w[1]++;
+    }
+    uint32_t n32 = n >> 2;
+    volatile uint32_t *d = (volatile uint32_t *)(void *)p;
+    const uint32_t *s = (const uint32_t *)(const void *)q;
+    for (uint32_t i = 0; i < n32; i++)
+        d[i] = s[i];
+    w[2] += n32;
+    p += n32 * 4u;
+    q += n32 * 4u;
+    n &= 3u;
+    if (n >= 2) {
+        *(volatile uint16_t *)(void *)p = *(const uint16_t *)(const void *)q;
+        p += 2;
+        q += 2;
+        n -= 2;
+        w[1]++;
+    }
+    if (n != 0) {
+        *(volatile uint8_t *)p = *q;
+        w[0]++;
+    }
+}
+
+/* hal_fill_span for pixels of many colours: row[x .. x + len) (row indexed by
+ * screen column, 4-aligned) to pixels [x, x + len) of row y, counted. On a
+ * planar page each pixel is a byte written with its plane's mask. */
+void hal_put_span(const hal_surface *s, int y, int x, int len, const uint8_t *row);
+
 /* Spans filled straight into a linear surface, counted here and added to the
  * counters at once (hal_add_tally): the renderer's fill loop pays no call and
  * no 64-bit sum per span, and every counter ends as hal_fill_span would leave it. */
@@ -155,6 +204,15 @@ static inline __attribute__((always_inline)) void hal_fill_linear(const hal_surf
                                                                  uint8_t colour, hal_tally *t)
 {
     hal_fill_run(s->pixels + (uint32_t)y * HAL_WIDTH + (uint32_t)x, (uint32_t)len, colour, t->w);
+    t->pixels += (uint32_t)len;
+}
+
+/* hal_put_span into a linear surface, counted into t (the caller keeps the
+ * bounds hal_fill_linear asks for). */
+static inline __attribute__((always_inline)) void hal_put_linear(const hal_surface *s, int y, int x, int len,
+                                                                const uint8_t *row, hal_tally *t)
+{
+    hal_copy_run(s->pixels + (uint32_t)y * HAL_WIDTH + (uint32_t)x, row, (uint32_t)x, (uint32_t)len, t->w);
     t->pixels += (uint32_t)len;
 }
 

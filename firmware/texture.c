@@ -1,0 +1,250 @@
+/* texture.c - textured spans: walls, floors and ceilings, the sky, under
+ * Doom's light (docs/textures.md gives the rules; docs/ranges.md the ranges).
+ *
+ * Screen positions are in half pixels from the view centre, so that a pixel
+ * centre is a whole number: column x is sx = 2x + 1 - 320, row y is
+ * sy = 2 (100 + look) - 2y - 1 (positive above the horizon). The ray through a
+ * pixel centre is F + (sx / 320) R + (sy / 320) up, F and R the view's forward
+ * and right unit vectors.
+ *
+ * Depths are 16.16 map units, at most TEX_ZMAX (65535 units): a surface
+ * farther than that is drawn with the texel of that depth. */
+#include "texture.h"
+
+#if CFG_TEXTURES
+
+#define TEX_ZMAX 0xFFFFFFFFu
+#define TEX_SUBDIV (1 << TEX_SUBDIV_BITS)
+#define LIGHT_TABLE_MASK (~((1 << (5 - TEX_LIGHT_BITS)) - 1))
+
+/* sky angle of each screen column: atan((160 - (x + 0.5)) / 160), a full turn
+ * being 2^32 (tools/gen_tables.c). */
+extern const uint32_t tex_sky_angle[VIEW_W];
+#if TEX_RECIP_BITS
+/* tex_recip[j] = 2^(k + 32) / (2m + 1) rounded, m = 2^k + j (as view.h's table) */
+extern const uint32_t tex_recip[1 << TEX_RECIP_BITS];
+#endif
+
+/* floor(num / den) for den > 0, at most TEX_ZMAX. */
+static inline uint32_t depth_div(uint64_t num, uint32_t den)
+{
+    if (num >= (uint64_t)den << 32) return TEX_ZMAX;
+#if TEX_RECIP_BITS
+    /* den = m 2^(b - k), 1/den ~ r / 2^(31 + b); num is cut to 32 bits first
+     * (its top bits are all the quotient's relative precision needs). */
+    int b = 31 - __builtin_clz(den);
+    uint32_t m = b >= TEX_RECIP_BITS ? den >> (b - TEX_RECIP_BITS) : den << (TEX_RECIP_BITS - b);
+    uint64_t r = tex_recip[m - (1u << TEX_RECIP_BITS)];
+    int sn = num >> 32 ? 32 - __builtin_clz((uint32_t)(num >> 32)) : 0;
+    uint64_t q = ((num >> sn) * r) >> (31 + b - sn); /* num >= den 2^32 was refused: 31 + b > sn */
+    return q > TEX_ZMAX ? TEX_ZMAX : (uint32_t)q;
+#elif FX_DIV32
+    uint32_t r;
+    return fx_udiv64_32(num, den, &r);
+#else
+    return (uint32_t)(num / den);
+#endif
+}
+
+/* The brightest light table of a light level (Doom: lightnum = level / 16). */
+static int8_t light_start(uint8_t light, int adj)
+{
+    int n = (light >> 4) + adj;
+    n = n < 0 ? 0 : (n > 15 ? 15 : n);
+    return (int8_t)((15 - n) * 4);
+}
+
+static const uint8_t *light_table(const tex_paint *p, int dim)
+{
+    int t = p->start - dim;
+    t = t < 0 ? 0 : (t > SCN_LIGHT_MAPS - 1 ? SCN_LIGHT_MAPS - 1 : t);
+    return p->lights + ((uint32_t)(t & LIGHT_TABLE_MASK) << 8);
+}
+
+static void set_texture(tex_paint *p, const scene *sc, uint32_t tex)
+{
+    const scn_texture *t = &sc->textures[tex];
+    p->texels = sc->texels + t->first;
+    p->hbits = t->hbits;
+    p->wmask = (1u << t->wbits) - 1u;
+    p->hmask = (1u << t->hbits) - 1u;
+    p->lights = sc->lights;
+    p->look = 0;
+}
+
+tex_paint tex_wall(const scene *sc, const view_xform *v, const scn_side *sd, uint32_t tex, const scn_vertex *a,
+                   int32_t top, uint8_t light, uint8_t colour)
+{
+    if (tex == SCN_TEX_NONE) return tex_flat(colour);
+    tex_paint p;
+    p.kind = TEX_WALL;
+    p.colour = colour;
+    set_texture(&p, sc, tex);
+    p.start = light_start(light, sd->light_adj);
+    p.look = VIEW_LOOK(v);
+    int64_t ux = sd->ux, uy = sd->uy;
+    /* |U| <= 1 in 2.30 and |sin|, |cos| <= 1: each dot product fits 2.30 */
+    int32_t uf = (int32_t)((ux * v->cos + uy * v->sin) >> 30); /* U . F */
+    int32_t ur = (int32_t)((ux * v->sin - uy * v->cos) >> 30); /* U . R */
+    /* The ray meets the line at depth z = d / (N . ray), N = (uy, -ux) the
+     * side's front normal, d the eye's distance in front: N . ray = U . R -
+     * (sx / 320) U . F. The texture column there is u(eye) + z U . ray. */
+    p.a = ur;
+    p.b = -uf / 320;
+    p.c = uf;
+    p.d = ur / 320;
+    int64_t dx = v->cx - a->x, dy = v->cy - a->y; /* |dx|, |dy| < 2^32: the cross product < 2^62.5 */
+    int64_t d = (uy * dx - ux * dy) >> 30;
+    if (d < 1) d = 1; /* the walk draws only walls the eye is in front of; rounding may say 0 */
+    p.dist = d * 16384;
+    p.u0 = (uint32_t)((ux * v->cx + uy * v->cy) >> 30) + (uint32_t)sd->u0;
+    p.v0 = (uint32_t)top + (uint32_t)sd->row_off - (uint32_t)v->cz;
+    p.dh = 0;
+    p.w0 = 0;
+    return p;
+}
+
+tex_paint tex_plane(const scene *sc, const view_xform *v, uint32_t tex, int32_t h, uint8_t light, uint8_t colour)
+{
+    if (tex == SCN_TEX_NONE) return tex_flat(colour);
+    tex_paint p;
+    p.kind = TEX_PLANE;
+    p.colour = colour;
+    set_texture(&p, sc, tex);
+    p.start = light_start(light, 0);
+    p.look = VIEW_LOOK(v);
+    p.a = v->cos;
+    p.b = v->sin;
+    p.c = v->sin / 320;
+    p.d = v->cos / 320;
+    p.dh = (int64_t)h - v->cz;
+    p.v0 = (uint32_t)v->cx;
+    p.w0 = 0u - (uint32_t)v->cy;
+    p.dist = 0;
+    p.u0 = 0;
+    return p;
+}
+
+tex_paint tex_sky(const scene *sc, const view_xform *v, uint8_t colour)
+{
+    if (!sc->look || sc->look->sky_tex == SCN_TEX_NONE) return tex_flat(colour);
+    tex_paint p;
+    p.kind = TEX_SKY;
+    p.colour = colour;
+    set_texture(&p, sc, sc->look->sky_tex);
+    p.start = 0;
+    p.look = VIEW_LOOK(v);
+    p.u0 = v->angle;
+    p.a = p.b = p.c = p.d = 0;
+    p.dist = p.dh = 0;
+    p.v0 = p.w0 = 0;
+    return p;
+}
+
+static inline uint8_t texel(const tex_paint *p, uint32_t u, uint32_t v)
+{
+    return p->texels[(((u >> 16) & p->wmask) << p->hbits) | ((v >> 16) & p->hmask)];
+}
+
+/* ---- walls ---- */
+
+typedef struct {
+    uint32_t u, v; /* 16.16 texture column and row */
+    const uint8_t *light;
+} wall_sample;
+
+/* Doom's scale light: 160 / z in steps of 1/16, at most 47, halved. */
+static const uint8_t *wall_light(const tex_paint *p, uint32_t z)
+{
+    uint32_t scale = z ? 167772160u / z : 47u; /* 2560 * 65536 / z */
+    return light_table(p, (int)(scale > 47u ? 47u : scale) / 2);
+}
+
+/* The exact texture column, row and light where the ray through (sx, row
+ * coefficient vk = sy * 2^22 / 320) meets the wall. */
+static wall_sample wall_at(const tex_paint *p, int32_t sx, int32_t vk)
+{
+    int64_t den = ((int64_t)p->a + (int64_t)sx * p->b) >> 16; /* 2.14, < 2^15 */
+    uint32_t z = den > 0 ? depth_div((uint64_t)p->dist, (uint32_t)den) : TEX_ZMAX;
+    int64_t slope = ((int64_t)p->c + (int64_t)sx * p->d) >> 16; /* 2.14 */
+    wall_sample s;
+    s.u = p->u0 + (uint32_t)(((int64_t)z * slope) >> 14);    /* < 2^47 before the shift */
+    s.v = p->v0 - (uint32_t)(((int64_t)z * vk) >> 22);       /* < 2^56 */
+    s.light = wall_light(p, z);
+    return s;
+}
+
+static void wall_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
+{
+    int32_t sy = 2 * (VIEW_CY + p->look) - 2 * y - 1;
+    int32_t vk = sy * 13107; /* sy 2^22 / 320, |sy| < 600 */
+    int32_t sx = 2 * x0 + 1 - VIEW_W;
+    wall_sample s = wall_at(p, sx, vk);
+    for (int x = x0; x < x1;) {
+        int n = x1 - x < TEX_SUBDIV ? x1 - x : TEX_SUBDIV;
+        wall_sample e = wall_at(p, sx + 2 * n, vk);
+        int32_t du = (int32_t)(e.u - s.u), dv = (int32_t)(e.v - s.v);
+        if (n == TEX_SUBDIV) {
+            du >>= TEX_SUBDIV_BITS;
+            dv >>= TEX_SUBDIV_BITS;
+        } else {
+            du /= n;
+            dv /= n;
+        }
+        const uint8_t *light = s.light;
+        uint32_t u = s.u, v = s.v;
+        for (int i = 0; i < n; i++) {
+            row[x + i] = light[texel(p, u, v)];
+            u += (uint32_t)du;
+            v += (uint32_t)dv;
+        }
+        x += n;
+        sx += 2 * n;
+        s = e;
+    }
+}
+
+/* ---- floors and ceilings: one depth a row (Doom's trick) ---- */
+
+static void plane_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
+{
+    int32_t sy = 2 * (VIEW_CY + p->look) - 2 * y - 1;
+    uint32_t z = TEX_ZMAX;
+    if (sy != 0 && (sy > 0) == (p->dh > 0)) /* the plane is on this side of the horizon */
+        z = depth_div((uint64_t)(p->dh < 0 ? -p->dh : p->dh) * 320u, (uint32_t)(sy < 0 ? -sy : sy));
+    int64_t sx = 2 * x0 + 1 - VIEW_W;
+    /* P = eye + z (F + sx / 320 R): |cos + sx sin / 320| < 2^30.5, z < 2^32 */
+    uint32_t u = p->v0 + (uint32_t)(((int64_t)z * (p->a + sx * p->c)) >> 30);
+    uint32_t w = p->w0 - (uint32_t)(((int64_t)z * (p->b - sx * p->d)) >> 30);
+    uint32_t du = (uint32_t)(((int64_t)z * (2 * p->c)) >> 30), dw = (uint32_t)(((int64_t)z * (2 * p->d)) >> 30);
+    uint32_t bucket = z >> 20; /* Doom's z light: 16 units a step, at most 127 */
+    const uint8_t *light = light_table(p, (int)(160u / ((bucket > 127u ? 127u : bucket) + 1u)) / 2);
+    for (int x = x0; x < x1; x++) {
+        row[x] = light[texel(p, u, w)];
+        u += du;
+        w += dw;
+    }
+}
+
+/* ---- the sky: by view angle, at full light ---- */
+
+static void sky_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
+{
+    const uint8_t *light = p->lights;
+    const uint8_t *column0 = p->texels + ((uint32_t)(y - p->look) & p->hmask);
+    for (int x = x0; x < x1; x++) {
+        uint32_t col = ((p->u0 + tex_sky_angle[x]) >> 22) & p->wmask;
+        row[x] = light[column0[col << p->hbits]];
+    }
+}
+
+void tex_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
+{
+    if (p->kind == TEX_WALL) wall_span(p, y, x0, x1, row);
+    else if (p->kind == TEX_PLANE) plane_span(p, y, x0, x1, row);
+    else if (p->kind == TEX_SKY) sky_span(p, y, x0, x1, row);
+    else
+        for (int x = x0; x < x1; x++) row[x] = p->colour;
+}
+
+#endif
