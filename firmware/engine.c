@@ -12,6 +12,7 @@ scene_status eng_init(engine *e, const void *blob, uint32_t len, scene_error *er
     e->world = (world_state){0, 0, 0, 0};
     e->t_ms = 0;
     e->present = HAL_PRESENT_FLIP;
+    e->flat = 0;
     e->frame = 0;
     e->stats = (render_stats){0};
     cam_start(&e->cam, &e->sc);
@@ -56,7 +57,7 @@ void eng_render(engine *e, uint32_t *ids)
 {
     hal_surface surf = hal_begin_frame(e->present);
     hal_tally tally = {{0, 0, 0}, 0};
-    rast_target t = {&surf, ids, hal_surface_linear(&surf) ? &tally : 0};
+    rast_target t = {&surf, ids, hal_surface_linear(&surf) ? &tally : 0, e->flat};
     render_frame(&e->sc, world_of(e), &e->cam.view, e->mode, &t, &e->rwork, &e->stats);
     if (t.tally) hal_add_tally(&surf, &tally);
     hal_present(e->present);

@@ -9,12 +9,14 @@
 #include "objects.h"
 #include "render.h"
 #include "scene.h"
+#include "texture.h"
 
 typedef struct {
     scene sc;
     cam_state cam;
     render_mode mode;
     hal_present_mode present;
+    uint8_t flat;           /* 1: a textured scene is drawn in its flat colours */
     uint32_t frame;         /* frames rendered since eng_init */
     render_stats stats;     /* of the last frame */
     render_work work;       /* given by the target: eng_set_work */
@@ -22,6 +24,13 @@ typedef struct {
     world_state world;      /* objects and doors now, in the work area; unset (NULL arrays) before eng_set_work */
     uint32_t t_ms;          /* time since eng_init: the sum of eng_step's dt */
 } engine;
+
+/* 1 if frames are drawn textured: the scene has a look, the build has the
+ * texture code, and flat colours were not asked for. */
+static inline int eng_textured(const engine *e)
+{
+    return CFG_TEXTURES && e->sc.look && !e->flat;
+}
 
 /* Validate the compiled scene, load its palette, put the eye at the player start.
  * Returns SCENE_OK or the loader's status (details in err, which may be NULL). */

@@ -417,7 +417,8 @@ static scene_status check_needs(const scene *s, scene_error *err)
 static scene_status check_build(const scene *s, scene_error *err)
 {
     const scn_needs *n = s->needs;
-    uint32_t missing = n->features & ~(uint32_t)CFG_FEATURES;
+    /* textures are optional: a build without them draws the scene's flat colours */
+    uint32_t missing = n->features & ~((uint32_t)CFG_FEATURES | SCN_NEED_TEXTURES);
     for (uint32_t bit = 0; missing; bit++)
         if (missing & (1u << bit)) return refuse(err, bit, 1, 0);
     if (s->hdr->max_depth > CFG_MAX_DEPTH)

@@ -17,7 +17,7 @@ extern const uint8_t default_scene[];
 extern const uint32_t default_scene_len;
 
 static const char usage[] =
-    "usage: emu [SCENE] [--scale N] [--frames N] [--headless] [--out DIR]\n"
+    "usage: emu [SCENE] [--scale N] [--frames N] [--headless] [--out DIR] [--flat]\n"
     "\n"
     "Walk through SCENE (default: the built-in scene) in a window.\n"
     "SCENE is a compiled scene, a text scene, or FILE.wad:MAP (e.g. freedoom2.wad:MAP01).\n"
@@ -28,6 +28,7 @@ static const char usage[] =
     "      C print counters, Esc quit.\n"
     "\n"
     "  --scale N     window size factor (default 3)\n"
+    "  --flat        draw a textured scene (a WAD map) in flat colours\n"
     "  --frames N    quit after N frames (default: run until Esc)\n"
     "  --headless    do not open a window: render the fly-through to PNG files\n"
     "  --out DIR     where the headless fly-through goes (default build/flythrough)\n"
@@ -89,11 +90,13 @@ int main(int argc, char **argv)
 {
     const char *spec = NULL, *out = "build/flythrough";
     long frames = 0;
-    int scale = HAL_SDL_DEFAULT_SCALE, headless = 0;
+    int scale = HAL_SDL_DEFAULT_SCALE, headless = 0, flat = 0;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
             fputs(usage, stdout);
             return 0;
+        } else if (!strcmp(argv[i], "--flat")) {
+            flat = 1;
         } else if (!strcmp(argv[i], "--headless")) {
             headless = 1;
         } else if (i + 1 < argc && !strcmp(argv[i], "--scale")) {
@@ -133,6 +136,7 @@ int main(int argc, char **argv)
         free(blob);
         return 1;
     }
+    e.flat = (uint8_t)flat;
     uint32_t need = eng_work_bytes(&e);
     void *work = need ? malloc(need) : NULL;
     if (!work || eng_set_work(&e, work, need) != 0) {

@@ -40,6 +40,7 @@ static const char usage[] =
     "  --raw FILE         write the 64,000 frame bytes\n"
     "  --ids FILE         write the surface-id buffer: 320x200 little-endian uint32,\n"
     "                     kind << 24 | index (0 none, 1 wall, 2 floor, 3 ceiling, 4 object)\n"
+    "  --flat             draw a textured scene (a WAD map) in flat colours\n"
     "  --repeat N         render the same frame N times (default 1); counters are\n"
     "                     those of the last frame\n"
     "  -h, --help         this text\n"
@@ -77,7 +78,7 @@ typedef struct {
     bspc_options bspc;
     long repeat;
     uint32_t time_ms;
-    int have_time, no_objects;
+    int have_time, no_objects, flat;
     const char *objects; /* --objects FILE */
     door_opt *doors;     /* room for every argument */
     int ndoors;
@@ -115,6 +116,8 @@ static int parse_args(options *o, int argc, char **argv)
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             fputs(usage, stdout);
             exit(0);
+        } else if (!strcmp(a, "--flat")) {
+            o->flat = 1;
         } else if (!strcmp(a, "--no-objects")) {
             o->no_objects = 1;
             takes = 0;
@@ -432,7 +435,8 @@ static void print_json(const options *o, const engine *e, uint32_t crc)
     print_fx("z", c->z, ", ");
     print_fx("angle", c->angle_deg, ", ");
     printf("\"look\": %d}, ", (int)c->look);
-    printf("\"mode\": \"%s\", \"present\": \"%s\", ", render_mode_name(e->mode), hal_present_name(e->present));
+    printf("\"mode\": \"%s\", \"present\": \"%s\", \"textured\": %d, ", render_mode_name(e->mode),
+           hal_present_name(e->present), eng_textured(e));
     printf("\"crc32\": \"%08x\", \"pixels_written\": %llu, \"overdraw\": %llu.%03llu, ", (unsigned)crc,
            (unsigned long long)pixels, (unsigned long long)(pixels / HAL_PAGE_BYTES),
            (unsigned long long)((pixels % HAL_PAGE_BYTES) * 1000 / HAL_PAGE_BYTES));
@@ -532,6 +536,7 @@ int main(int argc, char **argv)
     }
     e.mode = o.mode;
     e.present = o.present;
+    e.flat = (uint8_t)o.flat;
     if (o.have_at) {
         e.cam.view.x = o.cam.x;
         e.cam.view.y = o.cam.y;

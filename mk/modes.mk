@@ -17,3 +17,8 @@ render_modes_list = $(sort $(subst $(comma), ,$(1)))
 render_modes_check = $(if $(strip $(call render_modes_list,$(1))),,$(error modes: no render mode given (direct, spans, painter)))$(foreach m,$(call render_modes_list,$(1)),$(if $(RENDER_MODE_BIT_$(m)),,$(error modes: '$(m)' in '$(1)' is not a render mode (direct, spans, painter))))
 render_modes_mask = $(strip $(call render_modes_check,$(1))$(shell echo $$(( 0 $(foreach m,$(call render_modes_list,$(1)),+ $(RENDER_MODE_BIT_$(m))) ))))
 render_modes_def = -DCFG_RENDER_MODES=$(call render_modes_mask,$(1))
+
+# FLAT=1: a bare-metal build without the texture code; textured scenes are drawn
+# in their flat colours (a slow display link, a small flash).
+FLAT ?=
+flat_def = $(if $(filter 1,$(FLAT)),-DCFG_FLAT=1)

@@ -50,7 +50,7 @@ FW_MODES ?= direct
 # beyond them are worked out again where needed, never dropped.
 DIRECT_FACES ?= 16
 DIRECT_EDGES ?= 96
-FW_DEFS = $(call render_modes_def,$(FW_MODES)) -DCFG_DIRECT_FACES=$(DIRECT_FACES)u -DCFG_DIRECT_EDGES=$(DIRECT_EDGES)u
+FW_DEFS = $(call render_modes_def,$(FW_MODES)) $(flat_def) -DCFG_DIRECT_FACES=$(DIRECT_FACES)u -DCFG_DIRECT_EDGES=$(DIRECT_EDGES)u
 RAM_BYTES ?= 200000
 # The stack: the walks keep a stack of the tree's depth (CFG_MAX_DEPTH: the scene's
 # in a build for it, 255 in a FULL=1 build). Measured high-water marks (hal/mps2/README.md):

@@ -33,7 +33,7 @@ PC_CFLAGS := -std=c11 -O2 -g -m32 -march=i686 -ffreestanding -nostdlib -fno-pic 
              -fno-tree-loop-distribute-patterns -ffunction-sections -fdata-sections \
              $(WARN) -Ifirmware -Ihal -Ihal/pcvga -Ihal/bare
 PC_SRC    := $(FW_SRC) $(HAL_SRC) $(PCVGA_SRC)
-PC_SCENE_DEF  := $(if $(FULL),,-DSCENE_CONFIG='"$(abspath $(PC_OUT)/scene_config.h)"') $(call render_modes_def,$(PC_MODES))
+PC_SCENE_DEF  := $(if $(FULL),,-DSCENE_CONFIG='"$(abspath $(PC_OUT)/scene_config.h)"') $(call render_modes_def,$(PC_MODES)) $(flat_def)
 PC_CONFIG_DEP := $(if $(FULL),,$(PC_OUT)/scene_config.h) $(PC_OBJ)/modes
 PC_OBJS   := $(patsubst %.c,$(PC_OBJ)/%.o,$(PC_SRC)) $(patsubst %.S,$(PC_OBJ)/%.o,$(PCVGA_ASM)) $(PC_OUT)/fw_scene.o
 # libgcc's floating-point helpers for i386 (soft-float entry points and conversions).
