@@ -65,6 +65,7 @@
 #define CFG_SKY CFG_HAS(SCN_NEED_SKY)
 #define CFG_LOOK CFG_HAS(SCN_NEED_LOOK)
 #define CFG_YCLIP CFG_HAS(SCN_NEED_YCLIP)
+#define CFG_TEXTURES CFG_HAS(SCN_NEED_TEXTURES)
 
 /* The most vertices of a polygon before clipping: a wall (4), a leaf floor, an
  * object's face. */
