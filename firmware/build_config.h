@@ -65,6 +65,12 @@
 #define CFG_SKY CFG_HAS(SCN_NEED_SKY)
 #define CFG_LOOK CFG_HAS(SCN_NEED_LOOK)
 #define CFG_YCLIP CFG_HAS(SCN_NEED_YCLIP)
+/* CFG_FLAT=1: a build that draws every scene in flat colours, textured ones
+ * too (the loader accepts them and leaves their look unused). */
+#ifndef CFG_FLAT
+#define CFG_FLAT 0
+#endif
+#define CFG_TEXTURES (CFG_HAS(SCN_NEED_TEXTURES) && !CFG_FLAT)
 
 /* The most vertices of a polygon before clipping: a wall (4), a leaf floor, an
  * object's face. */

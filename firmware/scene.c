@@ -10,7 +10,7 @@ static const uint32_t record_bytes[SCN_SEC_COUNT] = {
     sizeof(scn_vertex), sizeof(scn_sector), sizeof(scn_line), sizeof(scn_seg),
     sizeof(scn_node), sizeof(scn_leaf), sizeof(scn_vertex), 3,
     sizeof(scn_model), sizeof(scn_mvert), sizeof(scn_face), sizeof(uint32_t), sizeof(scn_object),
-    sizeof(scn_needs),
+    sizeof(scn_needs), sizeof(scn_look), 256, sizeof(scn_texture), 1, sizeof(scn_side), sizeof(scn_plane),
 };
 
 const char *scene_status_text(scene_status st)
@@ -29,6 +29,7 @@ const char *scene_section_name(int section)
     static const char *const names[SCN_SEC_COUNT] = {
         "vertices", "sectors", "lines", "segs", "nodes", "leaves", "leaf polygon vertices", "palette",
         "models", "model vertices", "faces", "face indices", "objects", "needs",
+        "look", "light tables", "textures", "texels", "sides", "planes",
     };
     return (section >= 0 && section < SCN_SEC_COUNT) ? names[section] : "header";
 }
@@ -55,7 +56,8 @@ static scene_status refuse(scene_error *err, uint32_t item, uint32_t need, uint3
 const char *scene_item_name(uint32_t item)
 {
     static const char *const names[SCENE_ITEM_COUNT] = {
-        "objects", "doors", "two-sided walls", "height changes", "sky steps", "look up/down", "y-clipping", "textures",
+        "objects", "doors", "two-sided walls", "height changes", "sky steps", "look up/down", "y-clipping",
+        "textures",
         "edges per frame", "surfaces per frame", "tree depth", "leaf polygon vertices", "model vertices",
         "face vertices",
     };
@@ -66,6 +68,36 @@ static int coord_ok(int32_t v, int32_t limit_units)
 {
     int64_t lim = (int64_t)limit_units << 16;
     return v >= -lim && v <= lim;
+}
+
+/* The look's sections: none at all (a flat-shaded scene), or one look record
+ * with all 32 light tables, a side per line side and a plane per sector. */
+static scene_status check_look_sections(scene *s, const uint8_t *base, const scn_header *h, scene_error *err)
+{
+    const scn_section *sec = h->sec;
+    uint32_t look = sec[SCN_SEC_LOOK].count;
+    if (look > 1) return fail(err, SCENE_ERR_SECTION, SCN_SEC_LOOK, 0);
+    if (look == 0) {
+        for (int i = SCN_SEC_LIGHTS; i <= SCN_SEC_PLANES; i++)
+            if (sec[i].count != 0) return fail(err, SCENE_ERR_SECTION, i, 0);
+        s->look = 0;
+    } else {
+        if (sec[SCN_SEC_LIGHTS].count != SCN_LIGHT_MAPS) return fail(err, SCENE_ERR_SECTION, SCN_SEC_LIGHTS, 0);
+        if (sec[SCN_SEC_TEXTURES].count < 1) return fail(err, SCENE_ERR_SECTION, SCN_SEC_TEXTURES, 0);
+        if ((uint64_t)sec[SCN_SEC_SIDES].count != 2u * (uint64_t)s->nlines)
+            return fail(err, SCENE_ERR_SECTION, SCN_SEC_SIDES, 0);
+        if (sec[SCN_SEC_PLANES].count != s->nsectors) return fail(err, SCENE_ERR_SECTION, SCN_SEC_PLANES, 0);
+        s->look = (const scn_look *)(base + sec[SCN_SEC_LOOK].offset);
+    }
+    s->lights = base + sec[SCN_SEC_LIGHTS].offset;
+    s->textures = (const scn_texture *)(base + sec[SCN_SEC_TEXTURES].offset);
+    s->texels = base + sec[SCN_SEC_TEXELS].offset;
+    s->sides = (const scn_side *)(base + sec[SCN_SEC_SIDES].offset);
+    s->planes = (const scn_plane *)(base + sec[SCN_SEC_PLANES].offset);
+    s->nlights = sec[SCN_SEC_LIGHTS].count;
+    s->ntextures = sec[SCN_SEC_TEXTURES].count;
+    s->ntexels = sec[SCN_SEC_TEXELS].count;
+    return SCENE_OK;
 }
 
 static scene_status check_sections(scene *s, const uint8_t *base, const scn_header *h, scene_error *err)
@@ -104,7 +136,7 @@ static scene_status check_sections(scene *s, const uint8_t *base, const scn_head
     s->nfaces = h->sec[SCN_SEC_FACES].count;
     s->nfindex = h->sec[SCN_SEC_FINDEX].count;
     s->nobjects = h->sec[SCN_SEC_OBJECTS].count;
-    return SCENE_OK;
+    return check_look_sections(s, base, h, err);
 }
 
 static scene_status check_geometry(const scene *s, scene_error *err)
@@ -251,6 +283,40 @@ static scene_status check_objects(const scene *s, scene_error *err)
     return SCENE_OK;
 }
 
+static int tex_ok(const scene *s, uint32_t t)
+{
+    return t == SCN_TEX_NONE || t < s->ntextures;
+}
+
+/* Every texture inside the texels, every texture index in range, every side's
+ * mapping a unit vector's size, every reserved field 0 (docs/textures.md). */
+static scene_status check_look(const scene *s, scene_error *err)
+{
+    if (!s->look) return SCENE_OK;
+    if (!tex_ok(s, s->look->sky_tex) || s->look->flags != 0) return fail(err, SCENE_ERR_INDEX, SCN_SEC_LOOK, 0);
+    for (uint32_t i = 0; i < s->ntextures; i++) {
+        const scn_texture *t = &s->textures[i];
+        if (t->wbits > SCN_TEX_MAX_BITS || t->hbits > SCN_TEX_MAX_BITS || t->reserved != 0 || t->reserved2 != 0 ||
+            t->height == 0 || t->height > (1u << t->hbits))
+            return fail(err, SCENE_ERR_RANGE, SCN_SEC_TEXTURES, i);
+        if ((uint64_t)t->first + ((uint64_t)1 << (t->wbits + t->hbits)) > s->ntexels)
+            return fail(err, SCENE_ERR_INDEX, SCN_SEC_TEXTURES, i);
+    }
+    const int32_t one = 1 << 30;
+    for (uint32_t i = 0; i < 2u * s->nlines; i++) {
+        const scn_side *d = &s->sides[i];
+        if (!tex_ok(s, d->tex[0]) || !tex_ok(s, d->tex[1]) || !tex_ok(s, d->tex[2]))
+            return fail(err, SCENE_ERR_INDEX, SCN_SEC_SIDES, i);
+        if ((d->flags & ~(SCN_SIDE_UNPEG_TOP | SCN_SIDE_UNPEG_BOTTOM)) || d->light_adj < -1 || d->light_adj > 1 ||
+            d->ux < -one || d->ux > one || d->uy < -one || d->uy > one)
+            return fail(err, SCENE_ERR_RANGE, SCN_SEC_SIDES, i);
+    }
+    for (uint32_t i = 0; i < s->nsectors; i++)
+        if (!tex_ok(s, s->planes[i].floor_tex) || !tex_ok(s, s->planes[i].ceil_tex))
+            return fail(err, SCENE_ERR_INDEX, SCN_SEC_PLANES, i);
+    return SCENE_OK;
+}
+
 /* Walk the whole graph from the root with a stack of SCN_MAX_DEPTH + 1 entries,
  * counting visits: a tree visits each node at most once, so more visits than
  * nodes means a shared child or a cycle. Bounded by nnodes + 1 pops. */
@@ -315,6 +381,7 @@ scene_status scene_parse(scene *s, const void *blob, uint32_t len, scene_error *
     scene_status st = check_sections(s, base, h, err);
     if (st == SCENE_OK) st = check_geometry(s, err);
     if (st == SCENE_OK) st = check_objects(s, err);
+    if (st == SCENE_OK) st = check_look(s, err);
     if (st == SCENE_OK) st = check_tree(s, err);
     return st;
 }
@@ -348,6 +415,7 @@ uint32_t scene_sector_at(const scene *s, int32_t x, int32_t y)
 uint32_t scene_derived_features(const scene *s)
 {
     uint32_t f = s->nmodels ? SCN_NEED_OBJECTS : 0;
+    if (s->look) f |= SCN_NEED_TEXTURES;
     for (uint32_t i = 0; i < s->nsectors; i++) {
         const scn_sector *a = &s->sectors[i], *b = &s->sectors[0];
         if (a->flags & SCN_SECTOR_DOOR) f |= SCN_NEED_DOORS;

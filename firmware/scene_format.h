@@ -202,17 +202,16 @@ typedef struct {
  * sizes its buffers to the bounds; its loader refuses a scene that needs more.
  * The bounds hold for every camera the renderer accepts (any position in the
  * coordinate box, any height, any angle and look) and every door state. */
-enum {
-    SCN_NEED_OBJECTS = 1u << 0,   /* models (objects are placed from them) */
-    SCN_NEED_DOORS = 1u << 1,     /* a sector whose ceiling moves */
-    SCN_NEED_TWO_SIDED = 1u << 2, /* a line with a sector on both sides */
-    SCN_NEED_HEIGHTS = 1u << 3,   /* floors or ceilings at more than one height */
-    SCN_NEED_SKY = 1u << 4,       /* two sky ceilings meet at a step (Doom's sky rule) */
-    SCN_NEED_LOOK = 1u << 5,      /* the camera may look up and down */
-    SCN_NEED_YCLIP = 1u << 6,     /* a polygon can cross the top or bottom screen edge */
-    SCN_NEED_TEXTURES = 1u << 7,  /* textures, light tables and a sky (docs/textures.md) */
-    SCN_NEED_ALL = (1u << 8) - 1u
-};
+/* Macros, not an enum: builds test them in #if (build_config.h's CFG_TEXTURES). */
+#define SCN_NEED_OBJECTS (1u << 0) /* models (objects are placed from them) */
+#define SCN_NEED_DOORS (1u << 1) /* a sector whose ceiling moves */
+#define SCN_NEED_TWO_SIDED (1u << 2) /* a line with a sector on both sides */
+#define SCN_NEED_HEIGHTS (1u << 3) /* floors or ceilings at more than one height */
+#define SCN_NEED_SKY (1u << 4) /* two sky ceilings meet at a step (Doom's sky rule) */
+#define SCN_NEED_LOOK (1u << 5) /* the camera may look up and down */
+#define SCN_NEED_YCLIP (1u << 6) /* a polygon can cross the top or bottom screen edge */
+#define SCN_NEED_TEXTURES (1u << 7) /* textures, light tables and a sky (docs/textures.md) */
+#define SCN_NEED_ALL ((1u << 8) - 1u)
 
 typedef struct {
     uint32_t features;      /* SCN_NEED_* */

@@ -23,12 +23,6 @@
 #include "scene.h"
 #include "view.h"
 
-/* CFG_FLAT=1: a build that draws every scene in flat colours, textured ones
- * too (the loader accepts them and leaves their look unused). */
-#ifndef CFG_FLAT
-#define CFG_FLAT 0
-#endif
-#define CFG_TEXTURES (CFG_HAS(SCN_NEED_TEXTURES) && !CFG_FLAT)
 
 #ifndef TEX_SUBDIV_BITS
 #define TEX_SUBDIV_BITS 4

@@ -151,6 +151,20 @@ static void describe_section(const scn_header *h, int i, char *out, size_t n)
         snprintf(out, n, "%s section: %u entries, expected 256", name, count);
     else if (i == SCN_SEC_NEEDS && count != 1)
         snprintf(out, n, "%s section: %u records, expected 1", name, count);
+    else if (i == SCN_SEC_LOOK && count > 1)
+        snprintf(out, n, "%s section: %u records, expected 0 or 1", name, count);
+    else if (i > SCN_SEC_LOOK && h->sec[SCN_SEC_LOOK].count == 0 && count != 0)
+        snprintf(out, n, "%s section: %u records in a scene without a look section, expected 0", name, count);
+    else if (i == SCN_SEC_LIGHTS && count != SCN_LIGHT_MAPS)
+        snprintf(out, n, "%s section: %u tables, expected %d", name, count, SCN_LIGHT_MAPS);
+    else if (i == SCN_SEC_TEXTURES && count == 0)
+        snprintf(out, n, "%s section: no textures in a scene with a look", name);
+    else if (i == SCN_SEC_SIDES && count != 2u * h->sec[SCN_SEC_LINES].count)
+        snprintf(out, n, "%s section: %u records, expected 2 per line (%u lines)", name, count,
+                 h->sec[SCN_SEC_LINES].count);
+    else if (i == SCN_SEC_PLANES && count != h->sec[SCN_SEC_SECTORS].count)
+        snprintf(out, n, "%s section: %u records, expected 1 per sector (%u sectors)", name, count,
+                 h->sec[SCN_SEC_SECTORS].count);
     else
         snprintf(out, n, "%s section: %u records from offset %u run past the end of the scene (total_bytes %u)",
                  name, count, off, h->total_bytes);

@@ -19,6 +19,10 @@ _Static_assert(sizeof(scn_line) == 24, "scn_line layout");
 _Static_assert(sizeof(scn_seg) == 16, "scn_seg layout");
 _Static_assert(sizeof(scn_node) == 56, "scn_node layout");
 _Static_assert(sizeof(scn_leaf) == 20, "scn_leaf layout");
+_Static_assert(sizeof(scn_look) == 8, "scn_look layout");
+_Static_assert(sizeof(scn_texture) == 12, "scn_texture layout");
+_Static_assert(sizeof(scn_side) == 24, "scn_side layout");
+_Static_assert(sizeof(scn_plane) == 4, "scn_plane layout");
 
 typedef struct {
     uint8_t *p;
@@ -97,11 +101,16 @@ int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *l
 
     uint32_t npv = 0;
     for (uint32_t i = 0; i < t->nleaves; i++) npv += t->leaves[i].poly.n;
+    const bs_look *lk = &s->look;
+    int look = lk->present;
     uint32_t counts[SCN_SEC_COUNT] = {t->nverts, s->nsectors, s->nlines, t->nsegs,
                                       t->nnodes, t->nleaves,  npv,       256,
-                                      s->nmodels, s->nmverts, s->nfaces, s->nfindex, s->nobjects, 1};
+                                      s->nmodels, s->nmverts, s->nfaces, s->nfindex, s->nobjects, 1,
+                                      look ? 1u : 0u, look ? SCN_LIGHT_MAPS : 0u, look ? lk->ntex : 0u,
+                                      look ? lk->ntexels : 0u, look ? 2u * s->nlines : 0u,
+                                      look ? s->nsectors : 0u};
     static const uint32_t recsz[SCN_SEC_COUNT] = {8, 12 + 4, 24, 16, 56, 20, 8, 3, 28, 12, 8, 4, 40,
-                                                  sizeof(scn_needs)};
+                                                  sizeof(scn_needs), 8, 256, 12, 1, 24, 4};
     uint32_t off[SCN_SEC_COUNT];
     uint64_t at = sizeof(scn_header);
     for (int k = 0; k < SCN_SEC_COUNT; k++) {
@@ -211,7 +220,10 @@ int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *l
             wi32(&w, t->leaves[i].poly.v[k].y);
         }
     w.at = off[SCN_SEC_PALETTE];
-    bs_palette(p + w.at);
+    if (lk->doom_palette)
+        memcpy(p + w.at, lk->palette, 768);
+    else
+        bs_palette(p + w.at);
     w.at = off[SCN_SEC_MODELS];
     for (uint32_t i = 0; i < s->nmodels; i++) {
         const bs_model *m = &s->models[i];
@@ -252,6 +264,40 @@ int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *l
         wi32(&w, o->pb);
         w32(&w, o->period_ms);
         wi32(&w, o->spin);
+    }
+
+    if (look) {
+        w.at = off[SCN_SEC_LOOK];
+        w32(&w, lk->sky_tex);
+        w32(&w, 0);
+        memcpy(p + off[SCN_SEC_LIGHTS], lk->lights, 256 * SCN_LIGHT_MAPS);
+        w.at = off[SCN_SEC_TEXTURES];
+        for (uint32_t i = 0; i < lk->ntex; i++) {
+            w32(&w, lk->tex[i].first);
+            w8(&w, lk->tex[i].wbits);
+            w8(&w, lk->tex[i].hbits);
+            w8(&w, lk->tex[i].colour);
+            w8(&w, 0);
+            w16(&w, lk->tex[i].height);
+            w16(&w, 0);
+        }
+        memcpy(p + off[SCN_SEC_TEXELS], lk->texels, lk->ntexels);
+        w.at = off[SCN_SEC_SIDES];
+        for (uint32_t i = 0; i < 2 * s->nlines; i++) {
+            const scn_side *d = &lk->sides[i];
+            wi32(&w, d->ux);
+            wi32(&w, d->uy);
+            wi32(&w, d->u0);
+            wi32(&w, d->row_off);
+            for (int k = 0; k < 3; k++) w16(&w, d->tex[k]);
+            w8(&w, d->flags);
+            w8(&w, (uint8_t)d->light_adj);
+        }
+        w.at = off[SCN_SEC_PLANES];
+        for (uint32_t i = 0; i < s->nsectors; i++) {
+            w16(&w, lk->planes[i].floor_tex);
+            w16(&w, lk->planes[i].ceil_tex);
+        }
     }
 
     /* the needs record (SCN_SEC_NEEDS) stays zero here: bspc.c fills it in from

@@ -15,6 +15,7 @@ bspc_options bspc_defaults(void)
     bspc_options o;
     o.split = BSPC_SPLIT_MIXED;
     o.verbose = 0;
+    o.flat = 0;
     return o;
 }
 

@@ -14,6 +14,7 @@ typedef enum { BSPC_SPLIT_FEWEST, BSPC_SPLIT_BALANCED, BSPC_SPLIT_MIXED } bspc_s
 typedef struct {
     bspc_split split; /* default BSPC_SPLIT_MIXED */
     int verbose;      /* progress and warnings on stderr */
+    int flat;         /* leave a WAD map's look out (docs/textures.md): flat colours only */
 } bspc_options;
 
 typedef struct {

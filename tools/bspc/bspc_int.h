@@ -16,6 +16,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "bspc.h"
 #include "scene_format.h"
@@ -110,6 +111,23 @@ typedef struct {
 #define BS_PERIOD_MAX_MS 3600000u /* one hour */
 #define BS_SPIN_MAX 3600          /* |degrees per second| */
 
+/* A WAD map's look (docs/textures.md), filled by wad_look.c: the records of
+ * the look sections, ready to write. */
+typedef struct {
+    int present;                    /* write the look sections (not under --flat) */
+    int doom_palette;               /* palette[] is PLAYPAL's (even under --flat) */
+    uint8_t palette[768];
+    uint8_t *lights;                /* SCN_LIGHT_MAPS tables of 256 */
+    scn_texture *tex;
+    uint32_t ntex, tcap;
+    uint8_t *texels;
+    uint32_t ntexels, txcap;
+    uint32_t sky_tex;               /* SCN_TEX_NONE: no sky */
+    scn_side *sides;                /* 2 per scene line, index line * 2 + side */
+    scn_plane *planes;              /* one per sector */
+    uint8_t shade[3][256];          /* model faces' fake contrast under PLAYPAL: [contrast + 1][colour] */
+} bs_look;
+
 typedef struct {
     char name[300];                 /* for messages: "a.scene" or "x.wad:MAP01" */
     int is_text;                    /* messages quote text line numbers */
@@ -135,6 +153,7 @@ typedef struct {
     bs_object *objects;
     uint32_t nobjects, ocap;
     uint32_t ndoors;
+    bs_look look;
 } bs_scene;
 
 void bs_scene_free(bs_scene *s);
@@ -147,6 +166,33 @@ int bs_read_text(const char *path, bs_scene *s, const bspc_options *opt, char *e
  * display: the spec as the user wrote it, for messages. */
 int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_scene *s,
                 const bspc_options *opt, char *err, size_t errlen);
+
+/* wad_look.c: a WAD's palette, light tables, textures, flats and sprites
+ * (docs/textures.md). wad.c reads the directory and the map; it opens the look
+ * once (NULL and 0: the WAD has none, the scene stays flat as before), then
+ * asks it for each sector, each line side and each thing, and closes it. */
+typedef struct {
+    uint32_t pos, size;
+    char name[9];
+} bs_wadlump;
+typedef struct bs_wadlook bs_wadlook;
+int bs_look_open(FILE *f, size_t flen, const bs_wadlump *dir, uint32_t ndir, const char *map, bs_scene *s,
+                 uint32_t nsectors, uint32_t nlinedefs, const bspc_options *opt, bs_wadlook **out, char *err,
+                 size_t errlen);
+/* Sector i from its SECTORS record: plane textures and flat colours. */
+int bs_look_sector(bs_wadlook *L, uint32_t i, const uint8_t rec[26], char *err, size_t errlen);
+/* Side k of scene line li (vertices and sectors set) from its SIDEDEFS record
+ * and the linedef's flags: textures, column mapping, pegging, flat colours. */
+int bs_look_side(bs_wadlook *L, uint32_t li, int k, const uint8_t rec[30], unsigned line_flags, char *err,
+                 size_t errlen);
+/* A thing's box colour: the sprite's mean colour, or fallback (a default-palette
+ * colour of things.txt) moved to the nearest PLAYPAL colour. */
+uint8_t bs_look_thing_colour(bs_wadlook *L, const char prefix[4], uint8_t fallback);
+/* Done (also after a failure): the look is kept unless --flat (the Doom palette
+ * and colours stay either way). */
+void bs_look_close(bs_wadlook *L);
+/* default-palette colour, one light step brighter (+1) or darker (-1), in the scene's palette */
+uint8_t bs_scene_shade(const bs_scene *s, uint8_t c, int delta);
 
 /* scene_check.c: ranges (both inputs); closed loops and orientation (strict, text
  * scenes); the player's sector by winding number (SCN_NONE if outside all). */

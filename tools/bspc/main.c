@@ -1,5 +1,5 @@
 /* main.c - build/bspc, the BSP compiler's command line:
- *   bspc INPUT [-o OUT] [--split fewest|balanced|mixed] [--stats] [--needs] [--config FILE.h] [-v]
+ *   bspc INPUT [-o OUT] [--split fewest|balanced|mixed] [--flat] [--stats] [--needs] [--config FILE.h] [-v]
  * INPUT is a text scene (docs/scene-format.md) or file.wad:MAP01 / file.wad:E1M1. */
 #include <errno.h>
 #include <stdio.h>
@@ -12,8 +12,8 @@
 
 static void usage(FILE *f)
 {
-    fputs("usage: bspc INPUT [-o OUT] [--split fewest|balanced|mixed] [--stats] [--needs]\n"
-          "            [--config FILE.h] [-v]\n"
+    fputs("usage: bspc INPUT [-o OUT] [--split fewest|balanced|mixed] [--flat] [--stats]\n"
+          "            [--needs] [--config FILE.h] [-v]\n"
           "\n"
           "Compiles a scene into a BSP blob (firmware/scene_format.h).\n"
           "  INPUT            a text scene (docs/scene-format.md), or a Doom-format map as\n"
@@ -23,6 +23,8 @@ static void usage(FILE *f)
           "                   current folder; file.wad:MAP01 gives file-MAP01.bsc)\n"
           "  --split S        partition choice: fewest (fewest splits), balanced (best\n"
           "                   balance) or mixed (weighted, the default)\n"
+          "  --flat           leave a WAD map's textures and light tables out: flat\n"
+          "                   colours only (still from the WAD's palette; docs/textures.md)\n"
           "  --stats          print one JSON object of build figures on stdout\n"
           "  --needs          print what the scene needs: features, and the most work one\n"
           "                   frame can take for any camera (docs/needs.md)\n"
@@ -118,6 +120,8 @@ int main(int argc, char **argv)
             return 0;
         } else if (strcmp(a, "-v") == 0 || strcmp(a, "--verbose") == 0) {
             opt.verbose = 1;
+        } else if (strcmp(a, "--flat") == 0) {
+            opt.flat = 1;
         } else if (strcmp(a, "--stats") == 0) {
             want_stats = 1;
         } else if (strcmp(a, "--needs") == 0) {

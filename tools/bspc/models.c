@@ -162,7 +162,7 @@ int bs_model_add_part(bs_scene *s, const bs_mpart *p, char *err, size_t errlen)
         /* Doom's fake contrast: a face whose normal points along x (its edge
          * runs north-south) darker, along y lighter */
         int contrast = (ring[k].y == ring[j].y) ? 1 : (ring[k].x == ring[j].x) ? -1 : 0;
-        if (push_face(s, idx, 4, bs_shade(p->side, contrast), part))
+        if (push_face(s, idx, 4, bs_scene_shade(s, p->side, contrast), part))
             return bs_fail(err, errlen, "out of memory");
     }
     for (int k = 0; k < n; k++) idx[k] = base + (uint32_t)(n + k);

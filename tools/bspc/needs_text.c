@@ -14,7 +14,7 @@ static const struct {
     {"two sky ceilings meet across a line", "no two sky ceilings meet"},
     {"the scene allows it", "the scene says 'look off'"},
     {"a polygon seen from just beside it crosses the screen's top or bottom", "nothing to draw"},
-    {"the map brings textures and light tables", "flat colours"},
+    {"the scene has wall textures, flats and light tables", "flat-shaded"},
 };
 _Static_assert(SCN_NEED_ALL == (1u << (sizeof feature_text / sizeof feature_text[0])) - 1u, "one text per feature");
 #define NFEATURES (sizeof feature_text / sizeof feature_text[0])

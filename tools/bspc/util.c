@@ -81,6 +81,11 @@ void bs_scene_free(bs_scene *s)
     free(s->faces);
     free(s->findex);
     free(s->objects);
+    free(s->look.lights);
+    free(s->look.tex);
+    free(s->look.texels);
+    free(s->look.sides);
+    free(s->look.planes);
     memset(s, 0, sizeof *s);
 }
 

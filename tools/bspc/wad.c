@@ -8,7 +8,8 @@
  *
  * Things listed in tools/bspc/things.txt (built in as things_txt.h) become
  * objects on box models, and sectors opened by door specials become doors
- * (docs/objects.md).
+ * (docs/objects.md). The WAD's palette, textures, flats and sprites give the
+ * scene its look and colours (wad_look.c, docs/textures.md).
  */
 #include <ctype.h>
 #include <errno.h>
@@ -19,10 +20,7 @@
 #include "bspc_int.h"
 #include "things_txt.h" /* bs_things_txt[], bs_things_txt_len: tools/bspc/things.txt */
 
-typedef struct {
-    uint32_t pos, size;
-    char name[9];
-} lump;
+typedef bs_wadlump lump;
 
 static uint16_t rd16(const uint8_t *p) { return (uint16_t)(p[0] | (p[1] << 8)); }
 static int16_t rds16(const uint8_t *p) { return (int16_t)rd16(p); }
@@ -63,6 +61,8 @@ typedef struct {
     uint16_t type;
     int32_t radius, height; /* whole units */
     uint8_t colour;
+    char sprite[4];  /* Doom's sprite name */
+    int coloured;    /* colour taken from the sprite (or PLAYPAL's nearest) */
 } thing_kind;
 
 /* Parse the built-in table into kinds[] (at most cap); returns the count, or -1
@@ -83,14 +83,15 @@ static int read_thing_table(thing_kind *kinds, int cap, char *err, size_t errlen
         lineno++;
         char *hash = strchr(line, '#');
         if (hash) *hash = 0;
-        char *col[6];
+        char *col[7];
         int nc = 0;
         char *save = NULL;
-        for (char *c = strtok_r(line, " \t\r", &save); c && nc < 6; c = strtok_r(NULL, " \t\r", &save))
+        for (char *c = strtok_r(line, " \t\r", &save); c && nc < 7; c = strtok_r(NULL, " \t\r", &save))
             col[nc++] = c;
         if (nc == 0) continue;
         long v[3];
-        int bad = nc != 5;
+        int bad = nc != 6 || strlen(col[4]) != 4;
+        for (int j = 0; j < 4 && !bad; j++) bad = !isupper((unsigned char)col[4][j]) && !isdigit((unsigned char)col[4][j]);
         for (int j = 0; j < 3 && !bad; j++) {
             char *end;
             errno = 0;
@@ -109,10 +110,11 @@ static int read_thing_table(thing_kind *kinds, int cap, char *err, size_t errlen
             bad = colour < 0;
         }
         if (bad)
-            return bs_fail(err, errlen, "things.txt:%d: expected 'type radius height colour name' "
+            return bs_fail(err, errlen, "things.txt:%d: expected 'type radius height colour sprite name' "
                            "(radius 1..%d)", lineno, SCN_MODEL_MAX);
         if (n == cap) return bs_fail(err, errlen, "things.txt: more than %d thing types", cap);
-        kinds[n++] = (thing_kind){(uint16_t)v[0], (int32_t)v[1], (int32_t)v[2], (uint8_t)colour};
+        kinds[n] = (thing_kind){(uint16_t)v[0], (int32_t)v[1], (int32_t)v[2], (uint8_t)colour, {0}, 0};
+        memcpy(kinds[n++].sprite, col[4], 4);
     }
     return n;
 }
@@ -122,7 +124,7 @@ static int read_thing_table(thing_kind *kinds, int cap, char *err, size_t errlen
 
 /* Things of listed types, on skill 3 and in single player, become objects, one
  * box model per distinct (radius, height, colour), models in order of first use. */
-static int read_things(bs_scene *s, const uint8_t *recs, uint32_t count, const char *display,
+static int read_things(bs_scene *s, bs_wadlook *look, const uint8_t *recs, uint32_t count, const char *display,
                        const bspc_options *opt, char *err, size_t errlen)
 {
     enum { MAX_KINDS = 512 };
@@ -158,6 +160,10 @@ static int read_things(bs_scene *s, const uint8_t *recs, uint32_t count, const c
             bs_warn(opt, "%s: thing %u: coordinate -32768 out of range, left out", display, i);
             skipped++;
             continue;
+        }
+        if (look && !kinds[k].coloured) {
+            kinds[k].colour = bs_look_thing_colour(look, kinds[k].sprite, kinds[k].colour);
+            kinds[k].coloured = 1;
         }
         /* kinds sharing a size and colour share a model */
         for (int j = 0; j < nk && model_of[k] == SCN_NONE; j++)
@@ -278,6 +284,7 @@ int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_sc
     int rc = -1;
     lump *dir = NULL;
     uint8_t *vused = NULL, *dirbuf = NULL;
+    bs_wadlook *look = NULL;
     enum { L_THINGS, L_LINEDEFS, L_SIDEDEFS, L_VERTEXES, L_SECTORS, L_N };
     uint8_t *ld[L_N] = {0};
     uint8_t hdr[12];
@@ -380,6 +387,8 @@ int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_sc
         bs_fail(err, errlen, "%s: map has no sectors", display);
         goto out;
     }
+    if (bs_look_open(f, len, dir, nlumps, want, s, cnt[L_SECTORS], cnt[L_LINEDEFS], opt, &look, err, errlen))
+        goto out;
     s->sectors = calloc(cnt[L_SECTORS], sizeof *s->sectors);
     if (!s->sectors) {
         bs_fail(err, errlen, "%s: out of memory", display);
@@ -412,6 +421,7 @@ int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_sc
         } else {
             c->ceil_color = bs_flat_color(cflat, light, 1);
         }
+        if (look && bs_look_sector(look, i, r, err, errlen)) goto out;
     }
 
     /* vertices: all of them, in lump order (unused ones are dropped by the build) */
@@ -493,6 +503,7 @@ int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_sc
                 (up[0] && strcmp(up, "-") != 0) ? bs_wall_color(up, light, contrast) : cm;
             l->color[k][SCN_PART_LOWER] =
                 (lo[0] && strcmp(lo, "-") != 0) ? bs_wall_color(lo, light, contrast) : cm;
+            if (look && bs_look_side(look, s->nlines, k, sr, rd16(r + 4), err, errlen)) goto out;
         }
         vused[v1] = vused[v2] = 1;
         s->nlines++;
@@ -537,9 +548,10 @@ int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_sc
     }
     /* every sidedef and sector index was checked by the linedef loop above */
     if (find_doors(s, ld[L_LINEDEFS], nl, ld[L_SIDEDEFS], ld[L_SECTORS], display, err, errlen)) goto out;
-    if (read_things(s, ld[L_THINGS], cnt[L_THINGS], display, opt, err, errlen)) goto out;
+    if (read_things(s, look, ld[L_THINGS], cnt[L_THINGS], display, opt, err, errlen)) goto out;
     rc = 0;
 out:
+    bs_look_close(look);
     for (int k = 0; k < L_N; k++) free(ld[k]);
     free(vused);
     free(dir);

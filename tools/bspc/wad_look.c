@@ -1,0 +1,553 @@
+/* wad_look.c - a WAD map's look (docs/textures.md): PLAYPAL, COLORMAP, the wall
+ * textures composed from their patches (TEXTURE1/2, PNAMES), flats, the sky,
+ * each side's texture mapping and each sector's planes, and the colours of
+ * the flat-shaded view and of things taken from the same data.
+ *
+ * Only what the map uses is composed and stored, each name once. Every byte
+ * read from the WAD is bounds-checked: a damaged lump of a texture the map
+ * uses is refused with a message naming the file, the lump and the problem.
+ * Doubles are fine here (the compiler runs on the host).
+ */
+#include <ctype.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bspc_int.h"
+
+enum { KIND_WALL, KIND_FLAT };
+
+typedef struct {
+    char name[9];
+    int kind;
+    uint16_t tex; /* SCN_TEX_NONE: unknown (warned once) */
+} used_name;
+
+struct bs_wadlook {
+    FILE *f;
+    size_t flen;
+    const bs_wadlump *dir;
+    uint32_t ndir;
+    const char *wad; /* the scene spec, for messages */
+    const bspc_options *opt;
+    bs_scene *s;
+    bs_look *lk;
+    uint8_t *pnames;
+    uint32_t npnames;
+    uint8_t *tdef[2];
+    uint32_t tdsize[2];
+    used_name *used;
+    uint32_t nused, ucap;
+    double (*mean)[3]; /* per stored texture */
+    uint32_t mcap;
+    uint32_t nlines_cap; /* sides has room for 2 * nlines_cap */
+    const char *sky_name;
+    uint8_t neutral; /* palette index of a mid grey, for parts without a texture */
+};
+
+static uint16_t rd16(const uint8_t *p) { return (uint16_t)(p[0] | (p[1] << 8)); }
+static int16_t rds16(const uint8_t *p) { return (int16_t)rd16(p); }
+static uint32_t rd32(const uint8_t *p)
+{
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
+}
+
+static void name8(char out[9], const uint8_t *p)
+{
+    int i;
+    for (i = 0; i < 8 && p[i]; i++) out[i] = (char)toupper(p[i]);
+    out[i] = 0;
+}
+
+/* the last lump of that name in [from, to), or ndir */
+static uint32_t find_lump(const bs_wadlook *L, const char *name, uint32_t from, uint32_t to)
+{
+    for (uint32_t i = to; i-- > from;)
+        if (strcmp(L->dir[i].name, name) == 0) return i;
+    return L->ndir;
+}
+
+/* Read lump i whole (at least min bytes); malloc'd into *out. */
+static int load_lump(const bs_wadlook *L, uint32_t i, uint32_t min, uint8_t **out, char *err, size_t errlen)
+{
+    const bs_wadlump *e = &L->dir[i];
+    *out = NULL;
+    if (e->pos > L->flen || e->size > L->flen - e->pos)
+        return bs_fail(err, errlen, "%s: lump %s runs past the end of the file", L->wad, e->name);
+    if (e->size < min)
+        return bs_fail(err, errlen, "%s: lump %s is %u bytes, shorter than %u", L->wad, e->name, e->size, min);
+    uint8_t *b = malloc((size_t)e->size + 1);
+    if (!b) return bs_fail(err, errlen, "%s: out of memory", L->wad);
+    if (fseek(L->f, (long)e->pos, SEEK_SET) != 0 || fread(b, 1, e->size, L->f) != e->size) {
+        free(b);
+        return bs_fail(err, errlen, "%s: cannot read lump %s", L->wad, e->name);
+    }
+    *out = b;
+    return 0;
+}
+
+static uint8_t nearest(const uint8_t pal[768], double r, double g, double b)
+{
+    double best = 1e30;
+    int bi = 0;
+    for (int i = 0; i < 256; i++) {
+        double dr = pal[3 * i] - r, dg = pal[3 * i + 1] - g, db = pal[3 * i + 2] - b;
+        double d = dr * dr + dg * dg + db * db;
+        if (d < best) {
+            best = d;
+            bi = i;
+        }
+    }
+    return (uint8_t)bi;
+}
+
+/* ---- storing textures ---- */
+
+static int log2_floor(uint32_t v)
+{
+    int b = 0;
+    while ((2u << b) <= v) b++;
+    return b;
+}
+
+static int log2_ceil(uint32_t v)
+{
+    int b = 0;
+    while ((1u << b) < v) b++;
+    return b;
+}
+
+/* Append a texture from a column-major w x h picture: 2^floor(log2 w) columns,
+ * rows padded to 2^ceil(log2 h) by repeating from the top (docs/textures.md). */
+static int store(bs_wadlook *L, const char *name, const uint8_t *pic, uint32_t w, uint32_t h, uint16_t *out,
+                 char *err, size_t errlen)
+{
+    bs_look *lk = L->lk;
+    int wb = log2_floor(w), hb = log2_ceil(h);
+    if (wb > SCN_TEX_MAX_BITS || hb > SCN_TEX_MAX_BITS)
+        return bs_fail(err, errlen, "%s: texture %s is %u x %u, larger than %d x %d", L->wad, name, w, h,
+                       1 << SCN_TEX_MAX_BITS, 1 << SCN_TEX_MAX_BITS);
+    if (lk->ntex >= SCN_TEX_NONE) return bs_fail(err, errlen, "%s: more than %u textures", L->wad, SCN_TEX_NONE);
+    uint32_t cols = 1u << wb, rows = 1u << hb, n = cols << hb;
+    if ((uint64_t)lk->ntexels + n > UINT32_MAX / 2 ||
+        bs_grow(&lk->texels, &lk->txcap, lk->ntexels + n, 1) ||
+        bs_grow(&lk->tex, &lk->tcap, lk->ntex + 1, sizeof *lk->tex) ||
+        bs_grow(&L->mean, &L->mcap, lk->ntex + 1, sizeof *L->mean))
+        return bs_fail(err, errlen, "%s: out of memory", L->wad);
+    uint8_t *t = lk->texels + lk->ntexels;
+    double sum[3] = {0, 0, 0};
+    for (uint32_t u = 0; u < cols; u++)
+        for (uint32_t v = 0; v < rows; v++) {
+            uint8_t c = pic[u * h + v % h];
+            t[(u << hb) + v] = c;
+            if (v < h)
+                for (int k = 0; k < 3; k++) sum[k] += lk->palette[3 * c + k];
+        }
+    scn_texture *x = &lk->tex[lk->ntex];
+    x->first = lk->ntexels;
+    x->wbits = (uint8_t)wb;
+    x->hbits = (uint8_t)hb;
+    x->reserved = 0;
+    x->height = (uint16_t)h;
+    x->reserved2 = 0;
+    for (int k = 0; k < 3; k++) L->mean[lk->ntex][k] = sum[k] / ((double)cols * h);
+    x->colour = nearest(lk->palette, L->mean[lk->ntex][0], L->mean[lk->ntex][1], L->mean[lk->ntex][2]);
+    lk->ntexels += n;
+    *out = (uint16_t)lk->ntex++;
+    return 0;
+}
+
+/* ---- pictures (Doom's patch format: columns of posts) ---- */
+
+/* Draw patch data p[0..size) into the column-major w x h picture at (ox, oy),
+ * clipped. what names the lump for messages. opaque counts the pixels drawn
+ * and sum their colours (either may be NULL). */
+static int draw_patch(const bs_wadlook *L, const uint8_t *p, uint32_t size, const char *what, uint8_t *pic,
+                      int32_t w, int32_t h, int32_t ox, int32_t oy, uint64_t *opaque, double sum[3], char *err,
+                      size_t errlen)
+{
+    if (size < 8) return bs_fail(err, errlen, "%s: patch %s: %u bytes, shorter than its 8-byte header", L->wad, what, size);
+    int32_t pw = rds16(p), ph = rds16(p + 2);
+    if (pw <= 0 || ph <= 0 || (uint64_t)8 + 4u * (uint64_t)pw > size)
+        return bs_fail(err, errlen, "%s: patch %s: size %d x %d does not fit its %u bytes", L->wad, what, pw, ph, size);
+    for (int32_t c = 0; c < pw; c++) {
+        int32_t x = ox + c;
+        if (pic && (x < 0 || x >= w)) continue;
+        uint32_t at = rd32(p + 8 + 4 * c);
+        for (;;) { /* at grows by at least 4 a post */
+            if (at >= size)
+                return bs_fail(err, errlen, "%s: patch %s: column %d runs past the end of the lump", L->wad, what, c);
+            uint32_t top = p[at];
+            if (top == 0xFF) break;
+            if ((uint64_t)at + 3 > size)
+                return bs_fail(err, errlen, "%s: patch %s: column %d: post header past the end", L->wad, what, c);
+            uint32_t len = p[at + 1];
+            if ((uint64_t)at + 3 + len > size)
+                return bs_fail(err, errlen, "%s: patch %s: column %d: post of %u bytes at %u runs past the end "
+                               "(%u bytes)", L->wad, what, c, len, at, size);
+            const uint8_t *src = p + at + 3;
+            for (uint32_t k = 0; k < len; k++) {
+                int32_t y = oy + (int32_t)(top + k);
+                if (opaque) (*opaque)++;
+                if (sum)
+                    for (int g = 0; g < 3; g++) sum[g] += L->lk->palette[3 * src[k] + g];
+                if (pic && y >= 0 && y < h) pic[x * h + y] = src[k];
+            }
+            at += len + 4;
+        }
+    }
+    return 0;
+}
+
+/* ---- wall textures ---- */
+
+/* Find name in TEXTURE1 then TEXTURE2 (the first definition wins, as in Doom):
+ * the lump number (0, 1) and the definition's offset, or -1. */
+static int find_texdef(const bs_wadlook *L, const char *name, int *which, uint32_t *off, char *err, size_t errlen)
+{
+    static const char *lumpname[2] = {"TEXTURE1", "TEXTURE2"};
+    for (int t = 0; t < 2; t++) {
+        const uint8_t *d = L->tdef[t];
+        uint32_t sz = L->tdsize[t];
+        if (!d) continue;
+        uint32_t n = rd32(d);
+        if (n > (sz - 4) / 4)
+            return bs_fail(err, errlen, "%s: lump %s: %u textures do not fit its %u bytes", L->wad, lumpname[t], n, sz);
+        for (uint32_t i = 0; i < n; i++) {
+            uint32_t o = rd32(d + 4 + 4 * i);
+            if (o > sz || sz - o < 22)
+                return bs_fail(err, errlen, "%s: lump %s: texture %u at offset %u runs past the end (%u bytes)",
+                               L->wad, lumpname[t], i, o, sz);
+            char nm[9];
+            name8(nm, d + o);
+            if (strcmp(nm, name) == 0) {
+                *which = t;
+                *off = o;
+                return 1;
+            }
+        }
+    }
+    return 0;
+}
+
+static int compose_wall(bs_wadlook *L, const char *name, uint16_t *out, char *err, size_t errlen)
+{
+    static const char *lumpname[2] = {"TEXTURE1", "TEXTURE2"};
+    int which = 0;
+    uint32_t off = 0;
+    int f = find_texdef(L, name, &which, &off, err, errlen);
+    if (f <= 0) {
+        *out = SCN_TEX_NONE;
+        return f;
+    }
+    const uint8_t *d = L->tdef[which] + off;
+    uint32_t room = L->tdsize[which] - off;
+    int32_t w = rds16(d + 12), h = rds16(d + 14);
+    uint32_t np = rd16(d + 20);
+    if (w <= 0 || h <= 0 || w > 4096 || h > 4096)
+        return bs_fail(err, errlen, "%s: lump %s: texture %s: size %d x %d", L->wad, lumpname[which], name, w, h);
+    if (22u + 10u * np > room)
+        return bs_fail(err, errlen, "%s: lump %s: texture %s: %u patches run past the end of the lump", L->wad,
+                       lumpname[which], name, np);
+    uint8_t *pic = calloc((size_t)w * (size_t)h, 1);
+    if (!pic) return bs_fail(err, errlen, "%s: out of memory", L->wad);
+    int rc = 0;
+    for (uint32_t k = 0; k < np && rc == 0; k++) {
+        const uint8_t *mp = d + 22 + 10 * k;
+        int32_t ox = rds16(mp), oy = rds16(mp + 2);
+        uint32_t pi = rd16(mp + 4);
+        if (pi >= L->npnames) {
+            rc = bs_fail(err, errlen, "%s: lump %s: texture %s: patch %u: PNAMES entry %u out of range (%u names)",
+                         L->wad, lumpname[which], name, k, pi, L->npnames);
+            break;
+        }
+        char pn[9];
+        name8(pn, L->pnames + 4 + 8 * pi);
+        uint32_t li = find_lump(L, pn, 0, L->ndir);
+        if (li == L->ndir) {
+            rc = bs_fail(err, errlen, "%s: texture %s: patch %s (PNAMES entry %u) is not in the WAD", L->wad, name,
+                         pn, pi);
+            break;
+        }
+        uint8_t *p;
+        rc = load_lump(L, li, 0, &p, err, errlen);
+        if (rc == 0) rc = draw_patch(L, p, L->dir[li].size, pn, pic, w, h, ox, oy, NULL, NULL, err, errlen);
+        free(p);
+    }
+    if (rc == 0) rc = store(L, name, pic, (uint32_t)w, (uint32_t)h, out, err, errlen);
+    free(pic);
+    return rc < 0 ? -1 : 1;
+}
+
+/* ---- flats ---- */
+
+static int is_flat_start(const char *n) { return strcmp(n, "F_START") == 0 || strcmp(n, "FF_START") == 0; }
+static int is_flat_end(const char *n) { return strcmp(n, "F_END") == 0 || strcmp(n, "FF_END") == 0; }
+
+/* the last flat of that name between F_START/F_END or FF_START/FF_END, or ndir */
+static uint32_t find_flat(const bs_wadlook *L, const char *name)
+{
+    uint32_t found = L->ndir;
+    int in = 0;
+    for (uint32_t i = 0; i < L->ndir; i++) {
+        const char *n = L->dir[i].name;
+        if (is_flat_start(n)) in = 1;
+        else if (is_flat_end(n)) in = 0;
+        else if (in && strcmp(n, name) == 0) found = i;
+    }
+    return found;
+}
+
+static int compose_flat(bs_wadlook *L, const char *name, uint16_t *out, char *err, size_t errlen)
+{
+    uint32_t li = find_flat(L, name);
+    if (li == L->ndir) {
+        *out = SCN_TEX_NONE;
+        return 0;
+    }
+    uint8_t *p;
+    if (load_lump(L, li, 4096, &p, err, errlen)) return -1;
+    uint8_t pic[4096];
+    for (int u = 0; u < 64; u++)
+        for (int v = 0; v < 64; v++) pic[u * 64 + v] = p[v * 64 + u]; /* the lump is row-major */
+    free(p);
+    return store(L, name, pic, 64, 64, out, err, errlen) ? -1 : 1;
+}
+
+/* A texture of this kind and name: its index, stored on first use; unknown
+ * names and "-" give SCN_TEX_NONE (an unknown name warned once). */
+static int texture(bs_wadlook *L, const char *name, int kind, uint16_t *out, char *err, size_t errlen)
+{
+    *out = SCN_TEX_NONE;
+    if (!name[0] || strcmp(name, "-") == 0) return 0;
+    for (uint32_t i = 0; i < L->nused; i++)
+        if (L->used[i].kind == kind && strcmp(L->used[i].name, name) == 0) {
+            *out = L->used[i].tex;
+            return 0;
+        }
+    int f = kind == KIND_WALL ? compose_wall(L, name, out, err, errlen) : compose_flat(L, name, out, err, errlen);
+    if (f < 0) return -1;
+    if (f == 0) bs_warn(L->opt, "%s: unknown %s '%s': drawn flat", L->wad, kind == KIND_WALL ? "texture" : "flat", name);
+    if (bs_grow(&L->used, &L->ucap, L->nused + 1, sizeof *L->used)) return bs_fail(err, errlen, "%s: out of memory", L->wad);
+    used_name *u = &L->used[L->nused++];
+    snprintf(u->name, sizeof u->name, "%s", name);
+    u->kind = kind;
+    u->tex = *out;
+    return 0;
+}
+
+/* ---- light ---- */
+
+/* The light table at a middle distance (256 units) per docs/textures.md. */
+static int middle_table(int lightnum, int wall)
+{
+    if (lightnum < 0) lightnum = 0;
+    if (lightnum > 15) lightnum = 15;
+    int start = (15 - lightnum) * 4;
+    int t = wall ? start - 2560 / 256 / 2 : start - 160 / (256 / 16 + 1) / 2;
+    return t < 0 ? 0 : t > SCN_LIGHT_MAPS - 1 ? SCN_LIGHT_MAPS - 1 : t;
+}
+
+static uint8_t lit(const bs_wadlook *L, uint16_t tex, int lightnum, int wall)
+{
+    uint8_t base = tex == SCN_TEX_NONE ? L->neutral : L->lk->tex[tex].colour;
+    return L->lk->lights[middle_table(lightnum, wall) * 256 + base];
+}
+
+/* ---- the map ---- */
+
+static const char *sky_for(const char *map)
+{
+    static const char *sky[4] = {"SKY1", "SKY2", "SKY3", "SKY4"};
+    if (strncmp(map, "MAP", 3) == 0) {
+        int n = atoi(map + 3);
+        return n < 12 ? sky[0] : n < 21 ? sky[1] : sky[2];
+    }
+    if (map[0] == 'E' && map[1] >= '1' && map[1] <= '4') return sky[map[1] - '1'];
+    return sky[0];
+}
+
+int bs_look_open(FILE *f, size_t flen, const bs_wadlump *dir, uint32_t ndir, const char *map, bs_scene *s,
+                 uint32_t nsectors, uint32_t nlinedefs, const bspc_options *opt, bs_wadlook **out, char *err,
+                 size_t errlen)
+{
+    *out = NULL;
+    bs_wadlook tmp = {f, flen, dir, ndir, s->name, opt, s, &s->look, NULL, 0, {NULL, NULL}, {0, 0},
+                      NULL, 0, 0, NULL, 0, 0, NULL, 0};
+    static const char *need[] = {"PLAYPAL", "COLORMAP", "PNAMES", "TEXTURE1"};
+    uint32_t at[4];
+    char missing[64] = "";
+    for (int i = 0; i < 4; i++) {
+        at[i] = find_lump(&tmp, need[i], 0, ndir);
+        if (at[i] == ndir) snprintf(missing + strlen(missing), sizeof missing - strlen(missing), " %s", need[i]);
+    }
+    if (missing[0]) {
+        bs_note(opt, "%s: no%s in the WAD: the scene is flat-shaded", s->name, missing);
+        return 0;
+    }
+    bs_wadlook *L = malloc(sizeof *L);
+    if (!L) return bs_fail(err, errlen, "%s: out of memory", s->name);
+    *L = tmp;
+    bs_look *lk = &s->look;
+    uint8_t *b = NULL;
+    if (load_lump(L, at[0], 768, &b, err, errlen)) goto fail;
+    memcpy(lk->palette, b, 768);
+    free(b);
+    if (load_lump(L, at[1], 256 * SCN_LIGHT_MAPS, &lk->lights, err, errlen)) goto fail;
+    if (load_lump(L, at[2], 4, &L->pnames, err, errlen)) goto fail;
+    L->npnames = rd32(L->pnames);
+    if (L->npnames > (dir[at[2]].size - 4) / 8) {
+        bs_fail(err, errlen, "%s: lump PNAMES: %u names do not fit its %u bytes", s->name, L->npnames, dir[at[2]].size);
+        goto fail;
+    }
+    if (load_lump(L, at[3], 4, &L->tdef[0], err, errlen)) goto fail;
+    L->tdsize[0] = dir[at[3]].size;
+    uint32_t t2 = find_lump(L, "TEXTURE2", 0, ndir);
+    if (t2 != ndir) {
+        if (load_lump(L, t2, 4, &L->tdef[1], err, errlen)) goto fail;
+        L->tdsize[1] = dir[t2].size;
+    }
+    lk->doom_palette = 1;
+    lk->sky_tex = SCN_TEX_NONE;
+    L->sky_name = sky_for(map);
+    L->neutral = nearest(lk->palette, 128, 128, 128);
+    L->nlines_cap = nlinedefs;
+    lk->sides = calloc(2 * (size_t)nlinedefs + 2, sizeof *lk->sides);
+    lk->planes = calloc((size_t)nsectors + 1, sizeof *lk->planes);
+    if (!lk->sides || !lk->planes) {
+        bs_fail(err, errlen, "%s: out of memory", s->name);
+        goto fail;
+    }
+    for (uint32_t i = 0; i < 2 * nlinedefs + 2; i++)
+        lk->sides[i].tex[0] = lk->sides[i].tex[1] = lk->sides[i].tex[2] = SCN_TEX_NONE;
+    /* model faces: Doom's fake contrast as one light level (4 tables) either way of the box's own colour */
+    for (int c = 0; c < 256; c++) {
+        lk->shade[0][c] = lk->lights[8 * 256 + c];
+        lk->shade[1][c] = lk->lights[4 * 256 + c];
+        lk->shade[2][c] = (uint8_t)c;
+    }
+    *out = L;
+    return 0;
+fail:
+    bs_look_close(L);
+    return -1;
+}
+
+int bs_look_sector(bs_wadlook *L, uint32_t i, const uint8_t rec[26], char *err, size_t errlen)
+{
+    bs_sector *c = &L->s->sectors[i];
+    bs_look *lk = L->lk;
+    char fl[9], ce[9];
+    name8(fl, rec + 4);
+    name8(ce, rec + 12);
+    scn_plane *p = &lk->planes[i];
+    if (texture(L, fl, KIND_FLAT, &p->floor_tex, err, errlen)) return -1;
+    int lightnum = c->light >> 4;
+    c->floor_color = lit(L, p->floor_tex, lightnum, 0);
+    if (c->flags & SCN_SECTOR_SKY) {
+        p->ceil_tex = SCN_TEX_NONE;
+        if (lk->sky_tex == SCN_TEX_NONE) {
+            uint16_t t;
+            if (texture(L, L->sky_name, KIND_WALL, &t, err, errlen)) return -1;
+            lk->sky_tex = t;
+        }
+        c->ceil_color = lk->sky_tex == SCN_TEX_NONE ? L->neutral : lk->tex[lk->sky_tex].colour;
+    } else {
+        if (texture(L, ce, KIND_FLAT, &p->ceil_tex, err, errlen)) return -1;
+        c->ceil_color = lit(L, p->ceil_tex, lightnum, 0);
+    }
+    return 0;
+}
+
+int bs_look_side(bs_wadlook *L, uint32_t li, int k, const uint8_t rec[30], unsigned line_flags, char *err,
+                 size_t errlen)
+{
+    bs_scene *s = L->s;
+    bs_line *l = &s->lines[li];
+    if (li >= L->nlines_cap) return bs_fail(err, errlen, "%s: internal error: side of line %u", L->wad, li);
+    scn_side *sd = &L->lk->sides[2 * li + (uint32_t)k];
+    char name[3][9];
+    name8(name[SCN_PART_UPPER], rec + 4);
+    name8(name[SCN_PART_LOWER], rec + 12);
+    name8(name[SCN_PART_MIDDLE], rec + 20);
+    for (int part = 0; part < 3; part++)
+        if (texture(L, name[part], KIND_WALL, &sd->tex[part], err, errlen)) return -1;
+
+    /* the column mapping: u(P) = U . (P - O) + xoff, O the side's first vertex */
+    uint32_t o = k ? l->v2 : l->v1, e = k ? l->v1 : l->v2;
+    double ox = s->vx[o] / 65536.0, oy = s->vy[o] / 65536.0;
+    double dx = s->vx[e] / 65536.0 - ox, dy = s->vy[e] / 65536.0 - oy, len = sqrt(dx * dx + dy * dy);
+    double one = 1073741824.0; /* 2^30 */
+    sd->ux = (int32_t)llround(dx / len * one);
+    sd->uy = (int32_t)llround(dy / len * one);
+    double xoff = rds16(rec), yoff = rds16(rec + 2);
+    /* every texture wraps at a power of two <= 1024 columns, so u0 is kept modulo
+     * 1024 units: the same columns, and no overflow for far-off lines */
+    double u0 = xoff * 65536.0 - ((double)sd->ux * s->vx[o] + (double)sd->uy * s->vy[o]) / one;
+    int64_t m = 1024LL * 65536;
+    int64_t iu = llround(u0) % m;
+    sd->u0 = (int32_t)(iu < 0 ? iu + m : iu);
+    sd->row_off = (int32_t)(yoff * 65536.0);
+    sd->flags = (uint8_t)(((line_flags & 8u) ? SCN_SIDE_UNPEG_TOP : 0) | ((line_flags & 16u) ? SCN_SIDE_UNPEG_BOTTOM : 0));
+    sd->light_adj = (int8_t)(dy == 0 ? -1 : dx == 0 ? 1 : 0);
+
+    int lightnum = (s->sectors[l->sector[k]].light >> 4) + sd->light_adj;
+    uint8_t cm = lit(L, sd->tex[SCN_PART_MIDDLE], lightnum, 1);
+    l->color[k][SCN_PART_MIDDLE] = cm;
+    l->color[k][SCN_PART_UPPER] = sd->tex[SCN_PART_UPPER] == SCN_TEX_NONE ? cm : lit(L, sd->tex[SCN_PART_UPPER], lightnum, 1);
+    l->color[k][SCN_PART_LOWER] = sd->tex[SCN_PART_LOWER] == SCN_TEX_NONE ? cm : lit(L, sd->tex[SCN_PART_LOWER], lightnum, 1);
+    return 0;
+}
+
+/* ---- sprites ---- */
+
+static int is_sprite_start(const char *n) { return strcmp(n, "S_START") == 0 || strcmp(n, "SS_START") == 0; }
+static int is_sprite_end(const char *n) { return strcmp(n, "S_END") == 0 || strcmp(n, "SS_END") == 0; }
+
+uint8_t bs_look_thing_colour(bs_wadlook *L, const char prefix[4], uint8_t fallback)
+{
+    uint8_t def[768];
+    bs_palette(def);
+    uint8_t colour = nearest(L->lk->palette, def[3 * fallback], def[3 * fallback + 1], def[3 * fallback + 2]);
+    int in = 0;
+    for (uint32_t i = 0; i < L->ndir; i++) {
+        const char *n = L->dir[i].name;
+        if (is_sprite_start(n)) in = 1;
+        else if (is_sprite_end(n)) in = 0;
+        else if (in && strncmp(n, prefix, 4) == 0 && n[4] == 'A' && (n[5] == '0' || n[5] == '1')) {
+            uint8_t *p;
+            char msg[300];
+            uint64_t count = 0;
+            double sum[3] = {0, 0, 0};
+            int rc = load_lump(L, i, 0, &p, msg, sizeof msg);
+            if (rc == 0) rc = draw_patch(L, p, L->dir[i].size, n, NULL, 0, 0, 0, 0, &count, sum, msg, sizeof msg);
+            if (rc == 0 && count)
+                colour = nearest(L->lk->palette, sum[0] / (double)count, sum[1] / (double)count, sum[2] / (double)count);
+            else
+                bs_warn(L->opt, "%s: sprite %s: %s; the box keeps things.txt's colour", L->wad, n,
+                        rc ? msg : "no opaque pixels");
+            free(p);
+            break;
+        }
+    }
+    return colour;
+}
+
+uint8_t bs_scene_shade(const bs_scene *s, uint8_t c, int delta)
+{
+    if (!s->look.doom_palette) return bs_shade(c, delta);
+    return s->look.shade[delta < 0 ? 0 : delta > 0 ? 2 : 1][c];
+}
+
+void bs_look_close(bs_wadlook *L)
+{
+    if (!L) return;
+    bs_look *lk = L->lk;
+    if (lk->doom_palette && lk->ntex > 0 && !(L->opt && L->opt->flat)) lk->present = 1;
+    free(L->pnames);
+    free(L->tdef[0]);
+    free(L->tdef[1]);
+    free(L->used);
+    free(L->mean);
+    free(L);
+}
