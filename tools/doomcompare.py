@@ -117,23 +117,31 @@ def palette(path):
     return np.frombuffer(wad_lump(path, "PLAYPAL")[:768], np.uint8).reshape(256, 3)
 
 
-def weapon_mask(path):
-    """The screen pixels the ready pistol covers, as R_DrawPSprite places it at 320x200
-    with screenblocks 11: x = sx - leftoffset, y = sy - topoffset (+ the post's top)."""
-    p = wad_lump(path, WEAPON_SPRITE)
-    w, h, left, top = struct.unpack_from("<hhhh", p, 0)
+def draw_patch(patch, x, y):
+    """A Doom picture (patch format) drawn at x, y less its offsets, clipped to 320x200:
+    (palette indices, mask of the pixels it covers)."""
+    w, _, left, top = struct.unpack_from("<hhhh", patch, 0)
+    idx = np.zeros((H, W), np.uint8)
     mask = np.zeros((H, W), bool)
-    x0, y0 = WEAPON_SX - left, WEAPON_SY - top
+    x0, y0 = x - left, y - top
     for c in range(w):
-        (pos,) = struct.unpack_from("<I", p, 8 + 4 * c)
-        while pos < len(p) and p[pos] != 0xFF:
-            row, n = p[pos], p[pos + 1]
-            x = x0 + c
-            if 0 <= x < W:
-                ys = np.arange(y0 + row, y0 + row + n)
-                mask[ys[(ys >= 0) & (ys < H)], x] = True
+        (pos,) = struct.unpack_from("<I", patch, 8 + 4 * c)
+        sx = x0 + c
+        while 0 <= sx < W and pos + 1 < len(patch) and patch[pos] != 0xFF:
+            row, n = patch[pos], patch[pos + 1]
+            for k in range(n):
+                sy = y0 + row + k
+                if 0 <= sy < H and pos + 3 + k < len(patch):
+                    idx[sy, sx] = patch[pos + 3 + k]
+                    mask[sy, sx] = True
             pos += n + 4
-    return mask
+    return idx, mask
+
+
+def weapon_mask(path):
+    """The screen pixels the ready pistol covers, as R_DrawPSprite places it at 320x200 with
+    screenblocks 11 (scale 1): x = sx - leftoffset, y = sy - topoffset."""
+    return draw_patch(wad_lump(path, WEAPON_SPRITE), WEAPON_SX, WEAPON_SY)[1]
 
 
 # ---- the two frames ---------------------------------------------------------------------------
