@@ -9,7 +9,8 @@ For each FILE.wad:MAP it
      presented frame as SDL_window1-NNNNNNNN.bmp (SDL_VIDEO_DUMMY_SAVE_FRAMES), with a config
      that draws the whole 320x200 screen as the view (screenblocks 11: no status bar), no
      aspect-ratio correction and a 320x200 window, and takes the last frame: the screen melt
-     is over by then and the weapon is fully raised (it rises 6 pixels a tic for 16 tics);
+     is over by then (it runs before the first tic) and the weapon is fully raised (it rises
+     6 pixels a tic for 16 tics);
   3. renders the same view with build/render FILE.wad:MAP (the player start, Doom's eye
      height) and its id buffer;
   4. counts the 8x8 blocks whose mean RGB colour is within --tol of Chocolate Doom's in every
@@ -47,7 +48,7 @@ DEMO_VERSION = 109
 DEMO_HEADER = 13
 DEMO_END = 0x80
 SKILL_HMP = 2          # Doom's skill index 2 = skill 3, the THINGS flag bit 0x0002 bspc keeps
-DEFAULT_TICS = 35      # one second: the pistol is up after 16
+DEFAULT_TICS = 20      # the pistol is up from tic 17 on; few tics leave monsters little time to move
 
 # The pistol, the weapon every map starts with, in its ready state (A_WeaponReady with no
 # bob: sx = 1, sy = WEAPONTOP = 32).
