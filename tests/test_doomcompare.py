@@ -153,3 +153,11 @@ def test_chocolate_doom_frame_is_the_game_not_black_or_the_title(map01):
     assert choco.mean() > 10
     title = title_screen(str(FREEDOOM2))
     assert (np.abs(choco - title).max(axis=2) > 24).mean() > 0.5
+
+
+@pytest.mark.parametrize("spec", ["freedoom2.wad:MAP33", "freedoom2.wad:E1M1", "freedoom2.wad",
+                                  "nowhere.wad:MAP01", "freedoom2.wad:START"])
+def test_bad_map_is_refused_with_a_message(spec, tmp_path, capsys):
+    assert dc.main(["--render", "/nonexistent/render", "--out", str(tmp_path), spec]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"doomcompare: {spec}: ") and "Traceback" not in err
