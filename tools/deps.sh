@@ -17,6 +17,7 @@ PACKAGES=(
   libglib2.0-dev pkg-config   # building the QEMU instruction-counting plugin
   libusb-1.0-0-dev            # host/flash: USB DFU
   freedoom                    # real maps: freedoom1.wad, freedoom2.wad
+  chocolate-doom              # Doom's own renderer, for make compare-doom (tools/doomcompare.py)
   zdbsp glbsp                 # other BSP compilers, for make bench-bsp
   valgrind                    # instruction counts
   clang libclang-rt-14-dev    # libFuzzer harnesses with ASan and UBSan (make fuzz, tests/fuzz)
