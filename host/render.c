@@ -118,6 +118,7 @@ static int parse_args(options *o, int argc, char **argv)
             exit(0);
         } else if (!strcmp(a, "--flat")) {
             o->flat = 1;
+            takes = 0;
         } else if (!strcmp(a, "--no-objects")) {
             o->no_objects = 1;
             takes = 0;
