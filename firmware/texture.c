@@ -141,9 +141,52 @@ tex_paint tex_sky(const scene *sc, const view_xform *v, uint8_t colour)
     return p;
 }
 
-static inline uint8_t texel(const tex_paint *p, uint32_t u, uint32_t v)
+/* A texture's addressing in locals: the span loops store through a uint8_t
+ * pointer, which may alias anything, so fields read from the paint inside the
+ * loop would be read again after every pixel. */
+typedef struct {
+    const uint8_t *texels;
+    uint32_t cmask;  /* column bits, already shifted into place: wmask << hbits */
+    uint32_t rmask;  /* hmask */
+    unsigned cshift; /* 16 - hbits: a 16.16 column to its place in the index */
+} tex_addr;
+
+static inline tex_addr addr_of(const tex_paint *p)
 {
-    return p->texels[(((u >> 16) & p->wmask) << p->hbits) | ((v >> 16) & p->hmask)];
+    tex_addr a = {p->texels, p->wmask << p->hbits, p->hmask, 16u - p->hbits};
+    return a;
+}
+
+static inline uint8_t texel(tex_addr a, uint32_t u, uint32_t v)
+{
+    return a.texels[((u >> a.cshift) & a.cmask) | ((v >> 16) & a.rmask)];
+}
+
+/* n texels along a straight line through the texture, each through its
+ * light table: the inner loop of every wall piece and plane span. */
+static inline __attribute__((always_inline)) void run_of(uint8_t *out, int n, const uint8_t *light, tex_addr a,
+                                                        uint32_t u, uint32_t v, uint32_t du, uint32_t dv)
+{
+#pragma GCC unroll 4
+    for (int i = 0; i < n; i++) {
+        out[i] = light[texel(a, u, v)];
+        u += du;
+        v += dv;
+    }
+}
+
+/* run_of with the shifts and masks of the common shapes as constants: flats
+ * (64 x 64) and textures 128 rows high (most of Doom's walls). */
+static void texel_run(uint8_t *out, int n, const uint8_t *light, tex_addr a, uint32_t u, uint32_t v, uint32_t du,
+                      uint32_t dv)
+{
+    if (a.rmask == 63u && a.cmask == 63u << 6) {
+        run_of(out, n, light, (tex_addr){a.texels, 63u << 6, 63u, 10u}, u, v, du, dv);
+    } else if (a.rmask == 127u) {
+        run_of(out, n, light, (tex_addr){a.texels, a.cmask, 127u, 9u}, u, v, du, dv);
+    } else {
+        run_of(out, n, light, a, u, v, du, dv);
+    }
 }
 
 /* ---- walls ---- */
@@ -180,6 +223,7 @@ static void wall_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
     int32_t vk = sy * 13107; /* sy 2^22 / 320, |sy| < 600 */
     int32_t sx = 2 * x0 + 1 - VIEW_W;
     wall_sample s = wall_at(p, sx, vk);
+    tex_addr a = addr_of(p);
     for (int x = x0; x < x1;) {
         int n = x1 - x < TEX_SUBDIV ? x1 - x : TEX_SUBDIV;
         wall_sample e = wall_at(p, sx + 2 * n, vk);
@@ -191,13 +235,7 @@ static void wall_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
             du /= n;
             dv /= n;
         }
-        const uint8_t *light = s.light;
-        uint32_t u = s.u, v = s.v;
-        for (int i = 0; i < n; i++) {
-            row[x + i] = light[texel(p, u, v)];
-            u += (uint32_t)du;
-            v += (uint32_t)dv;
-        }
+        texel_run(row + x, n, s.light, a, s.u, s.v, (uint32_t)du, (uint32_t)dv);
         x += n;
         sx += 2 * n;
         s = e;
@@ -219,11 +257,7 @@ static void plane_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
     uint32_t du = (uint32_t)(((int64_t)z * (2 * p->c)) >> 30), dw = (uint32_t)(((int64_t)z * (2 * p->d)) >> 30);
     uint32_t bucket = z >> 20; /* Doom's z light: 16 units a step, at most 127 */
     const uint8_t *light = light_table(p, (int)(160u / ((bucket > 127u ? 127u : bucket) + 1u)) / 2);
-    for (int x = x0; x < x1; x++) {
-        row[x] = light[texel(p, u, w)];
-        u += du;
-        w += dw;
-    }
+    texel_run(row + x0, x1 - x0, light, addr_of(p), u, w, du, dw);
 }
 
 /* ---- the sky: by view angle, at full light ---- */
@@ -232,9 +266,11 @@ static void sky_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
 {
     const uint8_t *light = p->lights;
     const uint8_t *column0 = p->texels + ((uint32_t)(y - p->look) & p->hmask);
+    uint32_t angle = p->u0, wmask = p->wmask;
+    unsigned hbits = p->hbits;
     for (int x = x0; x < x1; x++) {
-        uint32_t col = ((p->u0 + tex_sky_angle[x]) >> 22) & p->wmask;
-        row[x] = light[column0[col << p->hbits]];
+        uint32_t col = ((angle + tex_sky_angle[x]) >> 22) & wmask;
+        row[x] = light[column0[col << hbits]];
     }
 }
 
