@@ -704,9 +704,25 @@ def _object_hits(parts, ex, ey, ez, fxd, fyd, rx, ry, look, dx, dy, yv):
 
 # ---- rendering ----------------------------------------------------------------------------
 
+class View:
+    """What each pixel's centre ray meets (cast_view): the camera as rendered (x, y, z, angle,
+    look, after rounding), the ray directions per column (dx, dy) and per row (yv), and per
+    pixel (200, 320): ids (uint32 surface ids), t (the world surface's forward depth, inf for
+    none; objects are not in it), line (the linedef of a wall pixel, else -1), part (0 upper,
+    1 middle, 2 lower for a wall pixel; 3 where the ray went over the missing upper wall between
+    two sky ceilings and met sky; -1 else). ceil: the ceiling heights used (doors applied)."""
+
+
 def render_ids(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="near",
                objects=None, ceilings=None):
     """Surface ids of the view from (x, y, z) at angle degrees: numpy uint32 (200, 320).
+    (cast_view(...).ids; the arguments are cast_view's.)"""
+    return cast_view(scene_spec, x, y, z, angle, look, fx, sky_owner, objects, ceilings).ids
+
+
+def cast_view(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="near",
+              objects=None, ceilings=None):
+    """The View from (x, y, z) at angle degrees (see View).
 
     z None: the floor of the eye's sector + 41. fx: round the camera to 16.16 first, as
     build/render does (pass False for the exact values). sky_owner: whose ceiling the sky seen
@@ -764,8 +780,11 @@ def render_ids(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="
     ce = np.append(ce, np.nan)
     sk = np.append(m.sky, False)
     out = np.zeros((H, W), np.uint32)
-    # the world's depth per pixel, where objects must be compared with it
-    world_t = np.full((H, W), np.inf) if parts else None
+    # the world's depth per pixel (where objects must be compared with it), and what was met
+    world_t = np.full((H, W), np.inf)
+    hit_line = np.full((H, W), -1, np.int64)
+    hit_part = np.full((H, W), -1, np.int8)
+    rows = np.arange(H)
     start = NONE if eye_sec is None else eye_sec
     # the eye exactly on a wall (or vertex): which sector a ray starts in depends on its direction;
     # take the near-side sector of the first wall it crosses
@@ -828,23 +847,32 @@ def render_ids(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="
         ids[:, 0::2] = plane_id
         ids[:, 1::2] = np.where(over_sky, sky_id[None, :], wall_id[li][None, :])
         first = np.argmax(ev, axis=1)
-        col = ids[np.arange(H), first]
-        got = ev[np.arange(H), first]
+        col = ids[rows, first]
+        got = ev[rows, first]
         col[~got] = 0
         out[:, px] = col.astype(np.uint32)
-        if world_t is not None:
-            with np.errstate(divide="ignore", invalid="ignore"):
-                tp = np.where(ceil_hit, cc, cf) - z
-                tp = tp / yv[:, None]
-            tev = np.empty((H, 2 * k + 1))
-            tev[:, 0::2] = tp
-            tev[:, 1::2] = tk[None, :]
-            world_t[:, px] = np.where(got, tev[np.arange(H), first], np.inf)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tp = np.where(ceil_hit, cc, cf) - z
+            tp = tp / yv[:, None]
+        tev = np.empty((H, 2 * k + 1))
+        tev[:, 0::2] = tp
+        tev[:, 1::2] = tk[None, :]
+        world_t[:, px] = np.where(got, tev[rows, first], np.inf)
+        if k:
+            crossing = got & (first % 2 == 1)
+            j = np.where(crossing, (first - 1) // 2, 0)
+            part = np.where(upper, 0, np.where(mid, 1, np.where(lower, 2, 3)))[rows, j]
+            hit_line[:, px] = np.where(crossing, li[j], -1)
+            hit_part[:, px] = np.where(crossing, part, -1)
     if parts:
         obj_t, obj = _object_hits(parts, x, y, z, fxd, fyd, rx, ry, look, dx, dy, yv)
         front = obj_t < world_t
         out[front] = ((KIND_OBJECT << 24) | obj[front]).astype(np.uint32)
-    return out
+    v = View()
+    v.scene, v.x, v.y, v.z, v.angle, v.look = m, x, y, z, float(angle), look
+    v.dx, v.dy, v.yv = dx, dy, yv
+    v.ids, v.t, v.line, v.part, v.ceil = out, world_t, hit_line, hit_part, ce[:-1]
+    return v
 
 
 # ---- output -------------------------------------------------------------------------------
