@@ -538,6 +538,9 @@ def read_wad(spec):
                               lin["tag"].astype(np.int64), front, back)
     m = Map(spec, x1[keep], y1[keep], x2[keep], y2[keep], front[keep], back[keep],
             sec["f"].astype(float), sec["c"].astype(float), sky, player, open_h=open_h)
+    # for the map's look (tools/reflook.py): the file, the map's lumps, and each kept line's
+    # linedef number
+    m.wad_file, m.wad_lumps, m.wad_lines = path, got, np.nonzero(keep)[0]
     if os.path.exists(THINGS_TXT):
         m.models, m.objects = wad_objects(thing, read_things_table(),
                                           lambda x, y: sector_at(m, x, y) is not None)
