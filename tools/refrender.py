@@ -96,7 +96,13 @@ sector's lines (a line with the sector on both sides counts twice and cancels); 
 sectors claim the point (a map whose sectors overlap), the one facing the point across the
 nearest line crossing the ray to +x wins.
 
-usage: tools/refrender.py SCENE --at X,Y[,Z] --angle DEG [--look PX] --ids OUT.bin [--png OUT.png]
+Colours (a WAD map; tools/reflook.py, docs/textures.md): --raw writes the expected frame (64,000
+palette indices, 0 where not compared: objects, nothing, no texture), --expect an .npz of the
+per-pixel category, texture, u, v, light table, colour and the 27 acceptable colours,
+--colour-png the expected frame in the WAD's palette. The colours are of the world alone.
+
+usage: tools/refrender.py SCENE --at X,Y[,Z] --angle DEG [--look PX] [--ids OUT.bin] [--png OUT.png]
+                          [--raw OUT.raw] [--expect OUT.npz] [--colour-png OUT.png]
                           [--sky-owner far|near] [--time MS] [--no-objects] [--door SECTOR=H]...
 """
 import argparse
@@ -922,7 +928,11 @@ def main(argv=None):
     ap.add_argument("--angle", help="degrees, 0 = east, counter-clockwise "
                                                "(default: the player start's)")
     ap.add_argument("--look", type=int, default=0, help="vertical shear in pixels, -100..100")
-    ap.add_argument("--ids", required=True, help="output id buffer")
+    ap.add_argument("--ids", help="output id buffer")
+    ap.add_argument("--raw", help="output the expected colours (WAD maps): 64,000 palette indices")
+    ap.add_argument("--expect", help="output the per-pixel texture, u, v, light and acceptable "
+                                     "colours (WAD maps), .npz")
+    ap.add_argument("--colour-png", help="output the expected colours as an RGB PNG (WAD maps)")
     ap.add_argument("--png", help="also write a false-colour PNG of the ids")
     ap.add_argument("--sky-owner", choices=("far", "near"), default="near",
                     help="sky seen over the missing upper wall between two sky sectors: the "
@@ -957,12 +967,27 @@ def main(argv=None):
             if not eq or not sec.isdigit() or int(sec) >= m.nsectors:
                 ap.error(f"--door '{d}': expected SECTOR=H with SECTOR < {m.nsectors}")
             ceilings[int(sec)] = _num(h, "--door")
+        if not (a.ids or a.raw or a.expect or a.colour_png):
+            ap.error("no output: give --ids, --raw, --expect or --colour-png")
         objs = [] if a.no_objects else object_states(m, a.time)
         ids = render_ids(m, px, py, z, pa, a.look, sky_owner=a.sky_owner, objects=objs,
                          ceilings=ceilings)
-        write_ids(a.ids, ids)
+        if a.ids:
+            write_ids(a.ids, ids)
         if a.png:
             write_png_rgb(a.png, false_colour(ids))
+        if a.raw or a.expect or a.colour_png:
+            import reflook
+            e = reflook.expect(cast_view(m, px, py, z, pa, a.look, sky_owner=a.sky_owner,
+                                         objects=[], ceilings=ceilings))
+            if a.raw:
+                e.colour.tofile(a.raw)
+            if a.colour_png:
+                write_png_rgb(a.colour_png, e.look.palette[e.colour])
+            if a.expect:
+                np.savez_compressed(a.expect, cat=e.cat, tex=e.tex, u=e.u, v=e.v, table=e.table,
+                                    colour=e.colour, cand=e.cand,
+                                    names=np.array([n for n, _ in e.look.names] or [""]))
     except (OSError, ValueError) as e:
         print(f"refrender: {e}", file=sys.stderr)
         return 1
