@@ -96,7 +96,13 @@ sector's lines (a line with the sector on both sides counts twice and cancels); 
 sectors claim the point (a map whose sectors overlap), the one facing the point across the
 nearest line crossing the ray to +x wins.
 
-usage: tools/refrender.py SCENE --at X,Y[,Z] --angle DEG [--look PX] --ids OUT.bin [--png OUT.png]
+Colours (a WAD map; tools/reflook.py, docs/textures.md): --raw writes the expected frame (64,000
+palette indices, 0 where not compared: objects, nothing, no texture), --expect an .npz of the
+per-pixel category, texture, u, v, light table, colour and the 27 acceptable colours,
+--colour-png the expected frame in the WAD's palette. The colours are of the world alone.
+
+usage: tools/refrender.py SCENE --at X,Y[,Z] --angle DEG [--look PX] [--ids OUT.bin] [--png OUT.png]
+                          [--raw OUT.raw] [--expect OUT.npz] [--colour-png OUT.png]
                           [--sky-owner far|near] [--time MS] [--no-objects] [--door SECTOR=H]...
 """
 import argparse
@@ -538,6 +544,9 @@ def read_wad(spec):
                               lin["tag"].astype(np.int64), front, back)
     m = Map(spec, x1[keep], y1[keep], x2[keep], y2[keep], front[keep], back[keep],
             sec["f"].astype(float), sec["c"].astype(float), sky, player, open_h=open_h)
+    # for the map's look (tools/reflook.py): the file, the map's lumps, and each kept line's
+    # linedef number
+    m.wad_file, m.wad_lumps, m.wad_lines = path, got, np.nonzero(keep)[0]
     if os.path.exists(THINGS_TXT):
         m.models, m.objects = wad_objects(thing, read_things_table(),
                                           lambda x, y: sector_at(m, x, y) is not None)
@@ -704,9 +713,25 @@ def _object_hits(parts, ex, ey, ez, fxd, fyd, rx, ry, look, dx, dy, yv):
 
 # ---- rendering ----------------------------------------------------------------------------
 
+class View:
+    """What each pixel's centre ray meets (cast_view): the camera as rendered (x, y, z, angle,
+    look, after rounding), the ray directions per column (dx, dy) and per row (yv), and per
+    pixel (200, 320): ids (uint32 surface ids), t (the world surface's forward depth, inf for
+    none; objects are not in it), line (the linedef of a wall pixel, else -1), part (0 upper,
+    1 middle, 2 lower for a wall pixel; 3 where the ray went over the missing upper wall between
+    two sky ceilings and met sky; -1 else). ceil: the ceiling heights used (doors applied)."""
+
+
 def render_ids(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="near",
                objects=None, ceilings=None):
     """Surface ids of the view from (x, y, z) at angle degrees: numpy uint32 (200, 320).
+    (cast_view(...).ids; the arguments are cast_view's.)"""
+    return cast_view(scene_spec, x, y, z, angle, look, fx, sky_owner, objects, ceilings).ids
+
+
+def cast_view(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="near",
+              objects=None, ceilings=None):
+    """The View from (x, y, z) at angle degrees (see View).
 
     z None: the floor of the eye's sector + 41. fx: round the camera to 16.16 first, as
     build/render does (pass False for the exact values). sky_owner: whose ceiling the sky seen
@@ -764,8 +789,11 @@ def render_ids(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="
     ce = np.append(ce, np.nan)
     sk = np.append(m.sky, False)
     out = np.zeros((H, W), np.uint32)
-    # the world's depth per pixel, where objects must be compared with it
-    world_t = np.full((H, W), np.inf) if parts else None
+    # the world's depth per pixel (where objects must be compared with it), and what was met
+    world_t = np.full((H, W), np.inf)
+    hit_line = np.full((H, W), -1, np.int64)
+    hit_part = np.full((H, W), -1, np.int8)
+    rows = np.arange(H)
     start = NONE if eye_sec is None else eye_sec
     # the eye exactly on a wall (or vertex): which sector a ray starts in depends on its direction;
     # take the near-side sector of the first wall it crosses
@@ -828,23 +856,32 @@ def render_ids(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="
         ids[:, 0::2] = plane_id
         ids[:, 1::2] = np.where(over_sky, sky_id[None, :], wall_id[li][None, :])
         first = np.argmax(ev, axis=1)
-        col = ids[np.arange(H), first]
-        got = ev[np.arange(H), first]
+        col = ids[rows, first]
+        got = ev[rows, first]
         col[~got] = 0
         out[:, px] = col.astype(np.uint32)
-        if world_t is not None:
-            with np.errstate(divide="ignore", invalid="ignore"):
-                tp = np.where(ceil_hit, cc, cf) - z
-                tp = tp / yv[:, None]
-            tev = np.empty((H, 2 * k + 1))
-            tev[:, 0::2] = tp
-            tev[:, 1::2] = tk[None, :]
-            world_t[:, px] = np.where(got, tev[np.arange(H), first], np.inf)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tp = np.where(ceil_hit, cc, cf) - z
+            tp = tp / yv[:, None]
+        tev = np.empty((H, 2 * k + 1))
+        tev[:, 0::2] = tp
+        tev[:, 1::2] = tk[None, :]
+        world_t[:, px] = np.where(got, tev[rows, first], np.inf)
+        if k:
+            crossing = got & (first % 2 == 1)
+            j = np.where(crossing, (first - 1) // 2, 0)
+            part = np.where(upper, 0, np.where(mid, 1, np.where(lower, 2, 3)))[rows, j]
+            hit_line[:, px] = np.where(crossing, li[j], -1)
+            hit_part[:, px] = np.where(crossing, part, -1)
     if parts:
         obj_t, obj = _object_hits(parts, x, y, z, fxd, fyd, rx, ry, look, dx, dy, yv)
         front = obj_t < world_t
         out[front] = ((KIND_OBJECT << 24) | obj[front]).astype(np.uint32)
-    return out
+    v = View()
+    v.scene, v.x, v.y, v.z, v.angle, v.look = m, x, y, z, float(angle), look
+    v.dx, v.dy, v.yv = dx, dy, yv
+    v.ids, v.t, v.line, v.part, v.ceil = out, world_t, hit_line, hit_part, ce[:-1]
+    return v
 
 
 # ---- output -------------------------------------------------------------------------------
@@ -891,7 +928,11 @@ def main(argv=None):
     ap.add_argument("--angle", help="degrees, 0 = east, counter-clockwise "
                                                "(default: the player start's)")
     ap.add_argument("--look", type=int, default=0, help="vertical shear in pixels, -100..100")
-    ap.add_argument("--ids", required=True, help="output id buffer")
+    ap.add_argument("--ids", help="output id buffer")
+    ap.add_argument("--raw", help="output the expected colours (WAD maps): 64,000 palette indices")
+    ap.add_argument("--expect", help="output the per-pixel texture, u, v, light and acceptable "
+                                     "colours (WAD maps), .npz")
+    ap.add_argument("--colour-png", help="output the expected colours as an RGB PNG (WAD maps)")
     ap.add_argument("--png", help="also write a false-colour PNG of the ids")
     ap.add_argument("--sky-owner", choices=("far", "near"), default="near",
                     help="sky seen over the missing upper wall between two sky sectors: the "
@@ -926,12 +967,27 @@ def main(argv=None):
             if not eq or not sec.isdigit() or int(sec) >= m.nsectors:
                 ap.error(f"--door '{d}': expected SECTOR=H with SECTOR < {m.nsectors}")
             ceilings[int(sec)] = _num(h, "--door")
+        if not (a.ids or a.raw or a.expect or a.colour_png):
+            ap.error("no output: give --ids, --raw, --expect or --colour-png")
         objs = [] if a.no_objects else object_states(m, a.time)
         ids = render_ids(m, px, py, z, pa, a.look, sky_owner=a.sky_owner, objects=objs,
                          ceilings=ceilings)
-        write_ids(a.ids, ids)
+        if a.ids:
+            write_ids(a.ids, ids)
         if a.png:
             write_png_rgb(a.png, false_colour(ids))
+        if a.raw or a.expect or a.colour_png:
+            import reflook
+            e = reflook.expect(cast_view(m, px, py, z, pa, a.look, sky_owner=a.sky_owner,
+                                         objects=[], ceilings=ceilings))
+            if a.raw:
+                e.colour.tofile(a.raw)
+            if a.colour_png:
+                write_png_rgb(a.colour_png, e.look.palette[e.colour])
+            if a.expect:
+                np.savez_compressed(a.expect, cat=e.cat, tex=e.tex, u=e.u, v=e.v, table=e.table,
+                                    colour=e.colour, cand=e.cand,
+                                    names=np.array([n for n, _ in e.look.names] or [""]))
     except (OSError, ValueError) as e:
         print(f"refrender: {e}", file=sys.stderr)
         return 1

@@ -1,0 +1,365 @@
+"""reflook.py - a Doom map's look in the reference renderer: the texel and light of each pixel.
+
+docs/textures.md is the contract; this is its double-precision reading, from the WAD itself (its
+own lump reading and patch composition, nothing from the compiled scene). Given what each pixel's
+centre ray meets (refrender.cast_view: the surface, its depth, a wall's line and part), expect()
+gives per pixel the texture and the exact (u, v), the light table, the colour
+lights[table][texel], and the colours a renderer may draw there: lights[t'][texel(u', v')] for t'
+within one light step and (u', v') within one texel (the 3 x 3 texels round (u, v), wrapped as the
+texture wraps), 27 candidates.
+
+Which pixels are compared (Expect.cat): walls (1), floors (2), ceilings (3) and sky (4) with a
+texture. Not compared (0): no surface, objects (the reference casts the world alone; a comparison
+also leaves out the renderer's object pixels), and parts or planes without a texture ('-', a name
+the WAD does not have, or Doom's texture 0, which Doom never draws), which keep their flat colour.
+
+Doom's lookups: a texture name is the first of that name in TEXTURE1 then TEXTURE2; a patch or a
+flat is the last lump of its name (flats among the F_START..F_END lumps). Holes a texture's patches
+leave are texel 0. The sky texture is Doom's: freedoom2/Doom II MAPxx: SKY1 below MAP12, SKY2
+below MAP21, else SKY3; ExMy: SKYx.
+"""
+import math
+import struct
+
+import numpy as np
+
+W, H = 320, 200
+FOCAL = 160.0
+NLIGHTS = 32
+CAT_NONE, CAT_WALL, CAT_FLOOR, CAT_CEIL, CAT_SKY = 0, 1, 2, 3, 4
+CAT_NAMES = {CAT_WALL: "wall", CAT_FLOOR: "floor", CAT_CEIL: "ceiling", CAT_SKY: "sky"}
+UNPEG_TOP, UNPEG_BOTTOM = 8, 16      # Doom's linedef flags
+
+
+def _name8(b):
+    return bytes(b).split(b"\0", 1)[0].decode("latin-1").upper()
+
+
+class Wad:
+    """A WAD's directory: lump(name) the last lump of that name (Doom's W_CheckNumForName)."""
+
+    def __init__(self, path):
+        self.data = open(path, "rb").read()
+        n, ofs = struct.unpack_from("<II", self.data, 4)
+        self.dir = [(*struct.unpack_from("<II", self.data, ofs + 16 * i),
+                     _name8(self.data[ofs + 16 * i + 8:ofs + 16 * i + 16])) for i in range(n)]
+        self.last = {name: i for i, (_, _, name) in enumerate(self.dir)}
+        self.flats = {}
+        inside = False
+        for i, (_, size, name) in enumerate(self.dir):
+            if name in ("F_START", "FF_START"):
+                inside = True
+            elif name in ("F_END", "FF_END"):
+                inside = False
+            elif inside and size == 4096:
+                self.flats[name] = i
+
+    def body(self, i):
+        pos, size, _ = self.dir[i]
+        return self.data[pos:pos + size]
+
+    def lump(self, name):
+        i = self.last.get(name)
+        return None if i is None else self.body(i)
+
+
+class Texture:
+    """Texels cols[u, v] (width x height, column-major as the scene stores them) and Doom's wrap:
+    columns at the largest power of two not above the width, rows at the next power of two not
+    below the height, the padding rows repeating the texture from its top."""
+
+    def __init__(self, name, cols):
+        self.name, self.cols = name, cols
+        w, h = cols.shape
+        self.width, self.height = w, h
+        self.wmask = (1 << (w.bit_length() - 1)) - 1
+        self.hmask = (1 << (h - 1).bit_length()) - 1
+
+    def texel(self, u, v):
+        """Texels at integer column u and row v (arrays), wrapped."""
+        return self.cols[u & self.wmask, (v & self.hmask) % self.height]
+
+
+def read_patch(data):
+    """A patch lump -> (width, height, columns), each column a list of (top, bytes) posts."""
+    w, h = struct.unpack_from("<hh", data, 0)
+    if w <= 0 or h <= 0 or len(data) < 8 + 4 * w:
+        raise ValueError("bad patch")
+    cols = []
+    for c in range(w):
+        (pos,) = struct.unpack_from("<I", data, 8 + 4 * c)
+        posts = []
+        while pos < len(data) and data[pos] != 0xFF:
+            top, n = data[pos], data[pos + 1]
+            posts.append((top, data[pos + 3:pos + 3 + n]))
+            pos += n + 4
+        cols.append(posts)
+    return w, h, cols
+
+
+def compose(width, height, patches):
+    """Doom's composition: patches [(originx, originy, patch lump)] in order, each post clipped
+    to the texture, later over earlier; texel 0 where none covers."""
+    cols = np.zeros((width, height), np.uint8)
+    for ox, oy, lump in patches:
+        _, _, pcols = read_patch(lump)
+        for c, posts in enumerate(pcols):
+            x = ox + c
+            if not 0 <= x < width:
+                continue
+            for top, px in posts:
+                y0 = oy + top
+                a, b = max(0, y0), min(height, y0 + len(px))
+                if a < b:
+                    cols[x, a:b] = np.frombuffer(px, np.uint8)[a - y0:b - y0]
+    return cols
+
+
+def read_texture_defs(wad):
+    """{name: (width, height, [(originx, originy, patch name)])}, TEXTURE1 then TEXTURE2, the
+    first of a name winning, and the name of Doom's texture 0 (never drawn)."""
+    pn = wad.lump("PNAMES")
+    (npn,) = struct.unpack_from("<i", pn, 0)
+    pnames = [_name8(pn[4 + 8 * i:12 + 8 * i]) for i in range(npn)]
+    defs, first = {}, None
+    for lname in ("TEXTURE1", "TEXTURE2"):
+        d = wad.lump(lname)
+        if d is None:
+            continue
+        (n,) = struct.unpack_from("<i", d, 0)
+        for i in range(n):
+            (ofs,) = struct.unpack_from("<i", d, 4 + 4 * i)
+            name = _name8(d[ofs:ofs + 8])
+            w, h = struct.unpack_from("<hh", d, ofs + 12)
+            (np_,) = struct.unpack_from("<h", d, ofs + 20)
+            pats = []
+            for k in range(np_):
+                ox, oy, pi = struct.unpack_from("<hhh", d, ofs + 22 + 10 * k)
+                pats.append((ox, oy, pnames[pi] if 0 <= pi < npn else None))
+            if first is None:
+                first = name
+            defs.setdefault(name, (w, h, pats))
+    return defs, first
+
+
+def sky_name(mapname):
+    m = mapname.upper()
+    if m.startswith("MAP"):
+        n = int(m[3:])
+        return "SKY1" if n < 12 else "SKY2" if n < 21 else "SKY3"
+    return f"SKY{m[1]}"
+
+
+class Look:
+    """A WAD map's look: palette (256, 3), lights (32, 256), per kept line (refrender's numbering)
+    its two sidedefs, per sector its light and flats, and textures and flats by name (composed
+    when first asked for)."""
+
+    def __init__(self, m):
+        if not hasattr(m, "wad_file"):
+            raise ValueError(f"{m.name}: not a WAD map: it has no textures")
+        self.wad = wad = Wad(m.wad_file)
+        self.palette = np.frombuffer(wad.lump("PLAYPAL")[:768], np.uint8).reshape(256, 3)
+        self.lights = np.frombuffer(wad.lump("COLORMAP")[:256 * NLIGHTS], np.uint8).reshape(NLIGHTS, 256)
+        lumps = m.wad_lumps
+        lin = np.frombuffer(lumps["LINEDEFS"], np.dtype([("v1", "<u2"), ("v2", "<u2"), ("fl", "<u2"),
+                                                         ("sp", "<u2"), ("tag", "<u2"), ("s0", "<u2"),
+                                                         ("s1", "<u2")]))[m.wad_lines]
+        sd = np.frombuffer(lumps["SIDEDEFS"], np.dtype([("xo", "<i2"), ("yo", "<i2"), ("up", "S8"),
+                                                        ("lo", "S8"), ("mid", "S8"), ("sec", "<u2")]))
+        sec = np.frombuffer(lumps["SECTORS"], np.dtype([("f", "<i2"), ("c", "<i2"), ("ff", "S8"),
+                                                        ("cf", "S8"), ("light", "<i2"), ("sp", "<i2"),
+                                                        ("tag", "<i2")]))
+        self.flags = lin["fl"].astype(np.int64)
+        s1 = lin["s1"].astype(np.int64)
+        self.side_def = np.stack([lin["s0"].astype(np.int64), np.where(s1 == 0xFFFF, -1, s1)], 1)
+        self.xoff, self.yoff = sd["xo"].astype(float), sd["yo"].astype(float)
+        self.sector_light = sec["light"].astype(np.int64)
+        self.defs, self.tex0 = read_texture_defs(wad)
+        self.sky = sky_name(m.name.rsplit(":", 1)[1])
+        # texture numbers: names in order of first use; -1 none
+        self.names, self._num, self._tex = [], {}, {}
+        self.side_tex = np.array([[self.number(_name8(r[k]), False) for k in ("up", "mid", "lo")]
+                                  for r in sd], np.int64).reshape(len(sd), 3)
+        self.floor_tex = np.array([self.number(_name8(n), True) for n in sec["ff"]], np.int64)
+        self.ceil_tex = np.array([self.number(_name8(n), True) for n in sec["cf"]], np.int64)
+        self.sky_tex = self.number(self.sky, False)
+
+    def number(self, name, flat):
+        key = (name, flat)
+        if key not in self._num:
+            ok = name in self.wad.flats if flat else (name in self.defs and name != self.tex0)
+            self._num[key] = len(self.names) if ok else -1
+            if ok:
+                self.names.append(key)
+        return self._num[key]
+
+    def texture(self, i):
+        """Texture number i (a Texture), composed or read on first use; None if it cannot be."""
+        if i not in self._tex:
+            name, flat = self.names[i]
+            if flat:
+                body = self.wad.body(self.wad.flats[name])
+                self._tex[i] = Texture(name, np.frombuffer(body, np.uint8).reshape(64, 64).T.copy())
+            else:
+                w, h, pats = self.defs[name]
+                lumps = [(ox, oy, self.wad.lump(p) if p else None) for ox, oy, p in pats]
+                try:
+                    if any(lump is None for _, _, lump in lumps) or w <= 0 or h <= 0:
+                        raise ValueError
+                    self._tex[i] = Texture(name, compose(w, h, lumps))
+                except (ValueError, struct.error, IndexError):
+                    self._tex[i] = None
+        return self._tex[i]
+
+
+_looks = {}
+
+
+def look_of(m):
+    if m.name not in _looks:
+        _looks[m.name] = Look(m)
+    return _looks[m.name]
+
+
+def wall_table(start, z):
+    """Doom's scale light: start - min(47, floor(2560 / z)) / 2, clamped to 0..31."""
+    with np.errstate(divide="ignore"):
+        j = np.minimum(47, np.floor(2560.0 / z))
+    return np.clip(start - (j.astype(np.int64) // 2), 0, NLIGHTS - 1)
+
+
+def plane_table(start, z):
+    """Doom's z light: start - floor(160 / (min(127, floor(z / 16)) + 1)) / 2, clamped."""
+    j = np.minimum(127, np.floor(z / 16.0)).astype(np.int64)
+    return np.clip(start - (160 // (j + 1)) // 2, 0, NLIGHTS - 1)
+
+
+def light_start(light, adj):
+    lightnum = np.clip((light >> 4) + adj, 0, 15)
+    return (15 - lightnum) * 4
+
+
+class Expect:
+    """Per pixel (200, 320): cat (CAT_*), tex (texture number in look.names, -1), u, v (float:
+    the exact texture coordinates; for the sky, the column and row), table (light table),
+    colour (the palette index; 0 where not compared) and cand (200, 320, 27): the acceptable
+    palette indices (every one of them colour where not compared)."""
+
+    def accept(self, frame):
+        """Boolean (200, 320): the frame's palette index is one of the candidates."""
+        return (self.cand == np.asarray(frame, np.uint8)[..., None]).any(-1)
+
+
+def expect(view):
+    """The Expect of a refrender.View of a WAD map."""
+    m = view.scene
+    lk = look_of(m)
+    e = Expect()
+    e.look = lk
+    kind = (view.ids >> 24).astype(np.int64)
+    index = (view.ids & 0xFFFFFF).astype(np.int64)
+    e.cat = np.zeros((H, W), np.int8)
+    e.tex = np.full((H, W), -1, np.int64)
+    e.u, e.v = np.full((H, W), np.nan), np.full((H, W), np.nan)
+    e.table = np.zeros((H, W), np.int64)
+    rr, cc = np.mgrid[0:H, 0:W]
+    t = view.t
+    px = view.x + t * view.dx[None, :]
+    py = view.y + t * view.dy[None, :]
+    pz = view.z + t * view.yv[:, None]
+
+    # walls
+    w = (kind == 1) & (view.part >= 0) & (view.part <= 2)
+    line, part, side = view.line[w], view.part[w].astype(np.int64), index[w] & 1
+    sd = lk.side_def[line, side]
+    near = np.where(side == 0, m.front[line], m.back[line])
+    far = np.where(side == 0, m.back[line], m.front[line])
+    tex = np.where(sd >= 0, lk.side_tex[np.maximum(sd, 0), part], -1)
+    texh = np.zeros(len(tex))
+    for i in np.unique(tex[tex >= 0]):
+        tx = lk.texture(int(i))
+        if tx is None:
+            tex[tex == i] = -1
+        else:
+            texh[tex == i] = tx.height
+    ceil, floor = view.ceil, m.floor
+    fl = lk.flags[line]
+    farc, farf = ceil[np.maximum(far, 0)], floor[np.maximum(far, 0)]
+    top = np.select([part == 0, part == 1],
+                    [np.where(fl & UNPEG_TOP, ceil[near], farc + texh),
+                     np.where(fl & UNPEG_BOTTOM, floor[near] + texh, ceil[near])],
+                    np.where(fl & UNPEG_BOTTOM, ceil[near], farf))
+    ox = np.where(side == 0, m.x1[line], m.x2[line])
+    oy = np.where(side == 0, m.y1[line], m.y2[line])
+    ux, uy = m.x2[line] - m.x1[line], m.y2[line] - m.y1[line]
+    ln = np.hypot(ux, uy)
+    sgn = np.where(side == 0, 1.0, -1.0)
+    ux, uy = sgn * ux / ln, sgn * uy / ln
+    sdi = np.maximum(sd, 0)
+    e.u[w] = ux * (px[w] - ox) + uy * (py[w] - oy) + lk.xoff[sdi]
+    e.v[w] = top - pz[w] + lk.yoff[sdi]
+    adj = np.where(m.y1[line] == m.y2[line], -1, np.where(m.x1[line] == m.x2[line], 1, 0))
+    e.table[w] = wall_table(light_start(lk.sector_light[near], adj), t[w])
+    e.tex[w] = tex
+    e.cat[w] = np.where(tex >= 0, CAT_WALL, CAT_NONE)
+
+    # floors and ceilings; the sky
+    sky = ((kind == 3) & (view.part == 3)) | ((kind == 3) & m.sky[np.where(kind == 3, index, 0)])
+    p = ((kind == 2) | (kind == 3)) & ~sky
+    sec = index[p]
+    tex = np.where(kind[p] == 2, lk.floor_tex[sec], lk.ceil_tex[sec])
+    e.tex[p] = tex
+    e.u[p], e.v[p] = px[p], -py[p]
+    e.table[p] = plane_table(light_start(lk.sector_light[sec], 0), t[p])
+    e.cat[p] = np.where(tex < 0, CAT_NONE, np.where(kind[p] == 2, CAT_FLOOR, CAT_CEIL))
+    if lk.sky_tex >= 0 and lk.texture(lk.sky_tex) is not None:
+        a = view.angle + np.degrees(np.arctan((FOCAL - (np.arange(W) + 0.5)) / FOCAL))
+        e.u[sky] = (a[None, :] * 1024.0 / 360.0 + 0 * rr)[sky]
+        e.v[sky] = ((rr - view.look) & 127)[sky]
+        e.table[sky] = 0
+        e.tex[sky] = lk.sky_tex
+        e.cat[sky] = CAT_SKY
+
+    # colours: the exact one and the 27 candidates, texture by texture
+    e.colour = np.zeros((H, W), np.uint8)
+    e.cand = np.zeros((H, W, 27), np.uint8)
+    on = e.cat > 0
+    ui = np.floor(np.where(on, e.u, 0)).astype(np.int64)
+    vi = np.floor(np.where(on, e.v, 0)).astype(np.int64)
+    du, dv = np.meshgrid([-1, 0, 1], [-1, 0, 1], indexing="ij")
+    du, dv = du.ravel(), dv.ravel()
+    for i in np.unique(e.tex[on]):
+        sel = on & (e.tex == i)
+        tx = lk.texture(int(i))
+        u0, v0, tb = ui[sel], vi[sel], e.table[sel]
+        e.colour[sel] = lk.lights[tb, tx.texel(u0, v0)]
+        near9 = tx.texel(u0[:, None] + du[None, :], v0[:, None] + dv[None, :])          # (n, 9)
+        tabs = np.clip(tb[:, None] + np.array([-1, 0, 1])[None, :], 0, NLIGHTS - 1)     # (n, 3)
+        e.cand[sel] = lk.lights[tabs[:, :, None], near9[:, None, :]].reshape(-1, 27)
+    e.cand[~on] = 0
+    return e
+
+
+def compare(e, frame, ids=None):
+    """Compare a renderer's frame (200, 320 palette indices) with an Expect: the pixels compared
+    are those with a texture in the reference and no object in the renderer's id buffer (ids,
+    optional). Returns (ok (200, 320) bool, compared (200, 320) bool, counts {category name:
+    (acceptable, compared)}, with "all")."""
+    frame = np.asarray(frame, np.uint8).reshape(H, W)
+    compared = e.cat > 0
+    if ids is not None:
+        compared &= (np.asarray(ids).reshape(H, W) >> 24) != 4
+    ok = e.accept(frame) & compared
+    counts = {name: (int(ok[e.cat == c].sum()), int(compared[e.cat == c].sum()))
+              for c, name in CAT_NAMES.items()}
+    counts["all"] = (int(ok.sum()), int(compared.sum()))
+    return ok, compared, counts
+
+
+def diff_rgb(e, frame, ok, compared):
+    """RGB (200, 320, 3): the frame in its palette, dimmed where not compared, failures red."""
+    rgb = e.look.palette[np.asarray(frame, np.uint8).reshape(H, W)].astype(np.uint16)
+    rgb[~compared] = rgb[~compared] // 3
+    rgb[compared & ~ok] = (255, 0, 0)
+    return rgb.astype(np.uint8)
