@@ -197,22 +197,23 @@ typedef struct {
 } wall_sample;
 
 /* Doom's scale light: 160 / z in steps of 1/16, at most 47, halved. */
-static const uint8_t *wall_light(const tex_paint *p, uint32_t z)
+static inline const uint8_t *wall_light(const tex_paint *p, uint32_t z)
 {
     uint32_t scale = z ? 167772160u / z : 47u; /* 2560 * 65536 / z */
     return light_table(p, (int)(scale > 47u ? 47u : scale) / 2);
 }
 
-/* The exact texture column, row and light where the ray through (sx, row
- * coefficient vk = sy * 2^22 / 320) meets the wall. */
-static wall_sample wall_at(const tex_paint *p, int32_t sx, int32_t vk)
+/* The exact texture column, row and light where a pixel's ray meets the
+ * wall: den and slope are the paint's a + sx b and c + sx d for the pixel's
+ * column (2.30, stepped along the span), vk its row's sy 2^22 / 320. */
+static inline __attribute__((always_inline)) wall_sample wall_at(const tex_paint *p, int64_t den, int64_t slope,
+                                                                int32_t vk)
 {
-    int64_t den = ((int64_t)p->a + (int64_t)sx * p->b) >> 16; /* 2.14, < 2^15 */
-    uint32_t z = den > 0 ? depth_div((uint64_t)p->dist, (uint32_t)den) : TEX_ZMAX;
-    int64_t slope = ((int64_t)p->c + (int64_t)sx * p->d) >> 16; /* 2.14 */
+    int64_t d14 = den >> 16; /* 2.14, < 2^15 */
+    uint32_t z = d14 > 0 ? depth_div((uint64_t)p->dist, (uint32_t)d14) : TEX_ZMAX;
     wall_sample s;
-    s.u = p->u0 + (uint32_t)(((int64_t)z * slope) >> 14);    /* < 2^47 before the shift */
-    s.v = p->v0 - (uint32_t)(((int64_t)z * vk) >> 22);       /* < 2^56 */
+    s.u = p->u0 + (uint32_t)(((int64_t)z * (slope >> 16)) >> 14); /* < 2^47 before the shift */
+    s.v = p->v0 - (uint32_t)(((int64_t)z * vk) >> 22);            /* < 2^56 */
     s.light = wall_light(p, z);
     return s;
 }
@@ -222,11 +223,21 @@ static void wall_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
     int32_t sy = 2 * (VIEW_CY + p->look) - 2 * y - 1;
     int32_t vk = sy * 13107; /* sy 2^22 / 320, |sy| < 600 */
     int32_t sx = 2 * x0 + 1 - VIEW_W;
-    wall_sample s = wall_at(p, sx, vk);
+    int64_t den = (int64_t)p->a + (int64_t)sx * p->b, slope = (int64_t)p->c + (int64_t)sx * p->d;
+    const int64_t dden = (int64_t)p->b * (2 * TEX_SUBDIV), dslope = (int64_t)p->d * (2 * TEX_SUBDIV);
+    wall_sample s = wall_at(p, den, slope, vk);
     tex_addr a = addr_of(p);
     for (int x = x0; x < x1;) {
-        int n = x1 - x < TEX_SUBDIV ? x1 - x : TEX_SUBDIV;
-        wall_sample e = wall_at(p, sx + 2 * n, vk);
+        int n = TEX_SUBDIV;
+        if (x1 - x < TEX_SUBDIV) { /* the last piece: the sample at the span's end */
+            n = x1 - x;
+            den += (int64_t)p->b * (2 * n);
+            slope += (int64_t)p->d * (2 * n);
+        } else {
+            den += dden;
+            slope += dslope;
+        }
+        wall_sample e = wall_at(p, den, slope, vk);
         int32_t du = (int32_t)(e.u - s.u), dv = (int32_t)(e.v - s.v);
         if (n == TEX_SUBDIV) {
             du >>= TEX_SUBDIV_BITS;
@@ -237,7 +248,6 @@ static void wall_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
         }
         texel_run(row + x, n, s.light, a, s.u, s.v, (uint32_t)du, (uint32_t)dv);
         x += n;
-        sx += 2 * n;
         s = e;
     }
 }

@@ -25,7 +25,7 @@
 
 
 #ifndef TEX_SUBDIV_BITS
-#define TEX_SUBDIV_BITS 4
+#define TEX_SUBDIV_BITS 3
 #endif
 #ifndef TEX_RECIP_BITS
 #define TEX_RECIP_BITS 0
