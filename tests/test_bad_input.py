@@ -145,7 +145,7 @@ COMPILED = [
     ("total-bytes-short-of-file", appended, ["header: total_bytes", "but the file has"]),
     ("total-bytes-not-multiple-of-4", lambda d: header_field(8, len(d) + 2)(d + b"\0\0"),
      ["header: total_bytes", "not a multiple of 4"]),
-    ("header-bytes", header_field(4, lambda d: 3 | (HEADER_BYTES - 4) << 16),
+    ("header-bytes", header_field(4, lambda d: 4 | (HEADER_BYTES - 4) << 16),
      [f"header: header_bytes = {HEADER_BYTES - 4}", f"expected {HEADER_BYTES}"]),
     ("flags", header_field(16, 1), ["header: flags = 0x1", "reserved"]),
     ("segs-offset-past-end", header_field(44 + 8 * SEGS, lambda d: len(d)),
