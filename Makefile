@@ -127,6 +127,7 @@ help:
 	@echo "                qemu-system-i386 (SCENE=, FULL=1, CAMPATH=, PC_MODES=); make run-pcvga [RUN_ARGS=...];"
 	@echo "                make bench-pcvga (write counters per present mode)"
 	@echo "make flash      IMAGE=x.dfu DEVICE=VID:PID (or LOOPBACK=1): USB DFU download"
+	@echo "make bench-textures  bytes of each Freedoom map's textures, flats and light tables (docs/textures-bytes.md)"
 	@echo "make bench-bsp  bspc over all 68 Freedoom maps per strategy, beside zdbsp and glbsp"
 	@echo "make report     error against the reference vs instructions per frame, per render mode and"
 	@echo "                precision-knob configuration (mk/report.mk) -> build/report/report.md and plots"
@@ -172,6 +173,12 @@ bench-size: deps $(BUILD)/bspc $(BUILD)/render
 	$(PY) tools/size_table.py
 
 .PHONY: bench-size
+
+# bytes of each Freedoom map's textures, flats and light tables (docs/textures-bytes.md)
+bench-textures: deps $(BUILD)/bspc
+	$(PY) tools/texture_bytes.py --bspc $(BUILD)/bspc
+
+.PHONY: bench-textures
 
 clean:
 	rm -rf $(BUILD)/obj $(BUILD)/san $(BUILD)/gen $(BUILD)/scene $(BUILD)/size $(PROGRAMS) $(BUILD)/*.bsc $(BUILD)/gen_tables $(BUILD)/bin2c $(BUILD)/fuzz/obj $(BUILD)/fuzz/fuzz_*

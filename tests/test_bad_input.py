@@ -43,9 +43,11 @@ def refused(args, *needles, status=1):
 
 # ---- compiled scenes ------------------------------------------------------------------------
 
-HEADER_BYTES = 156  # sizeof(scn_header)
+HEADER_BYTES = 204  # sizeof(scn_header)
 VERTICES, SECTORS, LINES, SEGS, NODES, LEAVES, PVERTS, PALETTE = range(8)
 NEEDS = 13
+LOOK, LIGHTS, TEXTURES, TEXELS, SIDES, PLANES = range(14, 20)
+TEXTURE_BYTES, SIDE_BYTES = 8, 24
 SEG_BYTES, NODE_BYTES, LEAF_BYTES, LINE_BYTES = 16, 56, 20, 24
 LEAF_BIT = 0x80000000
 
@@ -131,20 +133,20 @@ def patch_node_child(value):
 
 # (id, damage, needles): the needles name the item and the problem
 COMPILED = [
-    ("truncated-after-magic", truncate(lambda d: 6), ["truncated", "6 bytes", "156-byte header"]),
-    ("truncated-in-header", truncate(lambda d: 100), ["truncated", "100 bytes", "156-byte header"]),
+    ("truncated-after-magic", truncate(lambda d: 6), ["truncated", "6 bytes", f"{HEADER_BYTES}-byte header"]),
+    ("truncated-in-header", truncate(lambda d: 100), ["truncated", "100 bytes", f"{HEADER_BYTES}-byte header"]),
     ("truncated-in-segs", truncate(lambda d: section(d, SEGS)[0] + 5), ["truncated", "header total_bytes"]),
     ("truncated-one-byte-short", truncate(lambda d: len(d) - 1), ["truncated", "header total_bytes"]),
     ("wrong-magic", wrong_magic, ["magic", "BSCN"]),
-    ("wrong-version", set_version, ["header", "unsupported version 99", "reads version 3"]),
+    ("wrong-version", set_version, ["header", "unsupported version 99", "reads version 4"]),
     ("bad-crc", bad_crc, ["bad CRC-32", "header crc32", "damaged"]),
     ("total-bytes-beyond-file", header_field(8, lambda d: len(d) + 4),
      ["truncated", "header total_bytes"]),
     ("total-bytes-short-of-file", appended, ["header: total_bytes", "but the file has"]),
     ("total-bytes-not-multiple-of-4", lambda d: header_field(8, len(d) + 2)(d + b"\0\0"),
      ["header: total_bytes", "not a multiple of 4"]),
-    ("header-bytes", header_field(4, lambda d: 3 | (HEADER_BYTES - 4) << 16),
-     ["header: header_bytes = 152", "expected 156"]),
+    ("header-bytes", header_field(4, lambda d: 4 | (HEADER_BYTES - 4) << 16),
+     [f"header: header_bytes = {HEADER_BYTES - 4}", f"expected {HEADER_BYTES}"]),
     ("flags", header_field(16, 1), ["header: flags = 0x1", "reserved"]),
     ("segs-offset-past-end", header_field(44 + 8 * SEGS, lambda d: len(d)),
      ["segs section", "run past the end"]),
@@ -175,6 +177,45 @@ COMPILED = [
     ("vertex-out-of-range", record_field(VERTICES, 8, 0, 0, lambda d: (32768 << 16)),
      ["vertices record 0", "outside the proven-safe range"]),
 ]
+
+
+# damage to a textured scene's look (docs/textures.md): (id, damage, needles)
+LOOK_DAMAGE = [
+    ("side-texture-index", record_field(SIDES, SIDE_BYTES, 3, 16, lambda d: section(d, TEXTURES)[1]),
+     ["sides record 3", "index out of range"]),
+    ("texture-texels-past-end", record_field(TEXTURES, TEXTURE_BYTES, 2, 0, lambda d: section(d, TEXELS)[1]),
+     ["textures record 2", "index out of range"]),
+    ("texture-wbits", record_field(TEXTURES, TEXTURE_BYTES, 1, 4, lambda d: 11),
+     ["textures record 1", "outside the proven-safe range"]),
+    ("side-flags", record_field(SIDES, SIDE_BYTES, 5, 20, lambda d: 0x00040000),
+     ["sides record 5", "outside the proven-safe range"]),
+    ("plane-texture-index", record_field(PLANES, 4, 7, 0, lambda d: section(d, TEXTURES)[1] + 1),
+     ["planes record 7", "index out of range"]),
+    ("sky-texture-index", record_field(LOOK, 8, 0, 0, lambda d: section(d, TEXTURES)[1]),
+     ["look record 0", "index out of range"]),
+    ("sides-count", header_field(44 + 8 * SIDES + 4, lambda d: section(d, SIDES)[1] - 2),
+     ["sides section", "expected 2 per line"]),
+    ("lights-count", header_field(44 + 8 * LIGHTS + 4, 31), ["light tables section", "31 tables, expected 32"]),
+    ("look-count", header_field(44 + 8 * LOOK + 4, 2), ["look section", "2 records, expected 0 or 1"]),
+]
+
+
+@pytest.fixture(scope="module")
+def textured(tmp_path_factory):
+    out = tmp_path_factory.mktemp("bsc") / "map01.bsc"
+    run([program("bspc"), "freedoom2.wad:MAP01", "-o", out])
+    return out.read_bytes()
+
+
+@pytest.mark.parametrize("damage, needles", [c[1:] for c in LOOK_DAMAGE], ids=[c[0] for c in LOOK_DAMAGE])
+@pytest.mark.parametrize("tool", ["render", "bspc"])
+def test_damaged_look_is_refused(textured, tmp_path, tool, damage, needles):
+    bad = tmp_path / "bad.bsc"
+    bad.write_bytes(bytes(damage(bytearray(textured))))
+    out = tmp_path / "out"
+    args = [program("render"), bad, "-o", out] if tool == "render" else [program("bspc"), bad, "--config", out]
+    err = refused(args, f"{tool}: {bad}: ", "compiled scene rejected", *needles)
+    assert not out.exists()
 
 
 @pytest.mark.parametrize("damage, needles", [c[1:] for c in COMPILED], ids=[c[0] for c in COMPILED])

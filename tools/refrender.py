@@ -67,7 +67,7 @@ at at + R (cos 360k/N, sin 360k/N), the offset rounded to 16.16, then the same r
 as tools/bspc/models.c builds them; models numbered in declaration order; `object
 MODEL X Y [z=] [yaw=] [path=circle:R:MS | line:DX:DY:MS] [spin=]` numbered in file order, z by
 default the floor of the sector under (X, Y); `door=H` a sector's open ceiling. WAD maps: the
-things of tools/bspc/things.txt (type radius height colour name) that are in skill 3, not
+things of tools/bspc/things.txt (type radius height colour sprite name) that are in skill 3, not
 multiplayer-only, not at x or y = -32768 and inside a sector, in THINGS order, each an upright box
 2r x 2r x height on the floor under it, yawed by its angle, one model per distinct (radius,
 height, colour) in order of first use. WAD doors: the back sector of a line with a door special,
@@ -427,7 +427,9 @@ def colour_index(text):
 
 
 def read_things_table(path=THINGS_TXT):
-    """tools/bspc/things.txt: {type: (radius, height, colour index)}; `#` starts a comment."""
+    """tools/bspc/things.txt (type radius height colour sprite name): {type: (radius, height,
+    colour index)}; `#` starts a comment. The sprite column (bspc colours a WAD's boxes from it)
+    does not change a box's shape, which is all the reference draws of objects."""
     table = {}
     with open(path, "r", encoding="utf-8") as fh:
         for lineno, line in enumerate(fh, 1):
@@ -435,9 +437,11 @@ def read_things_table(path=THINGS_TXT):
             if not tok:
                 continue
             try:
+                if len(tok) != 6 or len(tok[4]) != 4:
+                    raise ValueError
                 table[int(tok[0])] = (float(tok[1]), float(tok[2]), colour_index(tok[3]))
             except (IndexError, ValueError):
-                raise ValueError(f"{path}:{lineno}: expected 'type radius height colour name'") from None
+                raise ValueError(f"{path}:{lineno}: expected 'type radius height colour sprite name'") from None
     return table
 
 
