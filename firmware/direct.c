@@ -613,6 +613,7 @@ void direct_render(const scene *sc, const world_state *w, const view_xform *v, c
     st->nodes = ws.nodes;
     st->boxes_culled = ws.boxes_culled + ws.boxes_hidden;
     if (CFG_OBJECTS && S->nactive) draw_objects(S);
+    tex_paint background = tex_flat(BACKGROUND_COLOUR);
     for (int y = 0; y < VIEW_H; y++) /* what no surface claimed: the background */
-        cov_fill(&S->cov, t, y, 0, VIEW_W, 0, BACKGROUND_COLOUR, RAST_ID(RAST_KIND_NONE, 0));
+        cov_fill(&S->cov, t, y, 0, VIEW_W, 0, &background, RAST_ID(RAST_KIND_NONE, 0));
 }

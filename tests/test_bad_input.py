@@ -47,7 +47,7 @@ HEADER_BYTES = 204  # sizeof(scn_header)
 VERTICES, SECTORS, LINES, SEGS, NODES, LEAVES, PVERTS, PALETTE = range(8)
 NEEDS = 13
 LOOK, LIGHTS, TEXTURES, TEXELS, SIDES, PLANES = range(14, 20)
-TEXTURE_BYTES, SIDE_BYTES = 8, 24
+TEXTURE_BYTES, SIDE_BYTES = 12, 24
 SEG_BYTES, NODE_BYTES, LEAF_BYTES, LINE_BYTES = 16, 56, 20, 24
 LEAF_BIT = 0x80000000
 
@@ -186,6 +186,10 @@ LOOK_DAMAGE = [
     ("texture-texels-past-end", record_field(TEXTURES, TEXTURE_BYTES, 2, 0, lambda d: section(d, TEXELS)[1]),
      ["textures record 2", "index out of range"]),
     ("texture-wbits", record_field(TEXTURES, TEXTURE_BYTES, 1, 4, lambda d: 11),
+     ["textures record 1", "outside the proven-safe range"]),
+    ("texture-height-zero", record_field(TEXTURES, TEXTURE_BYTES, 1, 8, lambda d: 0),
+     ["textures record 1", "outside the proven-safe range"]),
+    ("texture-taller-than-stored", record_field(TEXTURES, TEXTURE_BYTES, 1, 8, lambda d: 2048),
      ["textures record 1", "outside the proven-safe range"]),
     ("side-flags", record_field(SIDES, SIDE_BYTES, 5, 20, lambda d: 0x00040000),
      ["sides record 5", "outside the proven-safe range"]),

@@ -115,7 +115,7 @@ def compile_map(tmp_path, spec, *extra):
 
 def textures(blob):
     off, n = sections(blob)[SEC_TEXTURES]
-    return [struct.unpack_from("<IBBBB", blob, off + 8 * i) for i in range(n)]
+    return [struct.unpack_from("<IBBBB", blob, off + 12 * i) for i in range(n)]
 
 
 def sides(blob):

@@ -87,7 +87,7 @@ def measure(bspc, wad, mapname, tmp):
     blob = out.read_bytes()
     sec = sections(blob)
     toff, ntex = sec[SEC_TEXTURES]
-    tex = [struct.unpack_from("<IBB", blob, toff + 8 * i) for i in range(ntex)]
+    tex = [struct.unpack_from("<IBB", blob, toff + 12 * i) for i in range(ntex)]
     flats = set()
     poff, npl = sec[SEC_PLANES]
     for i in range(npl):

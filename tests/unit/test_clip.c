@@ -72,7 +72,8 @@ static void fill(const screen_pt *pts, int n, uint32_t id)
 {
     hal_surface s = hal_begin_frame(HAL_PRESENT_COPY32);
     rast_target t = {&s, ids};
-    rast_convex(&t, pts, n, 1, id);
+    tex_paint paint = tex_flat(1);
+    rast_convex(&t, pts, n, &paint, id);
 }
 
 static void test_full_screen_quad(void **state)
