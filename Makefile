@@ -76,6 +76,11 @@ $(eval $(call variant,$(BUILD)/san,$(SAN)))
 $(eval $(call variant,$(BUILD)/tinypools,$(REL) -DSPAN_POOL_EDGES=72u -DSPAN_POOL_SURFACES=6u -DCFG_DIRECT_FACES=3u -DCFG_DIRECT_EDGES=90u))
 $(BUILD)/tinypools/obj/tools/bspc/wad.o: $(THINGS_H)
 $(BUILD)/tinypools/obj/tools/bspc/wad.o: BASE += -I$(GEN)
+# A build without the texture code (CFG_FLAT=1): every scene in its flat colours
+# (tests/test_textures_flat.py checks its id buffers against build/render's).
+$(eval $(call variant,$(BUILD)/flat,$(REL) -DCFG_FLAT=1))
+$(BUILD)/flat/obj/tools/bspc/wad.o: $(THINGS_H)
+$(BUILD)/flat/obj/tools/bspc/wad.o: BASE += -I$(GEN)
 
 UNIT_TESTS := $(patsubst tests/unit/%.c,%,$(wildcard tests/unit/test_*.c))
 PROGRAMS   := $(BUILD)/bspc $(BUILD)/render $(BUILD)/emu $(BUILD)/display

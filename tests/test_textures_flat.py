@@ -1,0 +1,65 @@
+"""Texturing changes colours only: a flat build and a textured build draw the same surfaces.
+
+build/flat/render is build/render compiled with CFG_FLAT=1 (the Makefile): the texture code is left
+out and every scene is drawn in its flat colours. For each render mode, over the bench views of WAD
+maps (tests/bench_views.json) with their things, the textured frame of build/render, the same
+build's `--flat` frame and the flat build's frame must give identical surface-id buffers; the two
+flat frames must be identical pixel for pixel, and the textured frame must differ from them (it is
+textured). The flat build must carry no texture code.
+"""
+import json
+import subprocess
+
+import pytest
+
+from conftest import BUILD, ROOT, program, run
+
+MODES = ["direct", "spans", "painter"]
+
+
+def flat_render():
+    run(["make", "-C", ROOT, "--no-print-directory", "build/flat/render"], env=None)
+    return str(BUILD / "flat" / "render")
+
+
+def bench_views():
+    views = json.loads((ROOT / "tests" / "bench_views.json").read_text())
+    out = []
+    for group in (views["views"], views["open"]):
+        out += [v for v in group if ".wad:" in v["scene"]]
+    return out
+
+
+VIEWS = bench_views()[::3]  # every third: starts and open views of several maps
+
+
+def draw(render, view, mode, tmp_path, tag, *extra):
+    ids, raw = tmp_path / f"{tag}.ids", tmp_path / f"{tag}.raw"
+    args = [render, view["scene"], "--mode", mode, "--ids", ids, "--raw", raw, *extra]
+    if view.get("at"):
+        args += ["--at", view["at"], "--angle", str(view["angle"])]
+    out = json.loads(run(args).stdout)
+    return out, ids.read_bytes(), raw.read_bytes()
+
+
+def test_flat_build_has_no_texture_code():
+    symbols = subprocess.run(["nm", flat_render()], capture_output=True, text=True, check=True).stdout
+    assert "tex_span" not in symbols and "rast_textured" not in symbols
+    assert "tex_span" in subprocess.run(["nm", program("render", sanitized=False)], capture_output=True,
+                                        text=True, check=True).stdout
+
+
+@pytest.mark.parametrize("mode", MODES)
+@pytest.mark.parametrize("view", VIEWS, ids=lambda v: f"{v['scene']}@{v.get('at', 'start')}")
+def test_same_surfaces_textured_and_flat(view, mode, tmp_path):
+    render, flat = program("render"), flat_render()
+    tex, tex_ids, tex_raw = draw(render, view, mode, tmp_path, "tex")
+    rflat, rflat_ids, rflat_raw = draw(render, view, mode, tmp_path, "rflat", "--flat")
+    bflat, bflat_ids, bflat_raw = draw(flat, view, mode, tmp_path, "bflat")
+    assert (tex["textured"], rflat["textured"], bflat["textured"]) == (1, 0, 0)
+    assert tex_ids == rflat_ids == bflat_ids, "texturing changed which surface a pixel shows"
+    assert rflat_raw == bflat_raw, "--flat and the flat build draw different colours"
+    assert tex_raw != rflat_raw, "the textured frame is not textured"
+    for out in (tex, rflat, bflat):
+        assert out["overdraw"] == 1.0 or mode == "painter"
+        assert out["overflow"] == 0
