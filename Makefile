@@ -141,8 +141,19 @@ help:
 deps:
 	@tools/deps.sh
 
+# make run walks freedoom2.wad:MAP01, textured, when the WAD is installed (make deps
+# installs Debian's freedoom), else the built-in scene; SCENE=... on the command
+# line walks that scene.
+RUN_SCENE = $(if $(filter command line environment,$(origin SCENE)),$(SCENE))
 run: deps all
-	$(BUILD)/emu
+	@scene="$(RUN_SCENE)"; \
+	if [ -z "$$scene" ]; then \
+	  for d in $(DOOMWADDIR) /usr/share/games/doom; do \
+	    if [ -f "$$d/freedoom2.wad" ]; then scene=freedoom2.wad:MAP01; break; fi; \
+	  done; \
+	fi; \
+	echo "make run: $${scene:-the built-in scene} (SCENE=... for another)"; \
+	$(BUILD)/emu $$scene
 
 # No floating point in firmware/ and hal/ targets, three ways: no float/double token
 # in the code (comments stripped), the host compile with -mgeneral-regs-only above,
