@@ -4,8 +4,9 @@
 #   make report   builds build/knob/CONFIG/render (-O2) for every configuration
 #                 below and runs tools/report.py: per configuration and render
 #                 mode, the error against tools/refrender.py over the bench views
-#                 and the extreme scenes' views, and instructions per frame
-#                 (callgrind) over the bench views
+#                 and the extreme scenes' views, the texel-and-light error
+#                 against tools/reflook.py over the bench views, and
+#                 instructions per frame (callgrind) over the bench views
 #                 -> build/report/report.md, build/report/error_vs_ir.png
 #   make build/knob/CONFIG/render      one configuration
 #   make build/knob/CONFIG/san/render  the same with ASan + UBSan
@@ -13,8 +14,11 @@
 #
 # The knobs (documented where they are defined): VIEW_SHIFT, VIEW_SUBPIXEL_BITS,
 # VIEW_RECIP_BITS (firmware/view.h), RAST_STEP_BITS (firmware/raster.h),
-# FX_SIN_BITS, FX_SIN_LERP (firmware/fixed.h). Configuration "default" sets none
-# and draws exactly what build/render draws.
+# FX_SIN_BITS, FX_SIN_LERP (firmware/fixed.h); the texture knobs TEX_SUBDIV_BITS,
+# TEX_RECIP_BITS, TEX_LIGHT_BITS (firmware/texture.h), whose error the report
+# also gives as the share of pixels not within one texel and one light step of
+# tools/reflook.py. Configuration "default" sets none and draws exactly what
+# build/render draws.
 
 KNOB := $(BUILD)/knob
 
@@ -43,8 +47,21 @@ KNOB_FLAGS_sin4     := -DFX_SIN_BITS=4
 KNOB_FLAGS_sin12n   := -DFX_SIN_BITS=12 -DFX_SIN_LERP=0
 KNOB_FLAGS_sin8n    := -DFX_SIN_BITS=8 -DFX_SIN_LERP=0
 KNOB_FLAGS_cheap    := -DRAST_STEP_BITS=8 -DVIEW_RECIP_BITS=8 -DVIEW_SUBPIXEL_BITS=4
+# textures: wall span subdivision (default 2^3 pixels), the depth reciprocal
+# table (default: exact divides), light steps (default all 32 tables)
+KNOB_FLAGS_texsub0    := -DTEX_SUBDIV_BITS=0
+KNOB_FLAGS_texsub2    := -DTEX_SUBDIV_BITS=2
+KNOB_FLAGS_texsub4    := -DTEX_SUBDIV_BITS=4
+KNOB_FLAGS_texsub5    := -DTEX_SUBDIV_BITS=5
+KNOB_FLAGS_texrecip12 := -DTEX_RECIP_BITS=12
+KNOB_FLAGS_texrecip8  := -DTEX_RECIP_BITS=8
+KNOB_FLAGS_texrecip6  := -DTEX_RECIP_BITS=6
+KNOB_FLAGS_texlight4  := -DTEX_LIGHT_BITS=4
+KNOB_FLAGS_texlight3  := -DTEX_LIGHT_BITS=3
+KNOB_FLAGS_texlight2  := -DTEX_LIGHT_BITS=2
 REPORT_CONFIGS := default subpix8 subpix4 subpix2 subpix0 step16 step12 step8 step6 step4 \
-                  recip12 recip8 recip6 recip4 view12 view10 view8 view6 sin8 sin4 sin12n sin8n cheap
+                  recip12 recip8 recip6 recip4 view12 view10 view8 view6 sin8 sin4 sin12n sin8n cheap \
+                  texsub0 texsub2 texsub4 texsub5 texrecip12 texrecip8 texrecip6 texlight4 texlight3 texlight2
 
 # Only the firmware and build/render's main include the knobs' headers; the
 # scene compiler, PNG writer and HAL objects are shared with build/ (build/san/).
@@ -82,7 +99,7 @@ report-configs:
 report: deps $(BUILD)/bspc $(BUILD)/render $(KNOB_RENDERS)
 	$(PY) tools/report.py --configs $(REPORT_CONFIGS)
 
-# tests/test_report.py renders with one knob configuration beside the default.
-pytest: $(KNOB)/default/render $(KNOB)/subpix0/render $(KNOB)/subpix0/san/render
+# tests/test_report.py renders with two knob configurations beside the default.
+pytest: $(KNOB)/default/render $(KNOB)/subpix0/render $(KNOB)/subpix0/san/render $(KNOB)/texlight2/render
 
 # (their dependency files are included with the rest of build/ by the Makefile)

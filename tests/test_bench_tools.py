@@ -60,6 +60,25 @@ def test_p95_nearest_rank():
     assert (s["median"], s["p95"], s["max"]) == (2.5, 10, 10)
 
 
+def test_textured_against_flat_table_and_goal_figure():
+    views = [{"scene": "freedoom1.wad:E1M1", "at": "-160,304", "angle": "0"},
+             {"scene": bench.MAP01_START[0], "at": bench.MAP01_START[1], "angle": bench.MAP01_START[2]}]
+    res = {(0, "direct", "world"): (300.0, None), (0, "direct", "flat"): (100.0, None),
+           (1, "direct", "world"): (1_000.0, None), (1, "direct", "flat"): (800.0, None)}
+    lines, stats = bench.flat_table(views, ["direct"], res)
+    s = stats["direct"]
+    assert (s["textured"]["median"], s["textured"]["max"]) == (650.0, 1_000.0)
+    assert (s["flat"]["median"], s["flat"]["max"]) == (450.0, 800.0)
+    assert (s["ratio"]["median"], s["ratio"]["max"]) == (pytest.approx(2.125), 3.0)
+    assert lines[-1] == "| direct | 650 | 1,000 | 1,000 | 450 | 800 | 800 | 2.12 | 3.00 |"
+    line, fig = bench.goal_line(views, res)
+    assert (fig["textured"], fig["flat"], fig["ratio"]) == (1_000.0, 800.0, 1.25)
+    assert "textured **1,000**, flat 800" in line and "**1.25**" in line
+    # no MAP01 start, or no direct mode measured: no goal figure
+    assert bench.goal_line(views[:1], res) == (None, None)
+    assert bench.goal_line(views, res, mode="spans") == (None, None)
+
+
 def test_inlined_helpers_count_for_their_caller():
     chain = [("w128_mul", "firmware/wide128.h"), ("objd_front", "firmware/obj_draw.c")]
     assert bp.function_of(chain) == ("objd_front", "firmware/obj_draw.c")
@@ -70,6 +89,7 @@ def test_inlined_helpers_count_for_their_caller():
     assert bp.function_of([("objd_front", "firmware/wide128.h")], {"objd_front": "firmware/obj_draw.c"}) == \
         ("objd_front", "firmware/obj_draw.c")
     assert bp.stage_of("clip_plane.isra.0", "firmware/clip.c") == bp.XFORM
+    assert bp.stage_of("wall_span", "firmware/texture.c") == bp.TEXTURE
     assert bp.stage_of("__aeabi_ldivmod", "??") == bp.ARITH
     assert bp.stage_of("brand_new", "firmware/brand_new.c") == bp.OTHER
     assert bp.Profile({("brand_new", "firmware/brand_new.c"): 5, ("scan_line", "firmware/spans.c"): 7}).unclassified() == \

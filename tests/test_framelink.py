@@ -81,6 +81,23 @@ def test_walk_is_reproducible_by_render(walk):
         assert zlib.crc32(raw[k * 64000:(k + 1) * 64000]) == int(l["crc32"], 16)
 
 
+def test_flat_walk_has_the_same_cameras(walk, tmp_path):
+    """fltool walk --flat (make bench-link's flat frames): the textured walk's cameras, each frame
+    the one build/render --flat draws, and not the textured frame."""
+    _, _, lines = walk
+    n = 12
+    run([program("fltool", sanitized=False), "walk", "freedoom2.wad:MAP01", "--frames", n, "--out", tmp_path,
+         "--flat"])
+    flat = [json.loads(l) for l in (tmp_path / "frames.jsonl").read_text().splitlines()]
+    assert [l["raw"] for l in flat] == [l["raw"] for l in lines[:n]]
+    for l in (flat[0], flat[-1]):
+        c = l["camera"]
+        got = render("freedoom2.wad:MAP01", "--look", str(c["look"]), "--flat",
+                     at=f"{c['x']},{c['y']},{c['z']}", angle=str(c["angle"]), sanitized=False)
+        assert got["crc32"] == l["crc32"] and got["textured"] == 0
+        assert l["crc32"] != lines[l["frame"]]["crc32"]
+
+
 @pytest.mark.parametrize("extra", [[], ["--key-interval", "1"], ["--key-interval", "0"], ["--no-crc"],
                                    ["--scratch", "300"]])
 def test_same_events_clean(walk, tmp_path, extra):

@@ -58,9 +58,12 @@ def test_every_configuration_compiles():
 
 
 @pytest.mark.parametrize("flag", ["-DVIEW_SUBPIXEL_BITS=17", "-DRAST_STEP_BITS=3", "-DVIEW_RECIP_BITS=13",
-                                  "-DVIEW_SHIFT=15", "-DFX_SIN_BITS=13", "-DFX_SIN_LERP=2"])
+                                  "-DVIEW_SHIFT=15", "-DFX_SIN_BITS=13", "-DFX_SIN_LERP=2",
+                                  "-DTEX_SUBDIV_BITS=7", "-DTEX_RECIP_BITS=3", "-DTEX_RECIP_BITS=13",
+                                  "-DTEX_LIGHT_BITS=0", "-DTEX_LIGHT_BITS=6"])
 def test_out_of_range_knob_is_refused(flag):
-    proc = subprocess.run(["cc", *CFLAGS, flag, "firmware/view.c", "firmware/raster.c", "firmware/fixed.c"],
+    proc = subprocess.run(["cc", *CFLAGS, flag, "firmware/view.c", "firmware/raster.c", "firmware/fixed.c",
+                           "firmware/texture.c"],
                           cwd=ROOT, capture_output=True, text=True)
     assert proc.returncode != 0 and "#error" in proc.stderr, proc.stderr
 
@@ -90,8 +93,9 @@ def test_default_is_exact_and_a_coarse_knob_is_not(mode, tmp_path):
 
 
 def test_report_runs_on_one_view_without_callgrind(tmp_path):
-    knob_render("default", sanitized=False), knob_render("subpix0", sanitized=False)
-    proc = subprocess.run([sys.executable, str(ROOT / "tools/report.py"), "--configs", "default", "subpix0",
+    for c in ("default", "subpix0", "texlight2"):
+        knob_render(c, sanitized=False)
+    proc = subprocess.run([sys.executable, str(ROOT / "tools/report.py"), "--configs", "default", "subpix0", "texlight2",
                            "--views", "1", "--no-ir", "--jobs", "1", "--out", str(tmp_path)],
                           cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
@@ -105,23 +109,32 @@ def test_report_runs_on_one_view_without_callgrind(tmp_path):
     assert points[("default", "spans")]["views"] == 1
     assert points[("subpix0", "spans")]["mean_differ"] > points[("default", "spans")]["mean_differ"]
     assert any((tmp_path / "ref").glob("*.bin"))
+    # the texel-and-light error of the one view (a WAD map): 2 light steps of 32 are coarser than all
+    # of them, and do not move a surface
+    assert points[("default", "spans")]["tex_views"] == 1
+    assert points[("texlight2", "spans")]["tex_bad_mean"] > points[("default", "spans")]["tex_bad_mean"] + 0.05
+    assert points[("texlight2", "spans")]["mean_differ"] == points[("default", "spans")]["mean_differ"]
 
 
 def test_report_writes_tables_and_figure_from_fake_points(tmp_path):
     views = [{"set": "bench", "group": "bench", "name": "a"}, {"set": "extreme", "group": "s1", "name": "s1/v"}]
     errors = [{"differ": 0.01, "edge": 2, "hist": [[2, 99]]},
               {"differ": 0.03, "edge": report.CAP, "hist": [[1, 50], [report.CAP, 1]], "failed": 1}]
-    points = [report.summarise("default", "", "spans", views, errors, [1000, 3000]),
+    tex = [({"bad": 0.001, "compared": 64000}, "a"), ({"bad": 0.005, "compared": 60000}, "b")]
+    points = [report.summarise("default", "", "spans", views, errors, [1000, 3000], tex),
               report.summarise("cheap", "-DRAST_STEP_BITS=8 -DVIEW_RECIP_BITS=8", "painter", views, errors[:1], [500])]
     assert points[0]["ir"] == 2000 and points[0]["worst_differ"] == 0.03 and points[0]["worst_view"] == "s1/v"
     assert points[0]["mean_differ_bench"] == 0.01 and points[0]["p99_edge"] == 2 and points[0]["failed"] == ["s1/v"]
     per_scene = {"s1": {"views": 1, "spans": {"differ": 0.03, "edge": 320}, "painter": {"differ": 0.0, "edge": 0}}}
     report.plot(tmp_path / "p.png", points, no_ir=False)
     report.write_markdown(tmp_path / "r.md", points, per_scene, views,
-                          {"default": "", "cheap": points[1]["flags"]}, "p.png", no_ir=False)
+                          {"default": "", "cheap": points[1]["flags"]}, "p.png", no_ir=False, tex_names=["a", "b"])
     md = (tmp_path / "r.md").read_text()
     assert "| **default** | — | spans | 2,000 | +0.0% | 2.000% |" in md, md
     assert "| s1 | 1 | 3.00% | 320 | 0.00% | 0 |" in md, md
+    assert "| 1 | 0.300% | 0.50% | b |" in md, md            # texels off: mean, worst, its view
+    assert "| 0 | — | — | — |" in md, md                      # not measured for the second point
+    assert points[1]["tex_bad_mean"] is None
     assert "Failed renders" in md
     assert (tmp_path / "p.png").stat().st_size > 10000
     assert report.hist_percentile([0, 0, 5], 99) == 2 and report.hist_percentile([0] * 4, 99) == 0

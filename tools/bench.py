@@ -19,6 +19,12 @@ into the stages of the frame. A stage's share is given two ways: the mean over t
 share of each view's frame (every view weighs the same), and its share of all the views' frames
 summed (expensive views weigh more).
 
+Textured and flat: the bench views are WAD maps, which build/render draws textured, so every table
+but the textured-against-flat one is of textured frames. That table gives, per mode, the world alone
+(--no-objects) textured and again with --flat (the same scene in flat colours), and the ratio per
+view; a line gives the issue's goal figure, MAP01's start in mode direct, world alone, textured and
+flat.
+
 Also, as before: overdraw and the VRAM writes and modelled bus cycles of each present mode for the
 bench views, and instructions per frame with 0, 10 and 100 objects in a generated scene (see
 object_bench).
@@ -173,14 +179,24 @@ def view_name(v):
     return f"{v['scene']} @ {v['at']} {v['angle']}°" + (f" look {v['look']}" if v.get("look") else "")
 
 
+def frame_instructions(scene, view, mode, n, *extra, render=RENDER):
+    """Instructions per frame alone (no profile): (run of N+1 frames - run of one) / N."""
+    return (instructions(scene, view, mode, n + 1, *extra, render=render) -
+            instructions(scene, view, mode, 1, *extra, render=render)) / n
+
+
 def measure_views(views, modes, n, jobs, bench_dir):
-    """{(view index, mode, "world"|"things"): (Ir per frame, Profile)}, jobs callgrind pairs at once."""
+    """{(view index, mode, "world"|"things"|"flat"): (Ir per frame, Profile or None)}, jobs
+    callgrind pairs at once. "world" and "things" are the frames build/render draws (textured for
+    a WAD map), "flat" the world alone with --flat (no profile: only its total is reported)."""
     scenes = [compiled(v["scene"], bench_dir) for v in views]
-    tasks = [(i, m, w) for i in range(len(views)) for m in modes for w in ("world", "things")]
+    tasks = [(i, m, w) for i in range(len(views)) for m in modes for w in ("world", "things", "flat")]
     out, done, t0 = {}, 0, time.time()
 
     def one(task):
         i, m, w = task
+        if w == "flat":
+            return task, (frame_instructions(scenes[i], views[i], m, n, "--no-objects", "--flat"), None)
         return task, frame_profile(scenes[i], views[i], m, n, *(["--no-objects"] if w == "world" else []))
 
     with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
@@ -213,6 +229,44 @@ def summary_table(views, modes, res):
             f"{m} {statistics.median(res[(i, m, 'world')][0] for i in starts):,.0f} / "
             f"{statistics.median(res[(i, m, 'things')][0] for i in starts):,.0f}" for m in modes) + "."]
     return lines, stats
+
+
+def flat_table(views, modes, res):
+    """Textured against flat, the world alone: per mode the median, p95 and max of each over the
+    views, and of the per-view ratio textured / flat. Returns (lines, {mode: figures})."""
+    lines = ["| mode | textured: median | p95 | max | flat (--flat): median | p95 | max | "
+             "textured / flat per view: median | max |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    stats = {}
+    for m in modes:
+        tex = [res[(i, m, "world")][0] for i in range(len(views))]
+        flat = [res[(i, m, "flat")][0] for i in range(len(views))]
+        ratio = [t / f for t, f in zip(tex, flat) if f]
+        t, f = summary(tex), summary(flat)
+        r = summary(ratio) if ratio else None
+        stats[m] = {"textured": t, "flat": f, "ratio": r}
+        lines.append(f"| {m} | {t['median']:,.0f} | {t['p95']:,.0f} | {t['max']:,.0f} | {f['median']:,.0f} | "
+                     f"{f['p95']:,.0f} | {f['max']:,.0f} | " +
+                     (f"{r['median']:.2f} | {r['max']:.2f} |" if r else "- | - |"))
+    return lines, stats
+
+
+CHOCOLATE_MAP01 = 1.32e6   # issue 17: Chocolate Doom's whole renderer on the MAP01 start view
+
+
+def goal_line(views, res, mode="direct"):
+    """The issue's goal figure: MAP01's start, world alone, `mode`, textured and flat and their
+    ratio (None when the view or the mode was not measured)."""
+    m01 = next((i for i, v in enumerate(views) if (v["scene"], v["at"], v["angle"]) == MAP01_START), None)
+    if m01 is None or (m01, mode, "world") not in res:
+        return None, None
+    tex, flat = res[(m01, mode, "world")][0], res[(m01, mode, "flat")][0]
+    fig = {"mode": mode, "textured": tex, "flat": flat, "ratio": tex / flat if flat else None}
+    line = (f"Goal figure (issue 17): freedoom2.wad:MAP01 start (--at {MAP01_START[1]} --angle {MAP01_START[2]}), "
+            f"world alone (--no-objects), mode {mode}: textured **{tex:,.0f}**, flat {flat:,.0f} instructions per "
+            f"frame, textured / flat **{fig['ratio']:.2f}** (goal: at most {CHOCOLATE_MAP01 / 1e6:.2f} M, Chocolate "
+            f"Doom's whole renderer on the same view, and at most 2).")
+    return line, fig
 
 
 def stage_shares(views, modes, res):
@@ -381,6 +435,8 @@ def main(argv=None):
                     help="instructions per frame = (run of N+1 frames - run of 1) / N (default 10)")
     ap.add_argument("-j", "--jobs", type=int, default=2, help="callgrind runs at once (default 2)")
     ap.add_argument("--views", type=int, default=0, metavar="K", help="only the first K views (a quick look)")
+    ap.add_argument("--scene", action="append", default=[], metavar="WAD:MAP",
+                    help="only the views of this scene (repeatable; a quick look)")
     args = ap.parse_args(argv)
     started, t0 = datetime.datetime.now().astimezone(), time.time()
     bench_dir = BUILD / "bench"
@@ -393,10 +449,14 @@ def main(argv=None):
         print(text)
         return
     views = load_views()
+    if args.scene:
+        views = [v for v in views if v["scene"] in args.scene]
     if args.views:
         views = views[:args.views]
     res = measure_views(views, modes, args.frames, args.jobs, bench_dir)
     sum_lines, stats = summary_table(views, modes, res)
+    flat_lines, flat_stats = flat_table(views, modes, res)
+    goal, goal_fig = goal_line(views, res)
     shares, sums = stage_shares(views, modes, res)
     top_lines, unclassified = top_functions(modes, sums, views)
     n_bench = sum(v["set"] == "bench" for v in views)
@@ -410,10 +470,19 @@ def main(argv=None):
         f"{len(views)} views: {n_bench} bench views (player starts) and {len(views) - n_bench} open views "
         f"(tests/bench_views.json). Instructions per frame = (Ir of --repeat {args.frames + 1} - Ir of --repeat 1) / "
         f"{args.frames}, callgrind, build/render; world alone is --no-objects. p95: nearest rank. Modes: those "
-        f"build/render --help names and accepts ({', '.join(modes)}).",
+        f"build/render --help names and accepts ({', '.join(modes)}). The views are WAD maps, drawn textured: "
+        f"every table but the next one is of textured frames.",
         "",
         *sum_lines,
         "",
+        "### Textured against flat, x86-64, world alone",
+        "",
+        "The same views and frames, world alone (--no-objects): as build/render draws them (textured), and with "
+        "--flat (the same scene in its flat colours). Ratio: each view's textured frame over its flat frame.",
+        "",
+        *flat_lines,
+        "",
+        *([goal, ""] if goal else []),
         "### Stages of the frame, x86-64",
         "",
         "Share of each stage: the mean over the views of the stage's share of the view's frame, and in brackets "
@@ -444,11 +513,11 @@ def main(argv=None):
     ]) + "\n"
     (BUILD / "bench.md").write_text(text)
     figures = {"date": started.isoformat(timespec="seconds"), "seconds": round(elapsed), "frames": args.frames,
-               "modes": modes, "stats": stats,
+               "modes": modes, "stats": stats, "textured_vs_flat": flat_stats, "goal_map01": goal_fig,
                "stages": {f"{m} {w}": {s: {"mean": a, "of_sum": b} for s, (a, b) in v.items()}
                           for (m, w), v in shares.items()},
                "views": [{"view": view_name(v), "set": v["set"],
-                          **{f"{m} {w}": res[(i, m, w)][0] for m in modes for w in ("world", "things")}}
+                          **{f"{m} {w}": res[(i, m, w)][0] for m in modes for w in ("world", "things", "flat")}}
                          for i, v in enumerate(views)],
                "objects": obj_rows}
     (BUILD / "bench.json").write_text(json.dumps(figures, indent=1) + "\n")

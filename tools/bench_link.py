@@ -16,7 +16,12 @@ or any file of raw 64,000-byte frames given with --raw), it reports:
     the frames in slices of 40, each slice starting with a keyframe), checked to send the
     very bytes the host encoder sends;
   * the renderer's instructions per frame on x86-64 for a sample of the same frames (build/render
-    with each frame's camera, --repeat 3 minus --repeat 1, halved), for the ratio.
+    with each frame's camera, --repeat 3 minus --repeat 1, halved), for the ratio;
+  * textured against flat: the walk draws a WAD map textured (the tables above are of those
+    frames); the same walk again with --flat (the same cameras), and for each the bytes per frame
+    with the firmware's scratch buffer (hal/mps2/stream_fl.c: a coded frame larger than it is sent
+    raw) and with one large enough for any frame, and the frames per second that 115,200 baud,
+    1 Mbaud and 4 Mbaud (8N1) and USB full speed carry.
 
 Usage: bench_link.py [--raw FRAMES.raw] [--frames 200] [--out build/bench-link.md] [--no-m3]
 (make bench-link).
@@ -38,6 +43,12 @@ ROOT = Path(__file__).resolve().parent.parent
 BUILD = ROOT / "build"
 FRAME = 64000
 BAUD_BYTES = 115200 // 10
+FIRMWARE_SCRATCH = 8192     # hal/mps2/stream_fl.c's SCRATCH_BYTES
+LARGE_SCRATCH = 70000       # more than a raw frame message: no frame falls back to raw
+# (name, payload bytes per second): a UART at 8N1 carries baud / 10 bytes; USB full speed (12 Mbit/s)
+# at most 19 bulk packets of 64 bytes per 1 ms frame, its ceiling for a CDC serial port
+LINKS = [("115,200 baud", 115200 // 10), ("1 Mbaud", 1_000_000 // 10), ("4 Mbaud", 4_000_000 // 10),
+         ("USB full speed (12 Mbit/s, bulk)", 19 * 64 * 1000)]
 
 
 def sh(args, **kw):
@@ -54,9 +65,11 @@ def callgrind(args):
     return int(m.group(1))
 
 
-def link_sizes(fltool, raw, info, palette, key_interval, tmp):
+def link_sizes(fltool, raw, info, palette, key_interval, tmp, scratch=None):
     stream = tmp / f"stream_k{key_interval}.bin"
     args = [fltool, "encode", raw, "--out", stream, "--key-interval", key_interval, "--sizes"]
+    if scratch:
+        args += ["--scratch", scratch]
     if info:
         args += ["--info", info]
     if palette:
@@ -109,6 +122,35 @@ def render_cost(render, scene, lines, sample):
     return costs
 
 
+def textured_rows(fltool, walks, tmp):
+    """Per walk (name, DIR of fltool walk) and scratch size: (walk, scratch, mean bytes per frame,
+    max, frames sent raw) with a keyframe every 64 frames."""
+    rows = []
+    for name, d in walks:
+        for scratch in (FIRMWARE_SCRATCH, LARGE_SCRATCH):
+            sizes, _ = link_sizes(fltool, d / "frames.raw", d / "frames.jsonl", d / "palette.bin", 64, tmp, scratch)
+            b = [s["bytes"] for s in sizes]
+            rows.append((name, scratch, statistics.mean(b), max(b), sum(1 for x in b if x >= FRAME)))
+    return rows
+
+
+def textured_table(rows, n, scene):
+    out = [f"## Textured and flat frames: {n} frames of the fly-through of {scene}\n",
+           "The same walk (the same cameras) drawn textured (fltool walk's default for a WAD map) and with --flat. "
+           f"Keyframe every 64 frames. Scratch: the buffer a coded frame message is built in; a frame whose coding "
+           f"does not fit is sent raw (64,000 bytes and the message around them). {FIRMWARE_SCRATCH:,} bytes is the "
+           f"firmware's (hal/mps2/stream_fl.c), {LARGE_SCRATCH:,} holds any frame. Frames per second: the link's "
+           "bytes per second over the mean bytes per frame (8N1 UARTs carry baud / 10 bytes per second; USB full "
+           "speed at most 19 bulk packets of 64 bytes per millisecond, 1,216,000 bytes per second).\n",
+           "| frames | scratch | mean bytes/frame | max | sent raw | " +
+           " | ".join(f"fps at {name}" for name, _ in LINKS) + " |",
+           "|---|---:|---:|---:|---:|" + "---:|" * len(LINKS)]
+    for name, scratch, mean, mx, raw in rows:
+        out.append(f"| {name} | {scratch:,} | **{mean:,.0f}** | {fmt(mx)} | {raw} of {n} | " +
+                   " | ".join(f"{bps / mean:.1f}" for _, bps in LINKS) + " |")
+    return out
+
+
 def fmt(n):
     return f"{n:,.0f}"
 
@@ -129,10 +171,14 @@ def main(argv=None):
     work = BUILD / "bench-link"
     work.mkdir(parents=True, exist_ok=True)
     lines, palette = [], None
+    walks = []
     if a.raw:
         raw_path, info = Path(a.raw), a.info
     else:
         sh([fltool, "walk", a.scene, "--frames", a.frames, "--out", work])
+        (work / "flat").mkdir(exist_ok=True)
+        sh([fltool, "walk", a.scene, "--frames", a.frames, "--out", work / "flat", "--flat"])
+        walks = [("textured", work), ("flat (--flat)", work / "flat")]
         raw_path, info, palette = work / "frames.raw", work / "frames.jsonl", work / "palette.bin"
     if info:
         lines = [json.loads(l) for l in Path(info).read_text().splitlines()]
@@ -154,6 +200,8 @@ def main(argv=None):
 
     out = []
     out.append(f"# Frame link: {n} frames of {'a fly-through of ' + a.scene if not a.raw else raw_path}\n")
+    if walks:
+        out.append("The frames as fltool walk draws them: textured for a WAD map (the flat walk: the last section).\n")
     out.append("Bytes per frame on the wire (everything the UART carries for a frame message: COBS, header, "
                "frame information, frame check, CRC), beside raw frames and zlib at level 9; frames per second "
                "at 115,200 baud (8N1, 11,520 bytes/s).\n")
@@ -203,6 +251,9 @@ def main(argv=None):
                        f"{fmt(statistics.median(e3))}, max {fmt(max(e3))}) | {fmt(statistics.mean(c3))} | "
                        f"{m3r + ' (MAP01 start, build/bench-m3.md)' if m3r else '-'} | {r3} |")
             out.append("\nThe Cortex-M3 image sent exactly the bytes the host encoder sends for the same frames.")
+    if walks:
+        out.append("")
+        out += textured_table(textured_rows(fltool, walks, work), n, a.scene)
     text = "\n".join(out) + "\n"
     Path(a.out).write_text(text)
     print(text)

@@ -28,10 +28,11 @@ XFORM = "transform/clip/project"
 COVER = "coverage/occlusion"
 SCAN = "edge lists/scan"
 FILL = "span fill and counters (hal)"
+TEXTURE = "texels and light (texture.c)"
 OBJECTS = "objects"
 ARITH = "arithmetic helpers (out of line)"
 OTHER = "other"
-STAGES = [WALK, XFORM, COVER, SCAN, FILL, OBJECTS, ARITH, OTHER]
+STAGES = [WALK, XFORM, COVER, SCAN, FILL, TEXTURE, OBJECTS, ARITH, OTHER]
 
 STAGE_OF_FILE = {
     "firmware/bsp_walk.c": WALK,
@@ -50,6 +51,9 @@ STAGE_OF_FILE = {
     "firmware/objects.c": OBJECTS,
     "firmware/fixed.c": ARITH,
     "hal/fb.c": FILL,
+    "hal/hal.h": FILL,               # the inline run writers (hal_fill_run, hal_copy_run)
+    "firmware/texture.c": TEXTURE,   # a textured span's texels, depths and light tables
+    "firmware/texture.h": TEXTURE,
     "hal/perf.c": FILL,
     "hal/ram_target.c": FILL,
     "firmware/engine.c": OTHER,
@@ -80,7 +84,8 @@ STAGE_OF_FUNCTION = {
     "scan_lines": SCAN, "plan": SCAN, "nearest": SCAN, "overtake": SCAN, "overtakes_at": SCAN,
     "note": SCAN, "raise_surf": SCAN, "may_cross": SCAN, "in_front": SCAN, "mixed_front": SCAN,
     "plane_of": SCAN,
-    "emit_span": FILL, "flush_spans": FILL,
+    "emit_span": FILL, "flush_spans": FILL, "push_span": FILL,
+    "collect_objects": OBJECTS, "find_objects": OBJECTS, "box_add": OBJECTS, "obj_number": OBJECTS,
     "add_objects": OBJECTS, "any_in_view": OBJECTS, "object_bound": OBJECTS,
     # painter.c
     "number_leaf": WALK, "draw_leaf": WALK,

@@ -1,12 +1,14 @@
 /* fltool.c - build/fltool: the frame link on the host, for tests and benchmarks.
  *
- *   fltool walk SCENE [--frames N] [--dt MS] [--out DIR]
+ *   fltool walk SCENE [--frames N] [--dt MS] [--out DIR] [--flat]
  *       A deterministic fly-through: an autopilot walks the camera through the
  *       scene from the player start (the firmware's own camera and collision,
  *       eng_step at DT ms per frame, default 50 = 20 fps) along corridors. Writes
  *       DIR/frames.raw (N x 64,000 bytes) and DIR/frames.jsonl (one line per
  *       frame: number, crc32, the camera exactly as the firmware used it, raw and
  *       as exact decimals, mode, present) and DIR/palette.bin (768 bytes).
+ *       --flat draws a textured scene in its flat colours (the cameras are
+ *       the same: drawing does not steer the walk).
  *   fltool encode FRAMES.raw --out STREAM [--info FRAMES.jsonl] [--palette P.bin]
  *                 [--key-interval N] [--scratch BYTES] [--sizes]
  *       Encodes the frames with the C encoder (hello, palette, then one frame
@@ -37,7 +39,7 @@
 
 static int usage(void)
 {
-    fputs("usage: fltool walk SCENE [--frames N] [--dt MS] [--out DIR]\n"
+    fputs("usage: fltool walk SCENE [--frames N] [--dt MS] [--out DIR] [--flat]\n"
           "       fltool encode FRAMES.raw --out STREAM [--info FRAMES.jsonl] [--palette P.bin]\n"
           "                     [--key-interval N] [--scratch BYTES] [--sizes]\n"
           "       fltool decode STREAM [--chunk N] [--frames-out FILE]\n"
@@ -117,8 +119,10 @@ static int cmd_walk(int argc, char **argv)
 {
     const char *spec = NULL, *out = ".";
     long frames = 200, dt = 50;
+    int flat = 0;
     for (int i = 0; i < argc; i++) {
         if (!strcmp(argv[i], "--frames") && i + 1 < argc) frames = atol(argv[++i]);
+        else if (!strcmp(argv[i], "--flat")) flat = 1;
         else if (!strcmp(argv[i], "--dt") && i + 1 < argc) dt = atol(argv[++i]);
         else if (!strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
         else if (argv[i][0] != '-' && !spec) spec = argv[i];
@@ -142,6 +146,7 @@ static int cmd_walk(int argc, char **argv)
         free(blob);
         return 1;
     }
+    e.flat = (uint8_t)flat;
     uint32_t need = eng_work_bytes(&e);
     void *work = malloc(need);
     if (!work || eng_set_work(&e, work, need)) return 1;

@@ -10,17 +10,23 @@ painter):
   (tools/refrender.py), with tools/accuracy.py's figures: the share of differing pixels, and the
   displacement of each differing pixel from its surface in the other buffer (320 when that surface
   is not within accuracy.SEARCH pixels: a sliver one buffer lacks, or a larger shift);
+- texel-and-light error, over the bench views (all 20 player starts unless --tex-views N): the
+  share of pixels NOT within one texel and one light step of the reference's colour
+  (tools/reflook.py's compare, as tools/texcompare.py does: walls, floors, ceilings and sky with a
+  texture, the world alone), per view, then its mean and worst over the views. The knobs of
+  firmware/texture.h are about this error; the surface-id error above does not see them;
 - run time, over the bench views only: instructions per frame with callgrind, as tools/bench.py
-  counts them ((Ir of --repeat 3 - Ir of --repeat 1) / 2).
+  counts them ((Ir of --repeat 3 - Ir of --repeat 1) / 2); the bench views are WAD maps, so these
+  are textured frames.
 
 Writes OUT/report.md (default build/report/) with a table of every point, OUT/error_vs_ir.png
-(mean differing share and worst edge displacement against median instructions per frame, the
-default configuration marked), and a per-scene table of the extreme scenes for the default
+(mean differing share, worst edge displacement and mean texel-and-light error against median
+instructions per frame, the default configuration marked), and a per-scene table of the extreme scenes for the default
 configuration. Reference id buffers are kept in OUT/ref/, and every measured figure in
 OUT/cache.json keyed by the binary's and the scene's contents, so a re-run only measures what
 changed. Progress goes to stderr. A report, not a test: it asserts nothing about the figures.
 
-usage: tools/report.py [--configs NAME ...] [--views N] [--no-ir] [--jobs N] [--out DIR]
+usage: tools/report.py [--configs NAME ...] [--views N] [--tex-views N] [--no-ir] [--jobs N] [--out DIR]
 """
 import argparse
 import concurrent.futures as cf
@@ -39,7 +45,9 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import accuracy  # noqa: E402
 import bench  # noqa: E402
+import reflook  # noqa: E402
 import refrender  # noqa: E402
+import texcompare  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 BUILD = ROOT / "build"
@@ -156,6 +164,27 @@ def _error_task(args):
     }
 
 
+def _texerr_task(args):
+    """One bench view: the reference's texels and light (once), then each (render, mode)'s frame of
+    the view against it. Returns, per render, {"bad": share of compared pixels not within one
+    texel and one light step, "compared": pixels compared}. Runs in a worker."""
+    view, bsc, runs = args
+    e = texcompare.reference(view["scene"], view["at"], view["angle"], view["look"])
+    out = []
+    with tempfile.TemporaryDirectory() as tmp:
+        raw, idf = Path(tmp) / "frame.raw", Path(tmp) / "frame.ids"
+        for render, mode in runs:
+            proc = subprocess.run([str(render), str(bsc), *camera_args(view), "--mode", mode, "--raw", str(raw),
+                                   "--ids", str(idf)], capture_output=True, text=True)
+            if proc.returncode != 0:
+                out.append({"bad": 1.0, "compared": 0, "failed": proc.returncode})
+                continue
+            _, _, counts = reflook.compare(e, np.fromfile(raw, np.uint8), np.fromfile(idf, "<u4"))
+            ok, n = counts["all"]
+            out.append({"bad": 1.0 - ok / n if n else 0.0, "compared": n})
+    return out
+
+
 def sparse_hist(distances):
     """[[distance, count], ...] for the distances that occur (most views have few differing pixels)."""
     counts = np.bincount(np.minimum(distances, CAP), minlength=CAP + 1) if distances.size else np.zeros(0, int)
@@ -232,8 +261,9 @@ def hist_percentile(hist, q):
     return len(hist) - 1
 
 
-def summarise(config, flags, mode, views, errors, irs):
-    """One point: the figures of a configuration and mode over the views."""
+def summarise(config, flags, mode, views, errors, irs, tex=()):
+    """One point: the figures of a configuration and mode over the views; tex: the texel-and-light
+    errors (_texerr_task's) of the views measured for it, with the views' names."""
     differ = [e["differ"] for e in errors]
     bench_differ = [e["differ"] for e, v in zip(errors, views) if v["set"] == "bench"]
     ext_differ = [e["differ"] for e, v in zip(errors, views) if v["set"] == "extreme"]
@@ -253,6 +283,10 @@ def summarise(config, flags, mode, views, errors, irs):
         "p99_edge": hist_percentile(hist, 99),
         "views_at_cap": sum(1 for e in errors if e["edge"] >= CAP),
         "failed": [views[i]["name"] for i, e in enumerate(errors) if e.get("failed") is not None],
+        "tex_views": len(tex),
+        "tex_bad_mean": float(np.mean([t["bad"] for t, _ in tex])) if tex else None,
+        "tex_bad_worst": max(t["bad"] for t, _ in tex) if tex else None,
+        "tex_worst_view": max(tex, key=lambda p: p[0]["bad"])[1] if tex else "",
     }
 
 
@@ -260,7 +294,7 @@ def pct(x, digits=3):
     return "—" if x is None else f"{100 * x:.{digits}f}%"
 
 
-def write_markdown(path, points, per_scene, views, configs, png_name, no_ir):
+def write_markdown(path, points, per_scene, views, configs, png_name, no_ir, tex_names=()):
     """The report: how it was measured, every point, the default's extreme scenes."""
     n_bench = sum(1 for v in views if v["set"] == "bench")
     groups = sorted({v["group"] for v in views if v["set"] == "extreme"})
@@ -285,11 +319,19 @@ def write_markdown(path, points, per_scene, views, configs, png_name, no_ir):
         "buffers have, moved), *p99 edge* the 99th percentile of the displacements of all differing pixels "
         "pooled over the views, *views at 320* the views with a displacement of 320.",
         "",
+        (f"Texel-and-light error (*texels off*): the share of compared pixels whose colour is not within one "
+         f"texel and one light step of the reference's (tools/reflook.py's compare, as tools/texcompare.py does: "
+         f"wall, floor, ceiling and sky pixels with a texture, the world alone), the mean over {len(tex_names)} "
+         f"bench views and the worst view: " + ", ".join(tex_names) + ". The texture knobs (texsub*, texrecip*, "
+         f"texlight*) change only this error; the surface-id error above is the geometry's."
+         if tex_names else "Texel-and-light error: not measured (--tex-views 0)."),
+        "",
         f"![error against instructions per frame]({png_name})",
         "",
         "| config | flags | mode | median Ir/frame | vs default | mean differ | bench | extreme | worst differ "
-        "| worst view | worst edge px | worst moved edge px | p99 edge px | views at 320 |",
-        "|---|---|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|",
+        "| worst view | worst edge px | worst moved edge px | p99 edge px | views at 320 | texels off: mean "
+        "| worst | worst texel view |",
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---|",
     ]
     for p in points:
         base = default_ir.get(p["mode"])
@@ -300,7 +342,8 @@ def write_markdown(path, points, per_scene, views, configs, png_name, no_ir):
             f"| {rel} | {pct(p['mean_differ'])} | {pct(p['mean_differ_bench'])} | {pct(p['mean_differ_extreme'])} "
             f"| {pct(p['worst_differ'], 2)} | {p['worst_view']} | {p['worst_edge']} | {p['worst_moved_edge']} "
             f"| {p['p99_edge']} "
-            f"| {p['views_at_cap']} |")
+            f"| {p['views_at_cap']} | {pct(p['tex_bad_mean'])} | {pct(p['tex_bad_worst'], 2)} "
+            f"| {p['tex_worst_view'] or '—'} |")
     failed = [(p["config"], p["mode"], n) for p in points for n in p["failed"]]
     if failed:
         lines += ["", f"Failed renders (counted as every pixel differing, displacement 320): {len(failed)}: "
@@ -334,7 +377,9 @@ def family(config, flags):
         return "combined"
     return {"VIEW_SUBPIXEL_BITS": "subpixel bits", "RAST_STEP_BITS": "edge step bits",
             "VIEW_RECIP_BITS": "reciprocal table", "VIEW_SHIFT": "view-space bits",
-            "FX_SIN_BITS": "sine table", "FX_SIN_LERP": "sine table"}.get(sorted(knobs)[0], "other")
+            "FX_SIN_BITS": "sine table", "FX_SIN_LERP": "sine table",
+            "TEX_SUBDIV_BITS": "texture span subdivision", "TEX_RECIP_BITS": "texture reciprocal table",
+            "TEX_LIGHT_BITS": "light steps"}.get(sorted(knobs)[0], "other")
 
 
 def _place_labels(ax, items, fontsize=7):
@@ -371,7 +416,10 @@ def plot(path, points, no_ir):
     order = {c: i for i, c in enumerate(dict.fromkeys(p["config"] for p in points))}
     rows = [("mean_differ", "mean share of pixels differing\nfrom the reference (%)", 100.0, 0.001),
             ("worst_moved_edge", f"worst edge displacement (px),\nbelow 320 (found within {accuracy.SEARCH} px)", 1.0, 1.0)]
-    fig, axes = plt.subplots(len(rows), len(modes), figsize=(7.5 * len(modes), 10), squeeze=False, sharey="row")
+    if any(p.get("tex_bad_mean") is not None for p in points):
+        rows.append(("tex_bad_mean", "mean share of pixels not within one\ntexel and one light step (%)", 100.0, 0.01))
+    fig, axes = plt.subplots(len(rows), len(modes), figsize=(7.5 * len(modes), 5 * len(rows)), squeeze=False,
+                             sharey="row")
     labels = []
     for col, mode in enumerate(modes):
         pts = [p for p in points if p["mode"] == mode]
@@ -379,6 +427,8 @@ def plot(path, points, no_ir):
             ax = axes[row][col]
             items = []
             for p in pts:
+                if p.get(key) is None:
+                    continue
                 x = order[p["config"]] if no_ir or p["ir"] is None else p["ir"]
                 y = p[key] * scale
                 fam = family(p["config"], p["flags"])
@@ -418,6 +468,8 @@ def main(argv=None):
     ap.add_argument("--configs", nargs="+", default=[DEFAULT],
                     help="configuration names (build/knob/NAME/render); the first named 'default' is marked")
     ap.add_argument("--views", type=int, default=0, help="only the first N views (bench views first)")
+    ap.add_argument("--tex-views", type=int, default=None, metavar="N",
+                    help="texel-and-light error over the first N bench views (default: all; 0: none)")
     ap.add_argument("--no-ir", action="store_true", help="no instruction counts (no callgrind)")
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="parallel workers")
     ap.add_argument("--knob-dir", type=Path, default=KNOB, help="where the configurations' binaries are")
@@ -479,6 +531,33 @@ def main(argv=None):
             cache.put(key, r)
         cache.save()
 
+        # texel and light: every configuration and mode on the bench views that are WAD maps
+        tex_views = [i for i, v in enumerate(views) if v["set"] == "bench" and ".wad:" in v["scene"].lower()]
+        if args.tex_views is not None:
+            tex_views = tex_views[:args.tex_views]
+        look_digest = (file_digest(reflook.__file__) + file_digest(refrender.__file__))[:24]
+        texerr, tasks, task_keys = {}, [], []
+        for i in tex_views:
+            runs, keys = [], []
+            for c in configs:
+                for m in MODES:
+                    key = f"tex:{bin_digest[c]}:{m}:{view_keys[i]}:{look_digest}"
+                    hit = cache.get(key)
+                    texerr[(c, m, i)] = hit
+                    if hit is None:
+                        runs.append((args.knob_dir / c / "render", m))
+                        keys.append((c, m, key))
+            if runs:
+                tasks.append((views[i], bscs[i], runs))
+                task_keys.append((i, keys))
+        log(f"texels and light: {sum(len(k) for _, k in task_keys)} frames to compare over {len(tex_views)} views "
+            f"({sum(r is not None for r in texerr.values())} cached)")
+        for (i, keys), results in zip(task_keys, run_tasks(pool, _texerr_task, tasks, "texels and light", every=5)):
+            for (c, m, key), r in zip(keys, results):
+                texerr[(c, m, i)] = r
+                cache.put(key, r)
+        cache.save()
+
     # run time: every configuration and mode on the bench views
     irs = {}
     if not args.no_ir:
@@ -506,7 +585,8 @@ def main(argv=None):
         for m in MODES:
             errs = [errors[(c, m, i)] for i in range(len(views))]
             ir = [irs[(c, m, i)] for i, v in enumerate(views) if (c, m, i) in irs]
-            points.append(summarise(c, configs[c], m, views, errs, ir))
+            tex = [(texerr[(c, m, i)], views[i]["name"]) for i in tex_views]
+            points.append(summarise(c, configs[c], m, views, errs, ir, tex))
     per_scene = {}
     if DEFAULT in configs:
         for i, v in enumerate(views):
@@ -521,7 +601,8 @@ def main(argv=None):
 
     png = out / "error_vs_ir.png"
     plot(png, points, args.no_ir)
-    write_markdown(out / "report.md", points, per_scene, views, configs, png.name, args.no_ir)
+    write_markdown(out / "report.md", points, per_scene, views, configs, png.name, args.no_ir,
+                   [views[i]["name"] for i in tex_views])
     (out / "points.json").write_text(json.dumps({"points": points, "per_scene": per_scene}, indent=1))
     log(f"wrote {out / 'report.md'} and {png} in {time.time() - t_start:.0f} s")
     print((out / "report.md").read_text())
