@@ -1,7 +1,9 @@
 """The frame link's Python twin (tools/framelink.py) against the C encoder and decoder.
 
 Streams come from build/fltool (tools/fltool.c): a fly-through of freedoom2.wad:MAP01 rendered
-by the firmware on the null target, encoded by the C encoder. The C decoder (build/san/fltool
+by the firmware on the null target, encoded by the C encoder. The codec's tests use the walk in
+flat colours, whose frames take every path of the codec (runs, deltas, keyframes); textured frames
+are mostly raw (make bench-link), and one test sends them through too. The C decoder (build/san/fltool
 decode, under ASan + UBSan) and the Python decoder must report the same events in the same
 order and the same counters for the same bytes - clean, in any chunking, and with faults
 injected (bit flips, dropped and inserted bytes, truncations) - and neither may ever show a
@@ -25,15 +27,25 @@ import framelink  # noqa: E402
 FRAMES = 48
 
 
-@pytest.fixture(scope="module")
-def walk(tmp_path_factory):
+def make_walk(tmp_path_factory, *extra):
     """A fly-through of MAP01: frames.raw, frames.jsonl, palette.bin."""
     out = tmp_path_factory.mktemp("walk")
-    run([program("fltool", sanitized=False), "walk", "freedoom2.wad:MAP01", "--frames", FRAMES, "--out", out])
+    run([program("fltool", sanitized=False), "walk", "freedoom2.wad:MAP01", "--frames", FRAMES, "--out", out,
+         *extra])
     raw = (out / "frames.raw").read_bytes()
     assert len(raw) == FRAMES * framelink.FRAME_BYTES
     lines = [json.loads(l) for l in (out / "frames.jsonl").read_text().splitlines()]
     return out, raw, lines
+
+
+@pytest.fixture(scope="module")
+def walk(tmp_path_factory):
+    return make_walk(tmp_path_factory, "--flat")
+
+
+@pytest.fixture(scope="module")
+def walk_textured(tmp_path_factory):
+    return make_walk(tmp_path_factory)
 
 
 def encode(walk, tmp_path, *extra):
@@ -69,9 +81,9 @@ def sent_crcs(walk):
     return {l["frame"]: int(l["crc32"], 16) for l in walk[2]}
 
 
-def test_walk_is_reproducible_by_render(walk):
+def test_walk_is_reproducible_by_render(walk_textured):
     """The camera fltool walk writes is the camera exactly as used: build/render redraws the frame."""
-    _, raw, lines = walk
+    _, raw, lines = walk_textured
     for l in (lines[0], lines[FRAMES // 2], lines[-1]):
         c = l["camera"]
         got = render("freedoom2.wad:MAP01", "--look", str(c["look"]),
@@ -81,10 +93,10 @@ def test_walk_is_reproducible_by_render(walk):
         assert zlib.crc32(raw[k * 64000:(k + 1) * 64000]) == int(l["crc32"], 16)
 
 
-def test_flat_walk_has_the_same_cameras(walk, tmp_path):
+def test_flat_walk_has_the_same_cameras(walk_textured, tmp_path):
     """fltool walk --flat (make bench-link's flat frames): the textured walk's cameras, each frame
     the one build/render --flat draws, and not the textured frame."""
-    _, _, lines = walk
+    _, _, lines = walk_textured
     n = 12
     run([program("fltool", sanitized=False), "walk", "freedoom2.wad:MAP01", "--frames", n, "--out", tmp_path,
          "--flat"])
@@ -96,6 +108,17 @@ def test_flat_walk_has_the_same_cameras(walk, tmp_path):
                      at=f"{c['x']},{c['y']},{c['z']}", angle=str(c["angle"]), sanitized=False)
         assert got["crc32"] == l["crc32"] and got["textured"] == 0
         assert l["crc32"] != lines[l["frame"]]["crc32"]
+
+
+def test_textured_walk_clean(walk_textured, tmp_path):
+    """Textured frames (most of them sent raw) arrive whole: every frame shown, as sent."""
+    data = encode(walk_textured, tmp_path)
+    c_events, c_tail = c_decode(data, tmp_path)
+    p_events, p_tail, crcs = py_decode(data)
+    assert p_events == c_events and p_tail == c_tail
+    assert p_tail["counters"]["frames_shown"] == FRAMES and p_tail["counters"]["msgs_bad"] == 0
+    sent = sent_crcs(walk_textured)
+    assert [k for k, _ in crcs] == list(range(FRAMES)) and all(sent[k] == crc for k, crc in crcs)
 
 
 @pytest.mark.parametrize("extra", [[], ["--key-interval", "1"], ["--key-interval", "0"], ["--no-crc"],
