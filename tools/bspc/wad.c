@@ -61,6 +61,7 @@ typedef struct {
     uint16_t type;
     int32_t radius, height; /* whole units */
     uint8_t colour;
+    uint8_t table_colour; /* things.txt's colour: kinds share a model by it, as tools/refrender.py counts them */
     char sprite[4];  /* Doom's sprite name */
     int coloured;    /* colour taken from the sprite (or PLAYPAL's nearest) */
 } thing_kind;
@@ -113,7 +114,7 @@ static int read_thing_table(thing_kind *kinds, int cap, char *err, size_t errlen
             return bs_fail(err, errlen, "things.txt:%d: expected 'type radius height colour sprite name' "
                            "(radius 1..%d)", lineno, SCN_MODEL_MAX);
         if (n == cap) return bs_fail(err, errlen, "things.txt: more than %d thing types", cap);
-        kinds[n] = (thing_kind){(uint16_t)v[0], (int32_t)v[1], (int32_t)v[2], (uint8_t)colour, {0}, 0};
+        kinds[n] = (thing_kind){(uint16_t)v[0], (int32_t)v[1], (int32_t)v[2], (uint8_t)colour, (uint8_t)colour, {0}, 0};
         memcpy(kinds[n++].sprite, col[4], 4);
     }
     return n;
@@ -165,10 +166,10 @@ static int read_things(bs_scene *s, bs_wadlook *look, const uint8_t *recs, uint3
             kinds[k].colour = bs_look_thing_colour(look, kinds[k].sprite, kinds[k].colour);
             kinds[k].coloured = 1;
         }
-        /* kinds sharing a size and colour share a model */
+        /* kinds sharing a size and things.txt colour share a model (the first one's sprite colours it) */
         for (int j = 0; j < nk && model_of[k] == SCN_NONE; j++)
             if (model_of[j] != SCN_NONE && kinds[j].radius == kinds[k].radius &&
-                kinds[j].height == kinds[k].height && kinds[j].colour == kinds[k].colour)
+                kinds[j].height == kinds[k].height && kinds[j].table_colour == kinds[k].table_colour)
                 model_of[k] = model_of[j];
         if (model_of[k] == SCN_NONE) {
             bs_mpart p;
