@@ -218,36 +218,41 @@ static inline __attribute__((always_inline)) wall_sample wall_at(const tex_paint
     return s;
 }
 
+/* A row of a wall. The exact samples are taken at columns that are multiples
+ * of TEX_SUBDIV, whatever the span, so a pixel's texel does not depend on how
+ * its row was cut into spans: every render mode and pool size draws the same
+ * texels. Past a wall's vanishing point (a sample the ray of which misses the
+ * line) the span's own end is sampled instead. */
 static void wall_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
 {
     int32_t sy = 2 * (VIEW_CY + p->look) - 2 * y - 1;
     int32_t vk = sy * 13107; /* sy 2^22 / 320, |sy| < 600 */
-    int32_t sx = 2 * x0 + 1 - VIEW_W;
+    int k = x0 & ~(TEX_SUBDIV - 1);
+    int32_t sx = 2 * k + 1 - VIEW_W;
     int64_t den = (int64_t)p->a + (int64_t)sx * p->b, slope = (int64_t)p->c + (int64_t)sx * p->d;
     const int64_t dden = (int64_t)p->b * (2 * TEX_SUBDIV), dslope = (int64_t)p->d * (2 * TEX_SUBDIV);
     wall_sample s = wall_at(p, den, slope, vk);
     tex_addr a = addr_of(p);
-    for (int x = x0; x < x1;) {
-        int n = TEX_SUBDIV;
-        if (x1 - x < TEX_SUBDIV) { /* the last piece: the sample at the span's end */
-            n = x1 - x;
-            den += (int64_t)p->b * (2 * n);
-            slope += (int64_t)p->d * (2 * n);
-        } else {
-            den += dden;
-            slope += dslope;
+    for (int x = x0; x < x1; k += TEX_SUBDIV) {
+        den += dden;
+        slope += dslope;
+        int32_t du, dv;
+        wall_sample e;
+        if ((den >> 16) > 0) {
+            e = wall_at(p, den, slope, vk);
+            du = (int32_t)(e.u - s.u) >> TEX_SUBDIV_BITS;
+            dv = (int32_t)(e.v - s.v) >> TEX_SUBDIV_BITS;
+        } else { /* beyond the vanishing point: interpolate to the span's end */
+            int32_t ex = 2 * x1 + 1 - VIEW_W;
+            e = wall_at(p, (int64_t)p->a + (int64_t)ex * p->b, (int64_t)p->c + (int64_t)ex * p->d, vk);
+            du = (int32_t)(e.u - s.u) / (x1 - k);
+            dv = (int32_t)(e.v - s.v) / (x1 - k);
         }
-        wall_sample e = wall_at(p, den, slope, vk);
-        int32_t du = (int32_t)(e.u - s.u), dv = (int32_t)(e.v - s.v);
-        if (n == TEX_SUBDIV) {
-            du >>= TEX_SUBDIV_BITS;
-            dv >>= TEX_SUBDIV_BITS;
-        } else {
-            du /= n;
-            dv /= n;
-        }
-        texel_run(row + x, n, s.light, a, s.u, s.v, (uint32_t)du, (uint32_t)dv);
-        x += n;
+        int end = k + TEX_SUBDIV < x1 ? k + TEX_SUBDIV : x1;
+        uint32_t skip = (uint32_t)(x - k);
+        texel_run(row + x, end - x, s.light, a, s.u + skip * (uint32_t)du, s.v + skip * (uint32_t)dv, (uint32_t)du,
+                  (uint32_t)dv);
+        x = end;
         s = e;
     }
 }
