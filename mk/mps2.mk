@@ -21,7 +21,7 @@
 #          does not fit is refused with one line giving the RAM it needs. Up to 4 MB
 #          the RAM is SSRAM2/3 at 0x20000000, beyond that (benches of big work
 #          areas) PSRAM at 0x21000000, up to 16 MB.
-#          STACK_BYTES (default 8192, with FULL=1 12288): the stack (the firmware
+#          STACK_BYTES (default 9216, with FULL=1 12288): the stack (the firmware
 #          reports its high-water mark).
 #   make run-firmware [UART=FILE|stdio] [RUN_ARGS="--frames 10 ..."]
 #       runs it in qemu-system-arm; the UART (the frame stream) goes to
@@ -53,9 +53,11 @@ DIRECT_EDGES ?= 96
 FW_DEFS = $(call render_modes_def,$(FW_MODES)) $(flat_def) -DCFG_DIRECT_FACES=$(DIRECT_FACES)u -DCFG_DIRECT_EDGES=$(DIRECT_EDGES)u
 RAM_BYTES ?= 200000
 # The stack: the walks keep a stack of the tree's depth (CFG_MAX_DEPTH: the scene's
-# in a build for it, 255 in a FULL=1 build). Measured high-water marks (hal/mps2/README.md):
-# at most 4,016 bytes on the Freedoom maps built for the scene, 6,776 with FULL=1.
-STACK_BYTES ?= $(if $(FULL),12288,8192)
+# in a build for it, 255 in a FULL=1 build); a textured frame adds a row of texels
+# (320 bytes) and the span's samples. Measured high-water marks (hal/mps2/README.md):
+# 6,272 bytes on freedoom2.wad:MAP12 textured (8 frames of the default path; the
+# tests keep it within 3/4 of the stack), 6,776 with FULL=1 (flat).
+STACK_BYTES ?= $(if $(FULL),12288,9216)
 # SSRAM2/3 is 4 MB (mirrored above it); more RAM than that is PSRAM's 16 MB.
 MPS2_SSRAM_BYTES := 4194304
 MPS2_RAM_ORIGIN := $(shell [ '$(RAM_BYTES)' -gt $(MPS2_SSRAM_BYTES) ] 2>/dev/null && echo 0x21000000 || echo 0x20000000)
