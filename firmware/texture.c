@@ -265,11 +265,13 @@ static void plane_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
     uint32_t z = TEX_ZMAX;
     if (sy != 0 && (sy > 0) == (p->dh > 0)) /* the plane is on this side of the horizon */
         z = depth_div((uint64_t)(p->dh < 0 ? -p->dh : p->dh) * 320u, (uint32_t)(sy < 0 ? -sy : sy));
-    int64_t sx = 2 * x0 + 1 - VIEW_W;
-    /* P = eye + z (F + sx / 320 R): |cos + sx sin / 320| < 2^30.5, z < 2^32 */
-    uint32_t u = p->v0 + (uint32_t)(((int64_t)z * (p->a + sx * p->c)) >> 30);
-    uint32_t w = p->w0 - (uint32_t)(((int64_t)z * (p->b - sx * p->d)) >> 30);
+    /* P = eye + z (F + sx / 320 R): |cos + sx sin / 320| < 2^30.5, z < 2^32. Taken at
+     * column 0 and stepped from there, so that a pixel's texel does not depend on
+     * where its span starts. */
+    const int64_t sx = 1 - VIEW_W;
     uint32_t du = (uint32_t)(((int64_t)z * (2 * p->c)) >> 30), dw = (uint32_t)(((int64_t)z * (2 * p->d)) >> 30);
+    uint32_t u = p->v0 + (uint32_t)(((int64_t)z * (p->a + sx * p->c)) >> 30) + (uint32_t)x0 * du;
+    uint32_t w = p->w0 - (uint32_t)(((int64_t)z * (p->b - sx * p->d)) >> 30) + (uint32_t)x0 * dw;
     uint32_t bucket = z >> 20; /* Doom's z light: 16 units a step, at most 127 */
     const uint8_t *light = light_table(p, (int)(160u / ((bucket > 127u ? 127u : bucket) + 1u)) / 2);
     texel_run(row + x0, x1 - x0, light, addr_of(p), u, w, du, dw);

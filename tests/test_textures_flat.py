@@ -63,3 +63,21 @@ def test_same_surfaces_textured_and_flat(view, mode, tmp_path):
     for out in (tex, rflat, bflat):
         assert out["overdraw"] == 1.0 or mode == "painter"
         assert out["overflow"] == 0
+
+
+@pytest.mark.parametrize("view", VIEWS, ids=lambda v: f"{v['scene']}@{v.get('at', 'start')}")
+def test_texels_do_not_depend_on_the_mode(view, tmp_path):
+    """The texel of a pixel depends on the pixel alone, not on how a mode cut its row into spans:
+    where two modes show the same surface, they show the same colour."""
+    import numpy as np
+    render = program("render")
+    frames = {}
+    for mode in MODES:
+        _, ids, raw = draw(render, view, mode, tmp_path, mode)
+        frames[mode] = (np.frombuffer(ids, "<u4"), np.frombuffer(raw, np.uint8))
+    ids0, raw0 = frames["direct"]
+    for mode in ("spans", "painter"):
+        ids, raw = frames[mode]
+        same = ids == ids0
+        assert same.mean() > 0.99
+        assert np.array_equal(raw[same], raw0[same]), f"{mode}: {(raw[same] != raw0[same]).sum()} pixels differ"
