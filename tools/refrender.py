@@ -15,7 +15,7 @@ Reading, numbered exactly as build/bspc numbers them (tools/bspc/scene_text.c, w
   after it; linedefs whose two vertices are at the same point are skipped (the numbers after one
   shift down); sidedef 0 is the front (sector[0], right of v1 -> v2), sidedef 1 the back; a
   linedef is two-sided when it has a second sidedef. A ceiling flat F_SKY* is a sky. The player
-  start is the first thing of type 1.
+  start is the last thing of type 1 (Doom spawns the player at each; the last one is the player).
 
 Camera (DESIGN.md "Camera", as the C renderer): x east, y north, angle in degrees, 0 = east,
 counter-clockwise; forward f = (cos a, sin a), right r = (sin a, -cos a). Pixel (px, py):
@@ -542,7 +542,7 @@ def read_wad(spec):
     player = None
     starts = np.nonzero(thing["type"] == 1)[0]
     if len(starts):
-        t = thing[starts[0]]
+        t = thing[starts[-1]]
         player = (float(t["x"]), float(t["y"]), float(int(t["a"]) % 360))
     open_h = wad_door_heights(sec["c"], sec["tag"], lin["sp"].astype(np.int64),
                               lin["tag"].astype(np.int64), front, back)

@@ -525,8 +525,9 @@ int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_sc
             goto out;
         }
 
-    /* player 1 start */
-    for (uint32_t i = 0; i < cnt[L_THINGS]; i++) {
+    /* player 1 start: the last one, as in Doom (each spawns the player; the
+     * earlier ones are left behind as "voodoo dolls") */
+    for (uint32_t i = cnt[L_THINGS]; i-- > 0;) {
         const uint8_t *r = ld[L_THINGS] + 10 * i;
         if (rd16(r + 6) != 1) continue;
         int x = rds16(r), y = rds16(r + 2), a = rds16(r + 4);
