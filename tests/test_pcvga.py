@@ -155,3 +155,24 @@ def test_damaged_scene_is_refused():
     status, log = pcvga.run(work / "damaged" / "kernel.elf", "--frames 1")
     assert pcvga.exit_status(status) == EXIT_SCENE, log
     assert "is invalid: bad CRC-32; refusing to run" in log and "frame 0" not in log, log
+
+
+@pytest.fixture(scope="module")
+def kernel_map01():
+    """The kernel built for freedoom2.wad:MAP01 with its textures (build/pcvga-map01)."""
+    make("pcvga", "SCENE=freedoom2.wad:MAP01", "CAMPATH=map01", f"PC_OUT={BUILD / 'pcvga-map01'}")
+    return BUILD / "pcvga-map01" / "kernel.elf"
+
+
+@pytest.mark.parametrize("present", ("flip", "copy32"))
+def test_textured_screendump_is_the_host_frame(kernel_map01, present, tmp_path):
+    """Textured frames on the bare PC: in flip mode each textured span is written plane by plane
+    into the unchained page (hal_put_span), in copy32 through the system-memory buffer; either way
+    the screen is build/render's frame (the palette is PLAYPAL's, whose 6-bit DAC values do not
+    tell every index apart, so the DAC values are compared, and the frame's CRC)."""
+    s = pcvga.shot(kernel_map01, f"--at -100,-160 --angle 20 --frames 2 --present {present}",
+                   BUILD / "pcvga-map01" / "scene.bsc", png=tmp_path / "shot.png")
+    assert s["kernel_status"] == EXIT_OK, s
+    assert s["dac_pixels_differing"] == 0 and s["pixels_of_no_palette_colour"] == 0, s
+    assert s["last_frame"]["crc"] == s["render_crc32"], s
+    assert s["index_pixels_differing"] == 0, s
