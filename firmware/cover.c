@@ -80,7 +80,7 @@ static inline void close_words(cov_mask *m, int y, uint32_t full)
 /* cov_fill's work, inlined into it and into cov_fill_rows' loop. */
 static inline __attribute__((always_inline)) uint32_t fill_row(cov_mask *m, const rast_target *t, int y, int x0,
                                                                 int x1, const uint32_t *keep, const tex_paint *paint,
-                                                                uint32_t id)
+                                                                int textured, uint32_t id)
 {
     x0 = clamp_w(x0);
     x1 = clamp_w(x1);
@@ -101,7 +101,7 @@ static inline __attribute__((always_inline)) uint32_t fill_row(cov_mask *m, cons
                 full |= cov_inner_words(w0, w1);
                 full |= (uint32_t)((line[w1] |= last) == 0xFFFFFFFFu) << w1;
             }
-            rast_span(t, y, x0, x1, paint, id);
+            rast_span_as(t, y, x0, x1, paint, id, textured);
             close_words(m, y, full);
             return (uint32_t)(x1 - x0);
         }
@@ -119,7 +119,7 @@ static inline __attribute__((always_inline)) uint32_t fill_row(cov_mask *m, cons
         int base = w * 32;
         if (free == 0xFFFFFFFFu) { /* a whole free word */
             if (base != run1) {
-                if (run1 > run0) rast_span(t, y, run0, run1, paint, id);
+                if (run1 > run0) rast_span_as(t, y, run0, run1, paint, id, textured);
                 run0 = base;
             }
             run1 = base + 32;
@@ -132,14 +132,14 @@ static inline __attribute__((always_inline)) uint32_t fill_row(cov_mask *m, cons
             int e = carry ? __builtin_ctz(carry) : 32;
             free &= carry;
             if (base + s != run1) {
-                if (run1 > run0) rast_span(t, y, run0, run1, paint, id);
+                if (run1 > run0) rast_span_as(t, y, run0, run1, paint, id, textured);
                 run0 = base + s;
             }
             run1 = base + e;
             drawn += (uint32_t)(e - s);
         }
     }
-    if (run1 > run0) rast_span(t, y, run0, run1, paint, id);
+    if (run1 > run0) rast_span_as(t, y, run0, run1, paint, id, textured);
     close_words(m, y, full);
     return drawn;
 }
@@ -147,14 +147,20 @@ static inline __attribute__((always_inline)) uint32_t fill_row(cov_mask *m, cons
 uint32_t cov_fill(cov_mask *m, const rast_target *t, int y, int x0, int x1, const uint32_t *keep, const tex_paint *paint,
                   uint32_t id)
 {
-    return fill_row(m, t, y, x0, x1, keep, paint, id);
+    if (rast_textured_paint(t, paint)) return fill_row(m, t, y, x0, x1, keep, paint, 1, id);
+    return fill_row(m, t, y, x0, x1, keep, paint, 0, id);
 }
 
 uint32_t cov_fill_rows(cov_mask *m, const rast_target *t, int top, int bottom, const int16_t *lo, const int16_t *hi,
                        const tex_paint *paint, uint32_t id)
 {
     uint32_t drawn = 0;
-    for (int y = top; y < bottom; y++)
-        if (lo[y] < hi[y]) drawn += fill_row(m, t, y, lo[y], hi[y], 0, paint, id);
+    if (rast_textured_paint(t, paint)) {
+        for (int y = top; y < bottom; y++)
+            if (lo[y] < hi[y]) drawn += fill_row(m, t, y, lo[y], hi[y], 0, paint, 1, id);
+    } else {
+        for (int y = top; y < bottom; y++)
+            if (lo[y] < hi[y]) drawn += fill_row(m, t, y, lo[y], hi[y], 0, paint, 0, id);
+    }
     return drawn;
 }

@@ -602,6 +602,7 @@ void direct_render(const scene *sc, const world_state *w, const view_xform *v, c
     S->sink.polygon = add_polygon;
     S->sink.hidden = box_hidden;
     S->sink.ctx = S;
+    S->sink.flat = t->flat;
     cov_clear(&S->cov);
     occ_reset(&S->occ);
     list_objects_in_view(S);

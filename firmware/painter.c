@@ -176,6 +176,7 @@ void painter_render(const scene *sc, const world_state *w, const view_xform *v, 
         return;
     }
     p.sink.ctx = &p;
+    p.sink.flat = t->flat;
     render_clear(t, PAINTER_BACKGROUND);
     if (nobj) {
         pt_order *order = work->mem, *tmp = order + nobj;

@@ -110,20 +110,36 @@ static inline rast_box rast_bounds(const screen_pt *pts, int n)
 void rast_textured(const rast_target *t, int y, int x0, int x1, const tex_paint *paint);
 #endif
 
+/* 1 if the paint's spans are textured on this target (else its flat colour). */
+static inline int rast_textured_paint(const rast_target *t, const tex_paint *paint)
+{
+    return CFG_TEXTURES && paint->kind != TEX_FLAT && !t->flat;
+}
+
 /* Draw one span [x0, x1) of row y (0 <= x0, x1 <= 320, 0 <= y < 200) in its
- * paint, with its id. Inlined into the fill loops whole (left to itself the
- * compiler keeps an out-of-line part and pays a call a span). */
-static inline __attribute__((always_inline)) void rast_span(const rast_target *t, int y, int x0, int x1,
-                                                          const tex_paint *paint, uint32_t id)
+ * paint, with its id; textured: rast_textured_paint(t, paint), which the fill
+ * loops decide once for all their spans and pass as a constant. Inlined into
+ * the fill loops whole (left to itself the compiler keeps an out-of-line part
+ * and pays a call a span). */
+static inline __attribute__((always_inline)) void rast_span_as(const rast_target *t, int y, int x0, int x1,
+                                                             const tex_paint *paint, uint32_t id, int textured)
 {
     if (x1 <= x0) return;
 #if CFG_TEXTURES
-    if (paint->kind != TEX_FLAT && !t->flat) rast_textured(t, y, x0, x1, paint);
+    if (textured) rast_textured(t, y, x0, x1, paint);
     else
+#else
+    (void)textured;
 #endif
     if (t->tally) hal_fill_linear(t->surf, y, x0, x1 - x0, paint->colour, t->tally);
     else hal_fill_span(t->surf, y, x0, x1 - x0, paint->colour);
     if (t->ids) rast_ids(t, y, x0, x1, id);
+}
+
+static inline __attribute__((always_inline)) void rast_span(const rast_target *t, int y, int x0, int x1,
+                                                          const tex_paint *paint, uint32_t id)
+{
+    rast_span_as(t, y, x0, x1, paint, id, rast_textured_paint(t, paint));
 }
 
 /* The pixels of a convex polygon (clockwise on screen) on each row of [top,

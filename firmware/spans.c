@@ -725,6 +725,7 @@ void spans_render(const scene *sc, const world_state *w, const view_xform *v, co
     S->sink.polygon = add_polygon;
     S->sink.hidden = 0;
     S->sink.ctx = S;
+    S->sink.flat = t->flat;
     S->nedges = S->nsurfs = 0;
     S->edges_total = 0;
     S->final = S->flushed = 0;

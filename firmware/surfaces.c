@@ -22,8 +22,59 @@ static int project_unclipped(const view_xform *v, const clip_poly *p, screen_pt 
     return 1;
 }
 
-static void emit(const view_xform *v, clip_poly *p, unsigned mask, const surf_sink *sink, const tex_paint *paint,
-                 uint32_t id, uint32_t seg, render_stats *st)
+/* How a polygon is painted, kept as the few values that say it: the paint
+ * itself (tex_wall's and tex_plane's set-up) is worked out only for a polygon
+ * that survives the hidden test and clipping. */
+enum { LOOK_FLAT, LOOK_PART, LOOK_PLANE, LOOK_SKY };
+
+typedef struct {
+    uint8_t kind;   /* LOOK_* */
+    uint8_t part;   /* LOOK_PART: SCN_PART_* */
+    uint8_t colour; /* the flat colour */
+    uint8_t light;  /* the sector's light level */
+    const scn_seg *g;             /* LOOK_PART */
+    int32_t ff, fc, bf, bc;       /* LOOK_PART: front floor and ceiling, back floor and ceiling, now */
+    uint32_t tex;                 /* LOOK_PLANE */
+    int32_t h;                    /* LOOK_PLANE: its height */
+} surf_look;
+
+/* A wall part's paint: its texture, hung by Doom's pegging from the heights
+ * the sectors have now (a door's texture moves with the door). */
+static tex_paint part_paint(const scene *sc, const view_xform *v, const surf_look *k)
+{
+#if CFG_TEXTURES
+    const scn_side *sd = &sc->sides[k->g->line * 2u + k->g->side];
+    uint32_t tex = sd->tex[k->part];
+    int32_t top;
+    if (k->part == SCN_PART_MIDDLE)
+        top = (sd->flags & SCN_SIDE_UNPEG_BOTTOM) ? k->ff + tex_height(sc, tex) : k->fc;
+    else if (k->part == SCN_PART_UPPER)
+        top = (sd->flags & SCN_SIDE_UNPEG_TOP) ? k->fc : k->bc + tex_height(sc, tex);
+    else
+        top = (sd->flags & SCN_SIDE_UNPEG_BOTTOM) ? k->fc : k->bf;
+    return tex_wall(sc, v, sd, tex, &sc->verts[k->g->v1], top, k->light, k->colour);
+#else
+    (void)sc, (void)v;
+    return tex_flat(k->colour);
+#endif
+}
+
+static tex_paint paint_of(const scene *sc, const view_xform *v, const surf_sink *sink, const surf_look *k)
+{
+#if CFG_TEXTURES
+    if (sc->look && !sink->flat) {
+        if (k->kind == LOOK_PART) return part_paint(sc, v, k);
+        if (k->kind == LOOK_PLANE) return tex_plane(sc, v, k->tex, k->h, k->light, k->colour);
+        if (k->kind == LOOK_SKY) return tex_sky(sc, v, k->colour);
+    }
+#else
+    (void)sc, (void)v, (void)sink;
+#endif
+    return tex_flat(k->colour);
+}
+
+static void emit(const scene *sc, const view_xform *v, clip_poly *p, unsigned mask, const surf_sink *sink,
+                 const surf_look *look, uint32_t id, uint32_t seg, render_stats *st)
 {
     screen_pt s[CLIP_MAX_VERTS];
     int projected = sink->hidden && p->n <= CLIP_MAX_VERTS - 5 && project_unclipped(v, p, s);
@@ -43,7 +94,8 @@ static void emit(const view_xform *v, clip_poly *p, unsigned mask, const surf_si
         if (p->v[i].z < zmin) zmin = p->v[i].z;
         if (p->v[i].z > zmax) zmax = p->v[i].z;
     }
-    sink->polygon(sink->ctx, s, p->n, paint, id, seg, zmin, zmax);
+    tex_paint paint = paint_of(sc, v, sink, look);
+    sink->polygon(sink->ctx, s, p->n, &paint, id, seg, zmin, zmax);
 }
 
 /* Front-facing: the eye strictly on the right of a -> b (edge-on is culled).
@@ -56,8 +108,9 @@ static int faces_eye(const view_xform *v, const scn_vertex *a, const scn_vertex 
 
 /* The wall between view points a and b (rotated once per seg) from height
  * bottom to top. */
-static void wall_part(const view_xform *v, view_pt a, view_pt b, int32_t bottom, int32_t top, unsigned mask,
-                      const surf_sink *sink, const tex_paint *paint, uint32_t id, uint32_t seg, render_stats *st)
+static void wall_part(const scene *sc, const view_xform *v, view_pt a, view_pt b, int32_t bottom, int32_t top,
+                      unsigned mask, const surf_sink *sink, const surf_look *look, uint32_t id, uint32_t seg,
+                      render_stats *st)
 {
     if (top <= bottom) return;
     clip_poly p;
@@ -66,7 +119,7 @@ static void wall_part(const view_xform *v, view_pt a, view_pt b, int32_t bottom,
     p.v[1] = view_at_height(v, b, top);
     p.v[2] = view_at_height(v, b, bottom);
     p.v[3] = view_at_height(v, a, bottom);
-    emit(v, &p, mask, sink, paint, id, seg, st);
+    emit(sc, v, &p, mask, sink, look, id, seg, st);
 }
 
 /* A wall with no opening hides everything behind it in the columns it covers,
@@ -88,41 +141,6 @@ static void close_columns(const view_xform *v, const scn_vertex *a, const scn_ve
 static inline int32_t ceil_now(const scene *sc, const fx_t *ceil, uint32_t i)
 {
     return (CFG_DOORS && ceil) ? ceil[i] : sc->sectors[i].ceil_h;
-}
-
-/* The paint of a wall part: its texture, hung by Doom's pegging from the
- * heights the sectors have now (a door's texture moves with the door). */
-static tex_paint part_paint(const scene *sc, const view_xform *v, const scn_seg *g, int part, int32_t front_floor,
-                            int32_t front_ceil, int32_t back_floor, int32_t back_ceil, uint8_t light, uint8_t colour)
-{
-#if CFG_TEXTURES
-    if (sc->look) {
-        const scn_side *sd = &sc->sides[g->line * 2u + g->side];
-        uint32_t tex = sd->tex[part];
-        int32_t top;
-        if (part == SCN_PART_MIDDLE)
-            top = (sd->flags & SCN_SIDE_UNPEG_BOTTOM) ? front_floor + tex_height(sc, tex) : front_ceil;
-        else if (part == SCN_PART_UPPER)
-            top = (sd->flags & SCN_SIDE_UNPEG_TOP) ? front_ceil : back_ceil + tex_height(sc, tex);
-        else
-            top = (sd->flags & SCN_SIDE_UNPEG_BOTTOM) ? front_ceil : back_floor;
-        return tex_wall(sc, v, sd, tex, &sc->verts[g->v1], top, light, colour);
-    }
-#else
-    (void)sc, (void)v, (void)g, (void)part, (void)front_floor, (void)front_ceil, (void)back_floor, (void)back_ceil;
-    (void)light;
-#endif
-    return tex_flat(colour);
-}
-
-static tex_paint sky_paint(const scene *sc, const view_xform *v, uint8_t colour)
-{
-#if CFG_TEXTURES
-    if (sc->look) return tex_sky(sc, v, colour);
-#else
-    (void)sc, (void)v;
-#endif
-    return tex_flat(colour);
 }
 
 static void seg_parts(const scene *sc, const fx_t *ceil, const view_xform *v, uint32_t gi, unsigned mask,
@@ -150,34 +168,37 @@ static void seg_parts(const scene *sc, const fx_t *ceil, const view_xform *v, ui
     int32_t front_ceil = ceil_now(sc, ceil, front_index);
     uint32_t id = RAST_ID(RAST_KIND_WALL, g->line * 2u + g->side);
     const uint8_t *colour = l->color[g->side];
+    surf_look k = {LOOK_PART, SCN_PART_MIDDLE, colour[SCN_PART_MIDDLE], front->light, g,
+                   front->floor_h, front_ceil, front->floor_h, front_ceil, 0, 0};
     if (!CFG_TWO_SIDED || back_index == SCN_NONE) {
-        tex_paint pt = part_paint(sc, v, g, SCN_PART_MIDDLE, front->floor_h, front_ceil, front->floor_h, front_ceil,
-                                  front->light, colour[SCN_PART_MIDDLE]);
-        wall_part(v, pa, pb, front->floor_h, front_ceil, mask, sink, &pt, id, gi, st);
+        wall_part(sc, v, pa, pb, front->floor_h, front_ceil, mask, sink, &k, id, gi, st);
         if (occ) close_columns(v, a, b, pa, pb, mask, occ);
         return;
     }
     const scn_sector *back = &sc->sectors[back_index];
     int32_t back_ceil = ceil_now(sc, ceil, back_index);
+    k.bf = back->floor_h;
+    k.bc = back_ceil;
     if (CFG_HEIGHTS && back_ceil < front_ceil) {
         int32_t low = back_ceil > front->floor_h ? back_ceil : front->floor_h;
         /* Doom's sky rule: between two sky ceilings there is no upper wall but more
          * sky. The step is drawn as the front sector's sky ceiling, so the view
          * through it has no hole. */
         if (CFG_SKY && (front->flags & back->flags & SCN_SECTOR_SKY)) {
-            tex_paint pt = sky_paint(sc, v, front->ceil_color);
-            wall_part(v, pa, pb, low, front_ceil, mask, sink, &pt, RAST_ID(RAST_KIND_CEILING, front_index), gi, st);
+            surf_look sky = {LOOK_SKY, 0, front->ceil_color, 0, g, 0, 0, 0, 0, 0, 0};
+            wall_part(sc, v, pa, pb, low, front_ceil, mask, sink, &sky, RAST_ID(RAST_KIND_CEILING, front_index), gi,
+                      st);
         } else {
-            tex_paint pt = part_paint(sc, v, g, SCN_PART_UPPER, front->floor_h, front_ceil, back->floor_h, back_ceil,
-                                      front->light, colour[SCN_PART_UPPER]);
-            wall_part(v, pa, pb, low, front_ceil, mask, sink, &pt, id, gi, st);
+            k.part = SCN_PART_UPPER;
+            k.colour = colour[SCN_PART_UPPER];
+            wall_part(sc, v, pa, pb, low, front_ceil, mask, sink, &k, id, gi, st);
         }
     }
     if (CFG_HEIGHTS && back->floor_h > front->floor_h) {
         int32_t high = back->floor_h < front_ceil ? back->floor_h : front_ceil;
-        tex_paint pt = part_paint(sc, v, g, SCN_PART_LOWER, front->floor_h, front_ceil, back->floor_h, back_ceil,
-                                  front->light, colour[SCN_PART_LOWER]);
-        wall_part(v, pa, pb, front->floor_h, high, mask, sink, &pt, id, gi, st);
+        k.part = SCN_PART_LOWER;
+        k.colour = colour[SCN_PART_LOWER];
+        wall_part(sc, v, pa, pb, front->floor_h, high, mask, sink, &k, id, gi, st);
     }
     /* closed door: no opening between the two sectors */
     int32_t top = back_ceil < front_ceil ? back_ceil : front_ceil;
@@ -185,33 +206,27 @@ static void seg_parts(const scene *sc, const fx_t *ceil, const view_xform *v, ui
     if (occ && top <= bottom) close_columns(v, a, b, pa, pb, mask, occ);
 }
 
-/* A floor's or ceiling's paint: its flat, or the sky. */
-static tex_paint plane_paint(const scene *sc, const view_xform *v, uint32_t sector, int ceiling, int32_t h)
+/* A floor's or ceiling's look: its flat, or the sky. */
+static surf_look plane_look(const scene *sc, uint32_t sector, int ceiling, int32_t h)
 {
     const scn_sector *sec = &sc->sectors[sector];
-    uint8_t colour = ceiling ? sec->ceil_color : sec->floor_color;
-    if (ceiling && CFG_SKY && (sec->flags & SCN_SECTOR_SKY)) return sky_paint(sc, v, colour);
-#if CFG_TEXTURES
-    if (sc->look) {
-        const scn_plane *pl = &sc->planes[sector];
-        return tex_plane(sc, v, ceiling ? pl->ceil_tex : pl->floor_tex, h, sec->light, colour);
-    }
-#else
-    (void)h;
-#endif
-    return tex_flat(colour);
+    surf_look k = {LOOK_PLANE, 0, ceiling ? sec->ceil_color : sec->floor_color, sec->light, 0, 0, 0, 0, 0,
+                   SCN_TEX_NONE, h};
+    if (ceiling && CFG_SKY && (sec->flags & SCN_SECTOR_SKY)) k.kind = LOOK_SKY;
+    else if (CFG_TEXTURES && sc->look) k.tex = ceiling ? sc->planes[sector].ceil_tex : sc->planes[sector].floor_tex;
+    return k;
 }
 
 /* The leaf polygon at height h. Seen from above (floor) a counter-clockwise map
  * polygon runs counter-clockwise on screen, so floors are emitted reversed;
  * seen from below (ceiling) it runs clockwise as stored. */
-static void plane(const view_xform *v, const view_pt *pts, uint32_t n, int32_t h, int reverse, unsigned mask,
-                  const surf_sink *sink, const tex_paint *paint, uint32_t id, render_stats *st)
+static void plane(const scene *sc, const view_xform *v, const view_pt *pts, uint32_t n, int32_t h, int reverse,
+                  unsigned mask, const surf_sink *sink, const surf_look *look, uint32_t id, render_stats *st)
 {
     clip_poly p;
     p.n = (int)n;
     for (uint32_t i = 0; i < n; i++) p.v[i] = view_at_height(v, pts[reverse ? n - 1 - i : i], h);
-    emit(v, &p, mask, sink, paint, id, SCN_NONE, st);
+    emit(sc, v, &p, mask, sink, look, id, SCN_NONE, st);
 }
 
 void surf_leaf(const scene *sc, const world_state *w, const view_xform *v, uint32_t leaf, unsigned mask,
@@ -234,12 +249,12 @@ void surf_leaf(const scene *sc, const world_state *w, const view_xform *v, uint3
                 pts[i] = view_point(v, q->x, q->y, 0);
             }
         if (floor) {
-            tex_paint pt = plane_paint(sc, v, f->sector, 0, sec->floor_h);
-            plane(v, pts, n, sec->floor_h, 1, mask, sink, &pt, RAST_ID(RAST_KIND_FLOOR, f->sector), st);
+            surf_look k = plane_look(sc, f->sector, 0, sec->floor_h);
+            plane(sc, v, pts, n, sec->floor_h, 1, mask, sink, &k, RAST_ID(RAST_KIND_FLOOR, f->sector), st);
         }
         if (ceiling) {
-            tex_paint pt = plane_paint(sc, v, f->sector, 1, top);
-            plane(v, pts, n, top, 0, mask, sink, &pt, RAST_ID(RAST_KIND_CEILING, f->sector), st);
+            surf_look k = plane_look(sc, f->sector, 1, top);
+            plane(sc, v, pts, n, top, 0, mask, sink, &k, RAST_ID(RAST_KIND_CEILING, f->sector), st);
         }
     }
     for (uint32_t i = 0; i < f->num_segs; i++) seg_parts(sc, ceil, v, f->first_seg + i, mask, sink, occ, st);

@@ -29,6 +29,7 @@ typedef struct {
      * drawn, and the polygon is dropped unclipped. */
     int (*hidden)(void *ctx, const screen_pt *pts, int n);
     void *ctx;
+    uint8_t flat; /* 1: every paint is a flat colour (the target draws flat: rast_target.flat) */
 } surf_sink;
 
 /* Emit the leaf's surfaces in an order that is correct back to front within the
