@@ -114,7 +114,7 @@ int args_parse(fw_args *a, char *line, unsigned offered, char *err, int errsize)
     a->x = a->y = a->z = a->angle_deg = 0;
     a->look = 0;
     a->mode = a->present = -1;
-    a->no_stream = a->no_tick = a->fault = a->wait = a->no_objects = 0;
+    a->no_stream = a->no_tick = a->fault = a->wait = a->no_objects = a->flat = 0;
     a->acks = ARGS_ACKS_AUTO;
     for (int i = 1; i < n; i++) { /* words[0]: the program */
         const char *o = words[i];
@@ -122,11 +122,12 @@ int args_parse(fw_args *a, char *line, unsigned offered, char *err, int errsize)
         unsigned needs = option_feature(o);
         if (needs && !(offered & needs)) return fail(err, errsize, "option '%s' is not available on this target", o);
         if (same(o, "--no-stream") || same(o, "--no-tick") || same(o, "--fault") || same(o, "--wait") ||
-            same(o, "--no-objects")) {
+            same(o, "--no-objects") || same(o, "--flat")) {
             *(same(o, "--no-stream")    ? &a->no_stream
               : same(o, "--no-tick")    ? &a->no_tick
               : same(o, "--wait")       ? &a->wait
               : same(o, "--no-objects") ? &a->no_objects
+              : same(o, "--flat")       ? &a->flat
                                         : &a->fault) = 1;
             continue;
         }

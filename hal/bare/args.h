@@ -16,6 +16,7 @@
  *   --mode spans|painter, --present flip|copy8|copy16|copy32
  *   --no-objects        a fixed view (at the player start unless --at) of the
  *                       world alone, as build/render --no-objects draws it
+ *   --flat              draw a textured scene in its flat colours (build/render --flat)
  *   --linger MS         wait MS ms after the last frame before exiting
  *   --fault             (tests) cause a processor fault after start-up, to show
  *                       the fault handler's report and exit status
@@ -42,7 +43,7 @@ typedef struct {
     int32_t x, y, z, angle_deg; /* 16.16 */
     int32_t look;
     int mode, present;          /* -1: the engine's defaults */
-    int no_stream, no_tick, fault, wait, no_objects;
+    int no_stream, no_tick, fault, wait, no_objects, flat;
     int acks;                   /* ARGS_ACKS_* */
 } fw_args;
 

@@ -104,6 +104,7 @@ int main(void)
         return FW_EXIT_WORK;
     }
     if (args.mode >= 0) e.mode = (render_mode)args.mode;
+    e.flat = (uint8_t)args.flat;
     if (args.present >= 0) e.present = (hal_present_mode)args.present;
     if (fixed_view) fixed_view_apply(&e, &args);
 

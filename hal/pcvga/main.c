@@ -136,6 +136,7 @@ void pcvga_start(uint32_t magic, const uint32_t *info)
         pcvga_exit(PCVGA_EXIT_WORK);
     }
     if (args.mode >= 0) e.mode = (render_mode)args.mode;
+    e.flat = (uint8_t)args.flat;
     if (args.present >= 0) e.present = (hal_present_mode)args.present;
     if (fixed_view) fixed_view_apply(&e, &args);
     pcvga_use_present(e.present);

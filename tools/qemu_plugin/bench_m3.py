@@ -106,7 +106,7 @@ def main():
                  "FW_MODES=direct,spans,painter", "RAM_BYTES=16777216")
             elves[name] = out_dir / "firmware.elf"
 
-    tasks = [(i, m, w) for i in range(len(views)) for m in modes for w in ("world", "things")]
+    tasks = [(i, m, w) for i in range(len(views)) for m in modes for w in ("world", "things", "flat")]
 
     def one(task):
         i, m, w = task
@@ -115,7 +115,7 @@ def main():
         tag = f"{i}_{m}_{w}"
         args = ["--at", v["at"], "--angle", v["angle"], "--mode", m, "--frames", str(opt.frames + 1),
                 "--no-stream", "--no-tick"] + (["--look", str(v["look"])] if v.get("look") else []) + \
-               (["--no-objects"] if w == "world" else [])
+               (["--no-objects"] if w in ("world", "flat") else []) + (["--flat"] if w == "flat" else [])
         counts, runs = count(elf, args, elf.parent / f"insns_{tag}.txt", elf.parent / f"profile_{tag}.txt")
         per_frame = statistics.median(counts[1:]) if len(counts) > 1 else counts[0]
         frames = len(counts)
@@ -133,6 +133,7 @@ def main():
     sum_lines, stats = bench.summary_table(views, modes, res)
     shares, sums = bench.stage_shares(views, modes, res)
     top_lines, unclassified = bench.top_functions(modes, sums, views)
+    flat_lines, flat_stats = bench.flat_table(views, modes, res)
     elapsed = time.time() - t0
     n_bench = sum(v["set"] == "bench" for v in views)
     fps = "; ".join(f"{m}: median {48e6 / stats[m]['things']['median']:.1f} fps, slowest view "
@@ -147,6 +148,10 @@ def main():
         f"p95: nearest rank. Modes: {', '.join(modes)}.",
         "",
         *sum_lines,
+        "",
+        "Textured against flat (--flat, the same scene in its flat colours), world alone:",
+        "",
+        *flat_lines,
         "",
         f"At 48 MHz and one instruction per cycle (an upper bound on a real part), with things: {fps}.",
         "",
@@ -172,7 +177,7 @@ def main():
     print(text)
     Path(opt.out).write_text(text)
     figures = {"date": started.isoformat(timespec="seconds"), "seconds": round(elapsed), "modes": modes,
-               "stats": stats,
+               "stats": stats, "textured_vs_flat": flat_stats,
                "stages": {f"{m} {w}": {s: {"mean": a, "of_sum": b} for s, (a, b) in v.items()}
                           for (m, w), v in shares.items()},
                "views": [{"view": bench.view_name(v), "set": v["set"],
