@@ -55,8 +55,8 @@ RAM_BYTES ?= 200000
 # The stack: the walks keep a stack of the tree's depth (CFG_MAX_DEPTH: the scene's
 # in a build for it, 255 in a FULL=1 build); a textured frame adds a row of texels
 # (320 bytes) and the span's samples. Measured high-water marks (hal/mps2/README.md):
-# 6,272 bytes on freedoom2.wad:MAP12 textured (8 frames of the default path; the
-# tests keep it within 3/4 of the stack), 6,776 with FULL=1 (flat).
+# up to 6,272 bytes on freedoom2.wad:MAP12 textured (the tests keep it within 3/4
+# of the stack), 11,064 with FULL=1 (make bench-size).
 STACK_BYTES ?= $(if $(FULL),12288,9216)
 # SSRAM2/3 is 4 MB (mirrored above it); more RAM than that is PSRAM's 16 MB.
 MPS2_SSRAM_BYTES := 4194304
