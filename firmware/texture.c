@@ -237,18 +237,20 @@ static void wall_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
         den += dden;
         slope += dslope;
         int32_t du, dv;
+        int end = k + TEX_SUBDIV < x1 ? k + TEX_SUBDIV : x1;
         wall_sample e;
         if ((den >> 16) > 0) {
             e = wall_at(p, den, slope, vk);
             du = (int32_t)(e.u - s.u) >> TEX_SUBDIV_BITS;
             dv = (int32_t)(e.v - s.v) >> TEX_SUBDIV_BITS;
-        } else { /* beyond the vanishing point: interpolate to the span's end */
+        } else { /* beyond the vanishing point (rounding aside, only past the span's end):
+                  * the rest of the span interpolated to its end */
             int32_t ex = 2 * x1 + 1 - VIEW_W;
             e = wall_at(p, (int64_t)p->a + (int64_t)ex * p->b, (int64_t)p->c + (int64_t)ex * p->d, vk);
             du = (int32_t)(e.u - s.u) / (x1 - k);
             dv = (int32_t)(e.v - s.v) / (x1 - k);
+            end = x1;
         }
-        int end = k + TEX_SUBDIV < x1 ? k + TEX_SUBDIV : x1;
         uint32_t skip = (uint32_t)(x - k);
         texel_run(row + x, end - x, s.light, a, s.u + skip * (uint32_t)du, s.v + skip * (uint32_t)dv, (uint32_t)du,
                   (uint32_t)dv);

@@ -59,9 +59,13 @@ KNOB_FLAGS_texrecip6  := -DTEX_RECIP_BITS=6
 KNOB_FLAGS_texlight4  := -DTEX_LIGHT_BITS=4
 KNOB_FLAGS_texlight3  := -DTEX_LIGHT_BITS=3
 KNOB_FLAGS_texlight2  := -DTEX_LIGHT_BITS=2
+# and no textures at all: the build without the texture code (CFG_FLAT=1), the
+# flat-shaded frame of the same scenes
+KNOB_FLAGS_flat       := -DCFG_FLAT=1
 REPORT_CONFIGS := default subpix8 subpix4 subpix2 subpix0 step16 step12 step8 step6 step4 \
                   recip12 recip8 recip6 recip4 view12 view10 view8 view6 sin8 sin4 sin12n sin8n cheap \
-                  texsub0 texsub2 texsub4 texsub5 texrecip12 texrecip8 texrecip6 texlight4 texlight3 texlight2
+                  texsub0 texsub2 texsub4 texsub5 texrecip12 texrecip8 texrecip6 texlight4 texlight3 texlight2 \
+                  flat
 
 # Only the firmware and build/render's main include the knobs' headers; the
 # scene compiler, PNG writer and HAL objects are shared with build/ (build/san/).

@@ -379,7 +379,7 @@ def family(config, flags):
             "VIEW_RECIP_BITS": "reciprocal table", "VIEW_SHIFT": "view-space bits",
             "FX_SIN_BITS": "sine table", "FX_SIN_LERP": "sine table",
             "TEX_SUBDIV_BITS": "texture span subdivision", "TEX_RECIP_BITS": "texture reciprocal table",
-            "TEX_LIGHT_BITS": "light steps"}.get(sorted(knobs)[0], "other")
+            "TEX_LIGHT_BITS": "light steps", "CFG_FLAT": "flat (no textures)"}.get(sorted(knobs)[0], "other")
 
 
 def _place_labels(ax, items, fontsize=7):
