@@ -223,7 +223,8 @@ static inline __attribute__((always_inline)) wall_sample wall_at(const tex_paint
  * its row was cut into spans: every render mode and pool size draws the same
  * texels. Past a wall's vanishing point (a sample the ray of which misses the
  * line) the span's own end is sampled instead. */
-static void wall_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
+static inline __attribute__((always_inline)) void wall_span_as(const tex_paint *p, int y, int x0, int x1,
+                                                                uint8_t *row, tex_addr a)
 {
     int32_t sy = 2 * (VIEW_CY + p->look) - 2 * y - 1;
     int32_t vk = sy * 13107; /* sy 2^22 / 320, |sy| < 600 */
@@ -232,7 +233,6 @@ static void wall_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
     int64_t den = (int64_t)p->a + (int64_t)sx * p->b, slope = (int64_t)p->c + (int64_t)sx * p->d;
     const int64_t dden = (int64_t)p->b * (2 * TEX_SUBDIV), dslope = (int64_t)p->d * (2 * TEX_SUBDIV);
     wall_sample s = wall_at(p, den, slope, vk);
-    tex_addr a = addr_of(p);
     for (int x = x0; x < x1; k += TEX_SUBDIV) {
         den += dden;
         slope += dslope;
@@ -252,11 +252,20 @@ static void wall_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
             end = x1;
         }
         uint32_t skip = (uint32_t)(x - k);
-        texel_run(row + x, end - x, s.light, a, s.u + skip * (uint32_t)du, s.v + skip * (uint32_t)dv, (uint32_t)du,
-                  (uint32_t)dv);
+        run_of(row + x, end - x, s.light, a, s.u + skip * (uint32_t)du, s.v + skip * (uint32_t)dv, (uint32_t)du,
+               (uint32_t)dv);
         x = end;
         s = e;
     }
+}
+
+/* wall_span_as with the texture's shape as constants for the common shapes
+ * (most of Doom's wall textures are 128 rows high), the texel loop inlined. */
+static void wall_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
+{
+    tex_addr a = addr_of(p);
+    if (a.rmask == 127u) wall_span_as(p, y, x0, x1, row, (tex_addr){a.texels, a.cmask, 127u, 9u});
+    else wall_span_as(p, y, x0, x1, row, a);
 }
 
 /* ---- floors and ceilings: one depth a row (Doom's trick) ---- */
