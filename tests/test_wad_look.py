@@ -3,10 +3,14 @@ sections' counts, only the textures and flats the map uses, texels against an in
 composition from the WAD, --flat, and damaged texture data refused with a message (never a crash,
 under the sanitizer build)."""
 import struct
+import sys
 
 import pytest
 
-from conftest import program, run, freedoom
+from conftest import ROOT, program, run, freedoom
+
+sys.path.insert(0, str(ROOT / "tools"))
+from texture_bytes import flat_names, map_lumps, name8, read_wad, sections  # noqa: E402  (WAD and blob plumbing)
 
 SEC_LOOK, SEC_LIGHTS, SEC_TEXTURES, SEC_TEXELS, SEC_SIDES, SEC_PLANES = range(14, 20)
 SEC_LINES, SEC_SECTORS, SEC_PALETTE = 2, 1, 7
@@ -14,16 +18,6 @@ TEX_NONE = 0xFFFF
 
 
 # ---- reading a WAD (independently of tools/bspc) ----------------------------------------------
-
-def read_wad(path):
-    data = path.read_bytes()
-    n, dirofs = struct.unpack_from("<II", data, 4)
-    lumps = []
-    for i in range(n):
-        pos, size, name = struct.unpack_from("<II8s", data, dirofs + 16 * i)
-        lumps.append((name.split(b"\0", 1)[0].decode("latin-1").upper(), data[pos:pos + size]))
-    return lumps
-
 
 def last(lumps, name):
     found = None
@@ -33,8 +27,6 @@ def last(lumps, name):
     return found
 
 
-def name8(b):
-    return b.split(b"\0", 1)[0].decode("latin-1").upper()
 
 
 def texture_defs(lumps):
@@ -59,16 +51,6 @@ def texture_defs(lumps):
     return defs
 
 
-def flat_names(lumps):
-    names, inside = set(), False
-    for n, _ in lumps:
-        if n in ("F_START", "FF_START"):
-            inside = True
-        elif n in ("F_END", "FF_END"):
-            inside = False
-        elif inside:
-            names.add(n)
-    return names
 
 
 def compose(lumps, tdef):
@@ -93,18 +75,10 @@ def compose(lumps, tdef):
     return pic
 
 
-def map_lumps(lumps, mapname):
-    i = [n for n, _ in lumps].index(mapname)
-    out = {}
-    for n, d in lumps[i + 1:i + 12]:
-        out.setdefault(n, d)
-    return out
 
 
 # ---- the compiled scene ----------------------------------------------------------------------
 
-def sections(blob):
-    return [struct.unpack_from("<II", blob, 44 + 8 * i) for i in range(20)]
 
 
 def compile_map(tmp_path, spec, *extra):

@@ -13,6 +13,26 @@ static void row_break(long i, long last)
     printf("%s", (i % 8 == 7 || i == last) ? "\n" : "");
 }
 
+/* A reciprocal table for each allowed size 2^4 .. 2^12, chosen by the knob:
+ * name[i] = 2^(k + 32) / (2m + 1) rounded, m = 2^k + i (view.h). */
+static void recip_tables(const char *knob, const char *name)
+{
+    for (int bits = 4; bits <= 12; bits++) {
+        long n = 1L << bits;
+        printf("#%s %s == %d\n", bits == 4 ? "if" : "elif", knob, bits);
+        printf("/* 2^%d / (2m + 1) rounded, m = %ld + i (view.h) */\n", bits + 32, n);
+        printf("const uint32_t %s[%ld] = {\n", name, n);
+        for (long i = 0; i < n; i++) {
+            uint64_t den = 2 * (uint64_t)(n + i) + 1;
+            uint64_t r = (((uint64_t)1 << (bits + 33)) / den + 1) / 2;
+            printf("%s%lluu,", (i % 8) ? " " : "    ", (unsigned long long)r);
+            row_break(i, n - 1);
+        }
+        printf("};\n");
+    }
+    printf("#endif\n\n");
+}
+
 int main(void)
 {
     const double pi = 3.14159265358979323846;
@@ -31,20 +51,7 @@ int main(void)
         printf("};\n");
     }
     printf("#endif\n\n");
-    for (int bits = 4; bits <= 12; bits++) {
-        long n = 1L << bits;
-        printf("#%s VIEW_RECIP_BITS == %d\n", bits == 4 ? "if" : "elif", bits);
-        printf("/* 2^%d / (2m + 1) rounded, m = %ld + i (view.h) */\n", bits + 32, n);
-        printf("const uint32_t view_recip[%ld] = {\n", n);
-        for (long i = 0; i < n; i++) {
-            uint64_t den = 2 * (uint64_t)(n + i) + 1;
-            uint64_t r = (((uint64_t)1 << (bits + 33)) / den + 1) / 2;
-            printf("%s%lluu,", (i % 8) ? " " : "    ", (unsigned long long)r);
-            row_break(i, n - 1);
-        }
-        printf("};\n");
-    }
-    printf("#endif\n\n");
+    recip_tables("VIEW_RECIP_BITS", "view_recip");
     /* texture.c: the sky's angle of each screen column, and its reciprocals */
     printf("#if CFG_TEXTURES\n/* atan((160 - (x + 0.5)) / 160) in binary angle units (2^32 a turn) */\n");
     printf("const uint32_t tex_sky_angle[320] = {\n");
@@ -54,18 +61,6 @@ int main(void)
         row_break(x, 319);
     }
     printf("};\n#endif\n\n");
-    for (int bits = 4; bits <= 12; bits++) {
-        long n = 1L << bits;
-        printf("#%s TEX_RECIP_BITS == %d\n", bits == 4 ? "if" : "elif", bits);
-        printf("const uint32_t tex_recip[%ld] = {\n", n);
-        for (long i = 0; i < n; i++) {
-            uint64_t den = 2 * (uint64_t)(n + i) + 1;
-            uint64_t r = (((uint64_t)1 << (bits + 33)) / den + 1) / 2;
-            printf("%s%lluu,", (i % 8) ? " " : "    ", (unsigned long long)r);
-            row_break(i, n - 1);
-        }
-        printf("};\n");
-    }
-    printf("#endif\n");
+    recip_tables("TEX_RECIP_BITS", "tex_recip");
     return 0;
 }
