@@ -39,7 +39,10 @@ static const char usage[] =
     "  -h, --help         this text\n"
     "\n"
     "A frame is shown only if its message passed its CRC and its rebuilt pixels match\n"
-    "the CRC-32 the sender put in it; damaged frames are counted and dropped.\n";
+    "the CRC-32 the sender put in it; damaged frames are counted and dropped. Frames\n"
+    "that arrive before any palette are not shown (counted; the palette is asked for).\n"
+    "Exits 1 when the input ended or went quiet without a frame shown and it held no\n"
+    "frame-link message, bad messages, or frames without a palette.\n";
 
 typedef struct {
     int fd;
@@ -50,6 +53,8 @@ typedef struct {
     uint64_t frame_bytes;  /* wire bytes of the frame messages shown (approx: bytes between frames) */
     uint64_t bytes_at_last;
     long shown;
+    long no_palette;       /* frames that passed every check but came before any palette */
+    int have_palette;
     uint8_t palette[HAL_PALETTE_BYTES];
     int quit;
     fl_decoder dec;
@@ -68,8 +73,24 @@ static void put_back(void *ctx, const uint8_t *p, uint32_t n)
     }
 }
 
+/* A board that has never been given a palette has nothing true to show: its
+ * DAC holds no colours of the sender's. It keeps the pixels out of sight until
+ * a palette arrives (the decoder asks the sender for one) rather than show
+ * them in made-up colours. */
+static int palette_missing(board *b, const fl_event *ev)
+{
+    if (b->have_palette) return 0;
+    if (b->no_palette++ == 0)
+        fprintf(stderr,
+                "display: frame %u arrived before any palette: frames are not shown until a palette "
+                "arrives\n",
+                (unsigned)ev->frame_no);
+    return 1;
+}
+
 static void show_frame(board *b, const fl_event *ev)
 {
+    if (palette_missing(b, ev)) return;
     b->shown++;
     b->frame_bytes += b->dec.count.bytes - b->bytes_at_last;
     b->bytes_at_last = b->dec.count.bytes;
@@ -96,6 +117,7 @@ static void on_event(void *ctx, const fl_event *ev)
     switch (ev->kind) {
     case FL_EV_PALETTE:
         memcpy(b->palette, ev->palette, sizeof b->palette);
+        b->have_palette = 1;
         break;
     case FL_EV_FRAME:
         show_frame(b, ev);
@@ -192,18 +214,62 @@ static void print_summary(const board *b, int json)
     const fl_counters *c = &b->dec.count;
     unsigned long per_frame = b->shown ? (unsigned long)(b->frame_bytes / (uint64_t)b->shown) : 0;
     if (json) {
-        printf("{\"frames_shown\": %u, \"frames_dropped\": %u, \"frames_missed\": %u, \"msgs_ok\": %u, "
-               "\"msgs_bad\": %u, \"resyncs\": %u, \"keyreqs_sent\": %u, \"acks_sent\": %u, \"bytes\": %u, "
+        printf("{\"frames_shown\": %ld, \"frames_no_palette\": %ld, \"frames_dropped\": %u, "
+               "\"frames_missed\": %u, \"msgs_ok\": %u, \"msgs_bad\": %u, \"resyncs\": %u, "
+               "\"keyreqs_sent\": %u, \"palreqs_sent\": %u, \"acks_sent\": %u, \"bytes\": %u, "
                "\"bytes_per_frame\": %lu}\n",
-               c->frames_shown, c->frames_dropped, c->frames_missed, c->msgs_ok, c->msgs_bad, c->resyncs,
-               c->keyreqs_sent, c->acks_sent, c->bytes, per_frame);
+               b->shown, b->no_palette, c->frames_dropped, c->frames_missed, c->msgs_ok, c->msgs_bad, c->resyncs,
+               c->keyreqs_sent, c->palreqs_sent, c->acks_sent, c->bytes, per_frame);
     } else {
         fprintf(stderr,
-                "display: %u frames shown, %u bad messages, %u frames dropped, %u missed, %u resyncs, "
-                "%u keyframe requests, %u bytes (%lu per frame shown)\n",
-                c->frames_shown, c->msgs_bad, c->frames_dropped, c->frames_missed, c->resyncs, c->keyreqs_sent,
-                c->bytes, per_frame);
+                "display: %ld frames shown, %ld not shown for want of a palette, %u bad messages, "
+                "%u frames dropped, %u missed, %u resyncs, %u keyframe requests, %u bytes (%lu per frame "
+                "shown)\n",
+                b->shown, b->no_palette, c->msgs_bad, c->frames_dropped, c->frames_missed, c->resyncs,
+                c->keyreqs_sent, c->bytes, per_frame);
     }
+}
+
+/* n with thousands separators, for messages a person reads. */
+static const char *grouped(uint32_t n, char *out, size_t len)
+{
+    char digits[16];
+    int nd = snprintf(digits, sizeof digits, "%u", (unsigned)n);
+    size_t o = 0;
+    for (int i = 0; i < nd && o + 2 < len; i++) {
+        if (i > 0 && (nd - i) % 3 == 0) out[o++] = ',';
+        out[o++] = digits[i];
+    }
+    out[o] = '\0';
+    return out;
+}
+
+/* Exit status of a session: 1 when nothing was shown and the input gave a
+ * reason to doubt it was a frame link at all (no good message, bad ones, or
+ * frames without a palette); a clean stream that carried no frame is no fault. */
+static int verdict(const board *b, const char *port)
+{
+    const fl_counters *c = &b->dec.count;
+    const char *name = strcmp(port, "-") ? port : "stdin";
+    char nbytes[32];
+    grouped(c->bytes, nbytes, sizeof nbytes);
+    if (b->shown > 0) return 0;
+    if (c->msgs_ok == 0) {
+        fprintf(stderr, "display: %s: no frame-link message in %s bytes (%u bad messages)\n", name, nbytes,
+                c->msgs_bad);
+        return 1;
+    }
+    if (b->no_palette > 0) {
+        fprintf(stderr, "display: %s: %ld frames but no palette in %s bytes: nothing shown\n", name,
+                b->no_palette, nbytes);
+        return 1;
+    }
+    if (c->msgs_bad > 0 || c->frames_dropped > 0) {
+        fprintf(stderr, "display: %s: no frame shown: %u good and %u bad messages, %u frames dropped, in %s bytes\n",
+                name, c->msgs_ok, c->msgs_bad, c->frames_dropped, nbytes);
+        return 1;
+    }
+    return 0;
 }
 
 int main(int argc, char **argv)
@@ -280,5 +346,5 @@ int main(int argc, char **argv)
     print_summary(&b, json);
     if (b.window) hal_sdl_quit();
     if (b.fd > 0) close(b.fd);
-    return 0;
+    return verdict(&b, port);
 }
