@@ -159,3 +159,35 @@ def test_display_help_and_bad_port(tmp_path):
     proc = subprocess.run([program("display"), str(tmp_path / "none"), "--png", str(tmp_path)],
                           capture_output=True, text=True)
     assert proc.returncode != 0 and "none" in proc.stderr
+
+
+def test_capture_skips_frames_before_the_palette(tmp_path):
+    """A stream that starts after its palette (hello, frames 0-2, palette, frames 3-5): the frames
+    before the palette are not captured as black PNGs; those after it are, in the real palette."""
+    walk = tmp_path / "walk"
+    walk.mkdir()
+    run([program("fltool", sanitized=False), "walk", "freedoom2.wad:MAP01", "--frames", 6, "--flat", "--out", walk])
+    run([program("fltool", sanitized=False), "encode", walk / "frames.raw", "--info", walk / "frames.jsonl",
+         "--palette", walk / "palette.bin", "--out", walk / "s.bin"])
+    segs = (walk / "s.bin").read_bytes().split(b"\0")[:-1]
+    late = [segs[0]] + segs[2:5] + [segs[1]] + segs[5:]
+
+    class Port:
+        chunks = [b"".join(s + b"\0" for s in late)]
+
+        def read(self, n):
+            if not self.chunks:
+                raise serial.SerialException("closed")
+            return self.chunks.pop(0)
+
+        def write(self, data):
+            return len(data)
+
+    summary = capture.capture(Port(), 6, tmp_path / "cap", log=sys.stderr)
+    assert summary["frames_no_palette"] == 3 and summary["frames_captured"] == 3
+    pngs = sorted((tmp_path / "cap").glob("frame_*.png"))
+    assert [p.name for p in pngs] == [f"frame_{n:05d}.png" for n in range(3, 6)]
+    palette = (walk / "palette.bin").read_bytes()
+    assert all(read_png_indexed(p)[3] == palette for p in pngs)
+    records = [json.loads(line) for line in (tmp_path / "cap" / "frames.jsonl").read_text().splitlines()]
+    assert [r["frame"] for r in records] == [3, 4, 5]

@@ -17,7 +17,9 @@ it). Writes, in DIR:
                       build/render reproduce the frame bit for bit, and `stream_end`: the bytes
                       received from the start of the stream up to and including the delimiter
                       that ended the frame's message (where it was accepted)
-    summary.json      the decoder's counters
+    summary.json      the decoder's counters, frames_captured, and frames_no_palette: frames that
+                      passed every check before any palette came, which are not captured (there
+                      are no true colours for them; the decoder asks the sender for the palette)
 
 Exits 0 when N frames were captured, 1 when the stream ended or went quiet first.
 """
@@ -103,7 +105,8 @@ def capture(port, frames, out, png=True, timeout=10.0, log=sys.stderr):
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     dec = framelink.Decoder(back=port.write)
-    palette = bytes(768)
+    palette = None  # none yet: frames before the first palette are not captured (no true colours)
+    no_palette = 0
     got = 0
     last = time.monotonic()
     import serial  # pyserial
@@ -123,6 +126,11 @@ def capture(port, frames, out, png=True, timeout=10.0, log=sys.stderr):
             for ev, at in feed_at(dec, data):
                 if ev["event"] == "palette":
                     palette = ev["palette"]
+                elif ev["event"] == "frame" and got < frames and palette is None:
+                    if no_palette == 0:
+                        print(f"capture: frame {ev['frame']} arrived before any palette: frames are not "
+                              "captured until a palette arrives", file=log)
+                    no_palette += 1
                 elif ev["event"] == "frame" and got < frames:
                     rec = frame_record(ev)
                     rec["stream_end"] = at
@@ -133,7 +141,7 @@ def capture(port, frames, out, png=True, timeout=10.0, log=sys.stderr):
                     got += 1
                     if got % 25 == 0:
                         print(f"capture: {got}/{frames} frames", file=log, flush=True)
-    summary = dict(dec.counters, frames_captured=got)
+    summary = dict(dec.counters, frames_captured=got, frames_no_palette=no_palette)
     (out / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
     return summary
 
