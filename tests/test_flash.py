@@ -185,3 +185,26 @@ def test_missing_file(tmp_path):
     proc = flash(tmp_path / "nope.dfu", "--loopback")
     assert proc.returncode == 2
     assert "nope.dfu: cannot open" in proc.stderr
+
+
+@pytest.mark.parametrize("size", [1, 4096, 10_000])
+def test_unplug_verdict_follows_the_device(tmp_path, size):
+    """Unplugged after every possible request: the exit status and the message follow
+    what the device holds when plugged in again, never a guess about it."""
+    data = bytes((i * 13 + 5) & 0xFF for i in range(size))
+    dfu, _ = add_suffix(tmp_path, data)
+    total = int(re.search(r"loopback: (\d+) requests", flash(dfu, "--loopback").stdout).group(1))
+    seen_valid = 0
+    for n in range(1, total + 1):
+        proc = flash(dfu, "--loopback", "--loopback-unplug-after", str(n))
+        m = re.search(r"application valid: (\d+) bytes, CRC-32 0x([0-9a-f]{8})", proc.stdout)
+        holds = bool(m) and int(m.group(1)) == size and int(m.group(2), 16) == zlib.crc32(data)
+        assert holds or "no valid application" in proc.stdout, (n, proc.stdout)
+        if holds:
+            seen_valid += 1
+            assert proc.returncode == 0, (n, proc.stdout, proc.stderr)
+            assert "No firmware was marked valid" not in proc.stderr, (n, proc.stderr)
+        else:
+            assert proc.returncode == 4, (n, proc.stdout, proc.stderr)
+            assert "dfuERROR (errFIRMWARE)" in proc.stdout
+    assert seen_valid >= 2   # unplugged during manifestation, and during the final reset

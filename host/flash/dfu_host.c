@@ -167,7 +167,14 @@ static void fail_device(eng *e, const dstat *s, const char *fmt, ...)
 static void recover(eng *e)
 {
     if (e->last_xfer == DFU_XFER_NO_DEVICE) {
-        if (e->sent_dnload)
+        /* Manifestation writes the valid mark; a device gone during it may or may
+         * not have written it, and only the device can tell. */
+        if (e->r->manifest_started)
+            append(e, ". The device had the whole image and was checking it and marking it "
+                      "valid: it may have finished (then it runs the new firmware when "
+                      "reconnected) or not (then it stays in its bootloader); reconnect it to "
+                      "see which, and run the download again if it stays in its bootloader");
+        else if (e->sent_dnload)
             append(e, ". No firmware was marked valid: after reconnecting, the device stays in "
                       "its bootloader; run the download again");
         return;
@@ -361,6 +368,7 @@ static int manifest(eng *e, uint32_t blk)
         fail_xfer(e, x, "the final zero-length DNLOAD");
         return -1;
     }
+    e->r->manifest_started = 1;
     for (unsigned polls = 0; polls < MAX_POLLS; polls++) {
         x = getstatus(e, &s);
         if (x < 0) {
