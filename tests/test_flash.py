@@ -208,3 +208,20 @@ def test_unplug_verdict_follows_the_device(tmp_path, size):
             assert proc.returncode == 4, (n, proc.stdout, proc.stderr)
             assert "dfuERROR (errFIRMWARE)" in proc.stdout
     assert seen_valid >= 2   # unplugged during manifestation, and during the final reset
+
+
+@pytest.mark.parametrize("blength", [15, 17, 255])
+def test_suffix_length_must_be_16(tmp_path, blength):
+    """A bLength other than 16, with the CRC made right, is refused: it would take
+    firmware bytes for suffix."""
+    dfu, _ = add_suffix(tmp_path, bytes(range(256)) * 4)
+    blob = bytearray(dfu.read_bytes())
+    blob[-5] = blength
+    blob[-4:] = struct.pack("<I", zlib.crc32(bytes(blob[:-4])) ^ 0xFFFFFFFF)
+    bad = tmp_path / "blength.dfu"
+    bad.write_bytes(bytes(blob))
+    for args in (["--check", bad], [bad, "--loopback"]):
+        proc = flash(*args)
+        assert proc.returncode == 2, (args, proc.stdout, proc.stderr)
+        assert f"bLength {blength}" in proc.stderr and "not 16" in proc.stderr, proc.stderr
+        assert "loopback:" not in proc.stdout

@@ -252,10 +252,13 @@ static void test_parser_rejects_damage(void **state)
     f[len - 5] = 15;                                 /* bLength below 16 */
     recrc(f, len);
     assert_int_equal(dfu_image_parse(f, len, &img), DFU_IMAGE_BAD_LENGTH);
-    f[len - 5] = 255;                                /* fits: a longer suffix is allowed */
+    f[len - 5] = 255;                                /* fits, but would eat firmware bytes */
     recrc(f, len);
-    assert_int_equal(dfu_image_parse(f, len, &img), DFU_IMAGE_OK);
-    assert_int_equal(img.payload_len, len - 255);
+    assert_int_equal(dfu_image_parse(f, len, &img), DFU_IMAGE_BAD_LENGTH);
+    assert_int_equal(img.payload_len, 0);
+    f[len - 5] = 17;
+    recrc(f, len);
+    assert_int_equal(dfu_image_parse(f, len, &img), DFU_IMAGE_BAD_LENGTH);
     f[len - 5] = 16;
     f[len - 10] = 0x1A;                              /* bcdDFU 0x011A: DfuSe */
     f[len - 9] = 0x01;
