@@ -225,3 +225,19 @@ def test_suffix_length_must_be_16(tmp_path, blength):
         assert proc.returncode == 2, (args, proc.stdout, proc.stderr)
         assert f"bLength {blength}" in proc.stderr and "not 16" in proc.stderr, proc.stderr
         assert "loopback:" not in proc.stdout
+
+
+def test_loopback_is_the_projects_device(tmp_path):
+    """The simulated device is 1209:0001 whatever the image says: a suffix for another
+    VID:PID is refused without --device too, and --device naming another finds nothing."""
+    dfu, _ = add_suffix(tmp_path, b"\x02" * 1000, vid="1234", pid="5678")
+    proc = flash(dfu, "--loopback")
+    assert proc.returncode == 2, (proc.stdout, proc.stderr)
+    assert "another vendor id" in proc.stderr and "1234:5678" in proc.stderr
+    assert "nothing was sent" in proc.stderr and "loopback:" not in proc.stdout
+    anyid, _ = add_suffix(tmp_path, b"\x03" * 1000, vid="ffff", pid="ffff", name="any")
+    proc = flash(anyid, "--loopback")
+    assert proc.returncode == 0, proc.stderr
+    assert "simulated DFU device 1209:0001" in proc.stdout
+    proc = flash(anyid, "--loopback", "--device", "1234:5678")
+    assert proc.returncode == 3 and "no device found for 1234:5678" in proc.stderr
