@@ -241,3 +241,16 @@ def test_loopback_is_the_projects_device(tmp_path):
     assert "simulated DFU device 1209:0001" in proc.stdout
     proc = flash(anyid, "--loopback", "--device", "1234:5678")
     assert proc.returncode == 3 and "no device found for 1234:5678" in proc.stderr
+
+
+def test_oversized_image_refused_before_anything_is_sent(tmp_path):
+    """An image past the device's application area (4 MiB - 4 KiB on the loopback)
+    is refused before the first request, so an old valid mark is never erased."""
+    cap = 4 * 1024 * 1024 - 4096
+    dfu, _ = add_suffix(tmp_path, b"\x5A" * (cap + 1))
+    proc = flash(dfu, "--loopback")
+    assert proc.returncode == 2, (proc.stdout, proc.stderr)
+    assert f"{cap + 1} bytes of firmware do not fit" in proc.stderr and f"{cap} bytes" in proc.stderr
+    assert "loopback: 0 requests" in proc.stdout
+    fits, _ = add_suffix(tmp_path, b"\x5A" * cap, name="fits")
+    assert flash(fits, "--loopback").returncode == 0

@@ -254,6 +254,19 @@ static int detach(eng *e, uint8_t state)
     return 0;
 }
 
+/* An image larger than the device's application area is refused before the first
+ * DNLOAD, which would erase the old valid mark. */
+static int fits(eng *e, size_t len)
+{
+    uint32_t cap = e->desc.app_capacity;
+    if (cap == 0 || len <= cap)
+        return 1;
+    fail(e, DFU_HOST_BAD_IMAGE, "the image's %zu bytes of firmware do not fit the device's "
+         "application area of %u bytes; nothing was sent, the device keeps its firmware", len,
+         (unsigned)cap);
+    return 0;
+}
+
 /* Bring the device to dfuIDLE from wherever it is. */
 static int to_idle(eng *e)
 {
@@ -473,10 +486,14 @@ dfu_host_err dfu_host_download(const dfu_transport *t, const uint8_t *payload, s
              want, e.desc.transfer_size);
         return r->err;
     }
+    if (!fits(&e, len))
+        return r->err;
     if (to_idle(&e) < 0) {
         recover(&e);
         return r->err;
     }
+    if (!fits(&e, len))   /* the descriptor may have changed with DETACH */
+        return r->err;
     if (!(e.desc.attributes & DFU_ATTR_CAN_DNLOAD)) {
         fail(&e, DFU_HOST_BAD_ARGS, "the device does not accept downloads (bitCanDnload is 0)");
         return r->err;
