@@ -185,3 +185,72 @@ def test_missing_file(tmp_path):
     proc = flash(tmp_path / "nope.dfu", "--loopback")
     assert proc.returncode == 2
     assert "nope.dfu: cannot open" in proc.stderr
+
+
+@pytest.mark.parametrize("size", [1, 4096, 10_000])
+def test_unplug_verdict_follows_the_device(tmp_path, size):
+    """Unplugged after every possible request: the exit status and the message follow
+    what the device holds when plugged in again, never a guess about it."""
+    data = bytes((i * 13 + 5) & 0xFF for i in range(size))
+    dfu, _ = add_suffix(tmp_path, data)
+    total = int(re.search(r"loopback: (\d+) requests", flash(dfu, "--loopback").stdout).group(1))
+    seen_valid = 0
+    for n in range(1, total + 1):
+        proc = flash(dfu, "--loopback", "--loopback-unplug-after", str(n))
+        m = re.search(r"application valid: (\d+) bytes, CRC-32 0x([0-9a-f]{8})", proc.stdout)
+        holds = bool(m) and int(m.group(1)) == size and int(m.group(2), 16) == zlib.crc32(data)
+        assert holds or "no valid application" in proc.stdout, (n, proc.stdout)
+        if holds:
+            seen_valid += 1
+            assert proc.returncode == 0, (n, proc.stdout, proc.stderr)
+            assert "No firmware was marked valid" not in proc.stderr, (n, proc.stderr)
+        else:
+            assert proc.returncode == 4, (n, proc.stdout, proc.stderr)
+            assert "dfuERROR (errFIRMWARE)" in proc.stdout
+    assert seen_valid >= 2   # unplugged during manifestation, and during the final reset
+
+
+@pytest.mark.parametrize("blength", [15, 17, 255])
+def test_suffix_length_must_be_16(tmp_path, blength):
+    """A bLength other than 16, with the CRC made right, is refused: it would take
+    firmware bytes for suffix."""
+    dfu, _ = add_suffix(tmp_path, bytes(range(256)) * 4)
+    blob = bytearray(dfu.read_bytes())
+    blob[-5] = blength
+    blob[-4:] = struct.pack("<I", zlib.crc32(bytes(blob[:-4])) ^ 0xFFFFFFFF)
+    bad = tmp_path / "blength.dfu"
+    bad.write_bytes(bytes(blob))
+    for args in (["--check", bad], [bad, "--loopback"]):
+        proc = flash(*args)
+        assert proc.returncode == 2, (args, proc.stdout, proc.stderr)
+        assert f"bLength {blength}" in proc.stderr and "not 16" in proc.stderr, proc.stderr
+        assert "loopback:" not in proc.stdout
+
+
+def test_loopback_is_the_projects_device(tmp_path):
+    """The simulated device is 1209:0001 whatever the image says: a suffix for another
+    VID:PID is refused without --device too, and --device naming another finds nothing."""
+    dfu, _ = add_suffix(tmp_path, b"\x02" * 1000, vid="1234", pid="5678")
+    proc = flash(dfu, "--loopback")
+    assert proc.returncode == 2, (proc.stdout, proc.stderr)
+    assert "another vendor id" in proc.stderr and "1234:5678" in proc.stderr
+    assert "nothing was sent" in proc.stderr and "loopback:" not in proc.stdout
+    anyid, _ = add_suffix(tmp_path, b"\x03" * 1000, vid="ffff", pid="ffff", name="any")
+    proc = flash(anyid, "--loopback")
+    assert proc.returncode == 0, proc.stderr
+    assert "simulated DFU device 1209:0001" in proc.stdout
+    proc = flash(anyid, "--loopback", "--device", "1234:5678")
+    assert proc.returncode == 3 and "no device found for 1234:5678" in proc.stderr
+
+
+def test_oversized_image_refused_before_anything_is_sent(tmp_path):
+    """An image past the device's application area (4 MiB - 4 KiB on the loopback)
+    is refused before the first request, so an old valid mark is never erased."""
+    cap = 4 * 1024 * 1024 - 4096
+    dfu, _ = add_suffix(tmp_path, b"\x5A" * (cap + 1))
+    proc = flash(dfu, "--loopback")
+    assert proc.returncode == 2, (proc.stdout, proc.stderr)
+    assert f"{cap + 1} bytes of firmware do not fit" in proc.stderr and f"{cap} bytes" in proc.stderr
+    assert "loopback: 0 requests" in proc.stdout
+    fits, _ = add_suffix(tmp_path, b"\x5A" * cap, name="fits")
+    assert flash(fits, "--loopback").returncode == 0

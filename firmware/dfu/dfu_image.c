@@ -52,7 +52,9 @@ dfu_image_err dfu_image_parse(const uint8_t *data, size_t len, dfu_image_t *out)
         err = DFU_IMAGE_NO_SIGNATURE;
         goto done;
     }
-    if (img.suffix_len < DFU_SUFFIX_LEN || img.suffix_len > len) {
+    /* DFU 1.1 defines exactly 16 suffix bytes; a longer bLength would silently
+     * take the end of the firmware for suffix. */
+    if (img.suffix_len != DFU_SUFFIX_LEN) {
         err = DFU_IMAGE_BAD_LENGTH;
         goto done;
     }
@@ -90,7 +92,7 @@ const char *dfu_image_strerror(dfu_image_err e)
     case DFU_IMAGE_TOO_SHORT: return "too short to hold a DFU suffix (truncated, or not a DFU image)";
     case DFU_IMAGE_NO_SIGNATURE:
         return "no DFU suffix signature \"UFD\" at the end (truncated, or a raw binary: add a suffix with --add-suffix)";
-    case DFU_IMAGE_BAD_LENGTH: return "DFU suffix length field (bLength) is invalid";
+    case DFU_IMAGE_BAD_LENGTH: return "DFU suffix length field (bLength) is not 16, the length of a DFU 1.1 suffix";
     case DFU_IMAGE_BAD_CRC: return "CRC mismatch: the file is corrupted";
     case DFU_IMAGE_BAD_VERSION: return "DFU suffix bcdDFU is not 0x0100 (not a DFU 1.1 image; DfuSe files are not supported)";
     case DFU_IMAGE_EMPTY: return "no firmware before the DFU suffix";

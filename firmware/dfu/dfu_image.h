@@ -7,7 +7,8 @@
  *    4                             idVendor        2    vendor id, or 0xFFFF (any)
  *    6                             bcdDFU          2    0x0100
  *    8                             ucDfuSignature  3    'U' 'F' 'D' (the bytes 0x55 0x46 0x44)
- *   11                             bLength         1    16 (the suffix length, dwCRC included)
+ *   11                             bLength         1    16 (the suffix length, dwCRC included;
+ *                                                       any other value is refused)
  *   12                             dwCRC           4    CRC of the whole file but dwCRC
  *
  * All fields little-endian. dwCRC is the CRC-32 of the IEEE polynomial, reflected,
@@ -31,7 +32,7 @@ typedef enum dfu_image_err {
     DFU_IMAGE_OK = 0,
     DFU_IMAGE_TOO_SHORT,       /* shorter than a suffix */
     DFU_IMAGE_NO_SIGNATURE,    /* no "UFD": no suffix, or the file is truncated */
-    DFU_IMAGE_BAD_LENGTH,      /* bLength below 16 or longer than the file */
+    DFU_IMAGE_BAD_LENGTH,      /* bLength is not 16 (the DFU 1.1 suffix) */
     DFU_IMAGE_BAD_CRC,         /* dwCRC does not match the file: corrupted */
     DFU_IMAGE_BAD_VERSION,     /* bcdDFU is not 0x0100 (e.g. 0x011A, a DfuSe file) */
     DFU_IMAGE_EMPTY,           /* no firmware bytes before the suffix */

@@ -167,7 +167,14 @@ static void fail_device(eng *e, const dstat *s, const char *fmt, ...)
 static void recover(eng *e)
 {
     if (e->last_xfer == DFU_XFER_NO_DEVICE) {
-        if (e->sent_dnload)
+        /* Manifestation writes the valid mark; a device gone during it may or may
+         * not have written it, and only the device can tell. */
+        if (e->r->manifest_started)
+            append(e, ". The device had the whole image and was checking it and marking it "
+                      "valid: it may have finished (then it runs the new firmware when "
+                      "reconnected) or not (then it stays in its bootloader); reconnect it to "
+                      "see which, and run the download again if it stays in its bootloader");
+        else if (e->sent_dnload)
             append(e, ". No firmware was marked valid: after reconnecting, the device stays in "
                       "its bootloader; run the download again");
         return;
@@ -244,6 +251,19 @@ static int detach(eng *e, uint8_t state)
     }
     e->last_xfer = 0;
     e->t->functional(e->t->ctx, &e->desc);
+    return 0;
+}
+
+/* An image larger than the device's application area is refused before the first
+ * DNLOAD, which would erase the old valid mark. */
+static int fits(eng *e, size_t len)
+{
+    uint32_t cap = e->desc.app_capacity;
+    if (cap == 0 || len <= cap)
+        return 1;
+    fail(e, DFU_HOST_BAD_IMAGE, "the image's %zu bytes of firmware do not fit the device's "
+         "application area of %u bytes; nothing was sent, the device keeps its firmware", len,
+         (unsigned)cap);
     return 0;
 }
 
@@ -361,6 +381,7 @@ static int manifest(eng *e, uint32_t blk)
         fail_xfer(e, x, "the final zero-length DNLOAD");
         return -1;
     }
+    e->r->manifest_started = 1;
     for (unsigned polls = 0; polls < MAX_POLLS; polls++) {
         x = getstatus(e, &s);
         if (x < 0) {
@@ -465,10 +486,14 @@ dfu_host_err dfu_host_download(const dfu_transport *t, const uint8_t *payload, s
              want, e.desc.transfer_size);
         return r->err;
     }
+    if (!fits(&e, len))
+        return r->err;
     if (to_idle(&e) < 0) {
         recover(&e);
         return r->err;
     }
+    if (!fits(&e, len))   /* the descriptor may have changed with DETACH */
+        return r->err;
     if (!(e.desc.attributes & DFU_ATTR_CAN_DNLOAD)) {
         fail(&e, DFU_HOST_BAD_ARGS, "the device does not accept downloads (bitCanDnload is 0)");
         return r->err;

@@ -42,6 +42,7 @@ typedef struct dfu_host_report {
     uint32_t blocks_total, blocks_done;
     size_t bytes_done, payload_len;
     uint32_t payload_crc;         /* CRC-32 (zlib) of the firmware bytes sent */
+    int manifest_started;         /* the device took the final zero-length DNLOAD */
     int manifested;               /* the device confirmed manifestation (tolerant) */
     int reenumerated;             /* 1 back with DFU interface, 0 back without, -1 not seen */
     uint8_t final_state;          /* state after re-enumeration, when it has DFU */

@@ -182,6 +182,7 @@ static void lb_functional(void *ctx, dfu_func_desc *out)
     out->detach_timeout_ms = lb->cfg.detach_timeout_ms;
     out->transfer_size = lb->cfg.transfer_size;
     out->bcd_dfu = DFU_BCD_VERSION;
+    out->app_capacity = dfu_app_capacity(&lb->flash);
 }
 
 static const char *lb_last_error(void *ctx)

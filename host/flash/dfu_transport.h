@@ -23,6 +23,10 @@ typedef struct dfu_func_desc {
     uint16_t detach_timeout_ms;
     uint16_t transfer_size;
     uint16_t bcd_dfu;
+    /* The largest image the device takes, in bytes; 0 = not reported. DFU 1.1 has
+     * no field for it: the loopback reports its application area, a USB device
+     * does not yet (its own check stalls the first block past the end). */
+    uint32_t app_capacity;
 } dfu_func_desc;
 
 typedef struct dfu_transport {

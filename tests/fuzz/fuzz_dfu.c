@@ -80,7 +80,7 @@ static dfu_image_err ref_parse(const uint8_t *d, size_t len, uint32_t *crc)
     if (len < DFU_SUFFIX_LEN) return DFU_IMAGE_TOO_SHORT;
     const uint8_t *s = d + len - DFU_SUFFIX_LEN;
     if (s[8] != 0x55 || s[9] != 0x46 || s[10] != 0x44) return DFU_IMAGE_NO_SIGNATURE;
-    if (s[11] < DFU_SUFFIX_LEN || s[11] > len) return DFU_IMAGE_BAD_LENGTH;
+    if (s[11] != DFU_SUFFIX_LEN) return DFU_IMAGE_BAD_LENGTH;
     *crc = ~ref_crc(d, len - 4); /* preset ~0, no final complement */
     if (*crc != rd32(s + 12)) return DFU_IMAGE_BAD_CRC;
     if ((s[6] | s[7] << 8) != DFU_SUFFIX_BCD_DFU) return DFU_IMAGE_BAD_VERSION;

@@ -252,10 +252,13 @@ static void test_parser_rejects_damage(void **state)
     f[len - 5] = 15;                                 /* bLength below 16 */
     recrc(f, len);
     assert_int_equal(dfu_image_parse(f, len, &img), DFU_IMAGE_BAD_LENGTH);
-    f[len - 5] = 255;                                /* fits: a longer suffix is allowed */
+    f[len - 5] = 255;                                /* fits, but would eat firmware bytes */
     recrc(f, len);
-    assert_int_equal(dfu_image_parse(f, len, &img), DFU_IMAGE_OK);
-    assert_int_equal(img.payload_len, len - 255);
+    assert_int_equal(dfu_image_parse(f, len, &img), DFU_IMAGE_BAD_LENGTH);
+    assert_int_equal(img.payload_len, 0);
+    f[len - 5] = 17;
+    recrc(f, len);
+    assert_int_equal(dfu_image_parse(f, len, &img), DFU_IMAGE_BAD_LENGTH);
     f[len - 5] = 16;
     f[len - 10] = 0x1A;                              /* bcdDFU 0x011A: DfuSe */
     f[len - 9] = 0x01;
@@ -484,6 +487,14 @@ static void test_device_errors(void **state)
     device_error_case(DFU_LOOP_PROGRAM, -1, FLASH_SIZE - PAGE, DFU_LOOP_CORRUPT, DFU_STATUS_ERR_VERIFY);
 }
 
+/* A transport like the loopback's that does not report the application area, as a
+ * USB device does not: the device's own check must refuse the overflow. */
+static void functional_no_capacity(void *ctx, dfu_func_desc *out)
+{
+    dfu_loop_transport((dfu_loopback *)ctx).functional(ctx, out);
+    out->app_capacity = 0;
+}
+
 static void test_image_too_large(void **state)
 {
     (void)state;
@@ -491,7 +502,20 @@ static void test_image_too_large(void **state)
     size_t n = FLASH_SIZE - PAGE + 1;           /* one byte more than the region takes */
     uint8_t *p = payload_make(n, 10);
     dfu_host_report r;
-    assert_int_equal(flash_payload(p, n, 0, &r), DFU_HOST_DEVICE_ERROR);
+    /* an old application, then an oversized image: refused before any request, so
+     * the old valid mark stays */
+    assert_int_equal(flash_payload(p, 1000, 0, &r), DFU_HOST_OK);
+    unsigned long before = lb.requests, erases = lb.erases;
+    assert_int_equal(flash_payload(p, n, 0, &r), DFU_HOST_BAD_IMAGE);
+    assert_non_null(strstr(r.msg, "do not fit"));
+    assert_int_equal(lb.requests, before);
+    assert_int_equal(lb.erases, erases);
+    assert_app_is(p, 1000);
+
+    /* without the size reported, the device stalls the block past its end */
+    dfu_transport t = dfu_loop_transport(&lb);
+    t.functional = functional_no_capacity;
+    assert_int_equal(dfu_host_download(&t, p, n, NULL, &r), DFU_HOST_DEVICE_ERROR);
     assert_int_equal(r.dev_status, DFU_STATUS_ERR_ADDRESS);
     assert_non_null(strstr(r.msg, "errADDRESS"));
     assert_int_equal(dfu_dev_state(&lb.dev), DFU_STATE_IDLE);
