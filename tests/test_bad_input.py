@@ -523,8 +523,8 @@ def dfu(payload, vid=0x1209, pid=0x0001, bcd_dfu=0x0100, length=16):
 # dwCRC, a truncated image, a missing signature, an empty and a tiny file, another product id)
 DFU = [
     ("wrong-version", dfu(b"\x11" * 1000, bcd_dfu=0x011A), ["bcdDFU is not 0x0100", "bcdDFU 011a"]),
-    ("length-too-small", dfu(b"\x11" * 1000, length=8), ["bLength", "invalid", "bLength 8"]),
-    ("length-beyond-file", dfu(b"\x11" * 10, length=200), ["bLength", "invalid", "bLength 200, file 26 bytes"]),
+    ("length-too-small", dfu(b"\x11" * 1000, length=8), ["bLength", "is not 16", "bLength 8"]),
+    ("length-beyond-file", dfu(b"\x11" * 10, length=200), ["bLength", "is not 16", "bLength 200, file 26 bytes"]),
     ("no-firmware", dfu(b""), ["no firmware before the DFU suffix"]),
     ("another-vendor", dfu(b"\x11" * 1000, vid=0x1234), ["made for another vendor id", "1234:0001"]),
 ]
