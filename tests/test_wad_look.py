@@ -10,7 +10,8 @@ import pytest
 from conftest import ROOT, program, run, freedoom
 
 sys.path.insert(0, str(ROOT / "tools"))
-from texture_bytes import flat_names, map_lumps, name8, read_wad, sections  # noqa: E402  (WAD and blob plumbing)
+from fuzz import pwad  # noqa: E402  (a WAD of the lumps given)
+from texture_bytes import flat_names, map_lumps, name8, read_wad, sections, side_texture_names  # noqa: E402
 
 SEC_LOOK, SEC_LIGHTS, SEC_TEXTURES, SEC_TEXELS, SEC_SIDES, SEC_PLANES = range(14, 20)
 SEC_LINES, SEC_SECTORS, SEC_PALETTE = 2, 1, 7
@@ -123,17 +124,7 @@ def test_look_sections_hold_exactly_what_the_map_uses(tmp_path, wad, mapname):
     # the names the map uses, as the WAD gives them (zero-length linedefs are left out)
     m = map_lumps(lumps, mapname)
     defs, flats = texture_defs(lumps), flat_names(lumps)
-    vx = [struct.unpack_from("<hh", m["VERTEXES"], 4 * i) for i in range(len(m["VERTEXES"]) // 4)]
-    walls = set()
-    for i in range(len(m["LINEDEFS"]) // 14):
-        v1, v2, _, _, _, s0, s1 = struct.unpack_from("<HHHHHHH", m["LINEDEFS"], 14 * i)
-        if vx[v1] == vx[v2]:
-            continue
-        for sd in (s0, s1):
-            if sd == 0xFFFF:
-                continue
-            r = m["SIDEDEFS"][30 * sd:30 * sd + 30]
-            walls |= {name8(r[o:o + 8]) for o in (4, 12, 20)}
+    walls = side_texture_names(m)
     used_flats, sky = set(), False
     for i in range(len(m["SECTORS"]) // 26):
         r = m["SECTORS"][26 * i:26 * i + 26]
@@ -201,15 +192,6 @@ def test_flat_leaves_the_look_out(tmp_path):
 
 
 # ---- a small WAD with damaged texture data ---------------------------------------------------
-
-def pwad(lumps):
-    body, directory, pos = b"", b"", 12
-    for name, data in lumps:
-        directory += struct.pack("<II8s", pos, len(data), name.encode())
-        body += data
-        pos += len(data)
-    return b"PWAD" + struct.pack("<II", len(lumps), pos) + body + directory
-
 
 def patch_lump(w=64, h=64, colour=5):
     cols = b"".join(bytes([0, h, 0]) + bytes([colour]) * h + bytes([0, 0xFF]) for _ in range(w))

@@ -101,13 +101,11 @@ def measure(bspc, wad, mapname, tmp):
     }
 
 
-def largest_of_map01(lumps, r):
-    """Names of MAP01's largest wall texture and flat: the WAD's names of what its sides and
-    sectors use (scene line j is the j-th linedef of non-zero length)."""
-    m = map_lumps(lumps, "MAP01")
-    sizes = texture_sizes(lumps)
+def side_texture_names(m):
+    """The texture names the sides of a map's lumps m (map_lumps) name, upper, lower and middle,
+    "-" included; linedefs of zero length are left out, as the compiler leaves them out."""
     vx = [struct.unpack_from("<hh", m["VERTEXES"], 4 * i) for i in range(len(m["VERTEXES"]) // 4)]
-    walls = set()
+    names = set()
     for i in range(len(m["LINEDEFS"]) // 14):
         v1, v2, _, _, _, s0, s1 = struct.unpack_from("<HHHHHHH", m["LINEDEFS"], 14 * i)
         if vx[v1] == vx[v2]:
@@ -115,7 +113,16 @@ def largest_of_map01(lumps, r):
         for sd in (s0, s1):
             if sd != 0xFFFF:
                 rec = m["SIDEDEFS"][30 * sd:30 * sd + 30]
-                walls |= {name8(rec[o:o + 8]) for o in (4, 12, 20)} & set(sizes)
+                names |= {name8(rec[o:o + 8]) for o in (4, 12, 20)}
+    return names
+
+
+def largest_of_map01(lumps, r):
+    """Names of MAP01's largest wall texture and flat: the WAD's names of what its sides and
+    sectors use (scene line j is the j-th linedef of non-zero length)."""
+    m = map_lumps(lumps, "MAP01")
+    sizes = texture_sizes(lumps)
+    walls = side_texture_names(m) & set(sizes)
     wall = max(sorted(walls), key=lambda n: stored_bytes(*sizes[n]))
     flats = {name8(m["SECTORS"][26 * i + 4:26 * i + 12]) for i in range(len(m["SECTORS"]) // 26)}
     flat = sorted(flats & flat_names(lumps))[0]
