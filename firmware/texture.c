@@ -69,7 +69,6 @@ static void set_texture(tex_paint *p, const scene *sc, uint32_t tex)
     p->wmask = (1u << t->wbits) - 1u;
     p->hmask = (1u << t->hbits) - 1u;
     p->lights = sc->lights;
-    p->look = 0;
 }
 
 tex_paint tex_wall(const scene *sc, const view_xform *v, const scn_side *sd, uint32_t tex, const scn_vertex *a,

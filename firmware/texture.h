@@ -10,7 +10,7 @@
  * Precision knobs (compile-time; make report measures them against the
  * reference renderer):
  *   TEX_SUBDIV_BITS  walls: depth and texture column exact every 2^k pixels
- *                    of a span, interpolated linearly between (0..6, default 4).
+ *                    of a span, interpolated linearly between (0..6, default 3).
  *   TEX_RECIP_BITS   0 (default): the depth divides are exact. 4..12: depth
  *                    from view.h's table of 2^k reciprocals and a multiply.
  *   TEX_LIGHT_BITS   light tables used: 2^k of the 32 (1..5, default 5).
@@ -57,7 +57,7 @@ typedef struct {
     int64_t dist;   /* walls: the eye's distance from the wall's line, 16.16, times 2^14 */
     int64_t dh;     /* planes: the plane's height above the eye, 16.16 */
     int32_t a, b;   /* walls: depth denominator a + sx * b; planes: cos, sin of the view; 2.30 */
-    int32_t c, d;   /* walls: texture column slope c + sx * d (2.30); planes: the same divided by 160 */
+    int32_t c, d;   /* walls: texture column slope c + sx * d (2.30); planes: sin, cos divided by 320 */
     uint32_t u0;    /* walls: texture column at the eye, 16.16; sky: the view angle */
     uint32_t v0;    /* walls: texture row at the eye's height, 16.16; planes: the eye's x, 16.16 */
     uint32_t w0;    /* planes: minus the eye's y, 16.16 */
