@@ -16,6 +16,7 @@ PACKAGES=(
   gcc-multilib                # gcc -m32 and its libgcc: the hal/pcvga kernel
   libglib2.0-dev pkg-config   # building the QEMU instruction-counting plugin
   libusb-1.0-0-dev            # host/flash: USB DFU
+  umockdev gir1.2-umockdev-1.0 libumockdev-dev python3-gi  # an emulated USB DFU device for build/flash's tests
   freedoom                    # real maps: freedoom1.wad, freedoom2.wad
   chocolate-doom              # Doom's own renderer, for make compare-doom (tools/doomcompare.py)
   zdbsp glbsp                 # other BSP compilers, for make bench-bsp
