@@ -28,7 +28,15 @@ $(eval $(call flash_variant,$(BUILD),$(REL)))
 $(eval $(call flash_variant,$(BUILD)/san,$(SAN)))
 
 all: $(BUILD)/flash
-pytest: $(BUILD)/flash $(BUILD)/san/flash
+pytest: $(BUILD)/flash $(BUILD)/san/flash $(BUILD)/libdfudev.so
+
+# The device state machine as a shared library, for the USB device emulator
+# tests/usbdfu_mock.py (ctypes): the same sources the bootloader builds, freestanding
+# and integer-only, only position-independent.
+DFUDEV_SRC := firmware/dfu/dfu_device.c firmware/dfu/dfu_proto.c firmware/crc32.c
+$(BUILD)/libdfudev.so: $(DFUDEV_SRC) firmware/dfu/dfu_device.h firmware/dfu/dfu_proto.h firmware/crc32.h
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(REL) $(FW_FLAGS) -fPIC -shared $(DFUDEV_SRC) -o $@
 
 # make flash IMAGE=fw.dfu DEVICE=1209:0001 [FLASH_ARGS="--serial SN -v"]
 # make flash IMAGE=fw.dfu LOOPBACK=1       (simulated device, no hardware)
