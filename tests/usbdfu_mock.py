@@ -248,6 +248,11 @@ class Device:
         self.enumerations += 1
         tb = self.mock.testbed
         name = f"1-{self.port}"
+        protocol = 1 if self.runtime_mode() else 2
+        # the descriptors go in with the record: libusb reads them on the "add" uevent
+        # that add_from_string sends, before a later set_attribute could land
+        descriptors = device_descriptor(self.vid, self.pid) + config_descriptor(
+            protocol, self.cfg.attributes, self.cfg.detach_timeout_ms, self.cfg.transfer_size)
         record = "\n".join([
             f"P: /devices/usb1/{name}",
             f"N: bus/usb/001/{self.devnum:03d}",
@@ -259,15 +264,9 @@ class Device:
             "A: speed=12", "A: bConfigurationValue=1", "A: bNumConfigurations=1",
             f"A: serial={self.serial}",
             f"A: devpath={self.port}",
-            f"A: dev=189:{self.devnum - 1}", ""])
+            f"A: dev=189:{self.devnum - 1}", f"H: descriptors={descriptors.hex().upper()}", ""])
         tb.add_from_string(record)
         self.syspath = f"/sys/devices/usb1/{name}"
-        protocol = 1 if self.runtime_mode() else 2
-        tb.set_attribute_binary(self.syspath, "descriptors",
-                                device_descriptor(self.vid, self.pid)
-                                + config_descriptor(protocol, self.cfg.attributes,
-                                                    self.cfg.detach_timeout_ms,
-                                                    self.cfg.transfer_size))
         self.handler = UsbfsHandler(self)
         tb.attach_ioctl(self.node, self.handler)
         self.present = True
@@ -280,6 +279,10 @@ class Device:
         self.present = False
         if self.handler:
             self.handler.gone = True
+        # remove_device() alone sends no uevent: libusb (udev monitor) would keep the
+        # old device in its list. --stale-entry leaves it out, as a slow monitor would.
+        if not self.mock.args.stale_entry:
+            self.mock.testbed.uevent(self.syspath, "remove")
         self.mock.testbed.remove_device(self.syspath)
         self.mock.log(f"device {self.index} unplugged from {self.node}")
 
@@ -580,6 +583,8 @@ def main(argv):
     ap.add_argument("--pid", type=lambda s: int(s, 16), default=0x0001)
     ap.add_argument("--region-size", type=int, default=0)
     ap.add_argument("--reenum-ms", type=int, default=300, help="how long a re-enumeration takes")
+    ap.add_argument("--stale-entry", action="store_true",
+                    help="send no 'remove' uevent when the device leaves")
     ap.add_argument("--out", help="write device 0's flash region here")
     ap.add_argument("--lib", default=str(ROOT / "build" / "libdfudev.so"))
     ap.add_argument("--limit", type=float, default=120, help="seconds before the child is killed")
