@@ -280,9 +280,8 @@ class Device:
         if self.handler:
             self.handler.gone = True
         # remove_device() alone sends no uevent: libusb (udev monitor) would keep the
-        # old device in its list. --stale-entry leaves it out, as a slow monitor would.
-        if not self.mock.args.stale_entry:
-            self.mock.testbed.uevent(self.syspath, "remove")
+        # old device in its list
+        self.mock.testbed.uevent(self.syspath, "remove")
         self.mock.testbed.remove_device(self.syspath)
         self.mock.log(f"device {self.index} unplugged from {self.node}")
 
@@ -363,7 +362,9 @@ class UsbfsHandler(UMockdev.IoctlBase):
         if name == "GETDRIVER":
             return -1, errno.ENODATA          # no kernel driver bound
         if name in ("CLAIMINTERFACE", "RELEASEINTERFACE", "SETINTERFACE", "CLEAR_HALT",
-                    "DISCONNECT_CLAIM", "SETCONFIGURATION"):
+                    "DISCONNECT_CLAIM", "SETCONFIGURATION", "IOCTL"):
+            # IOCTL: libusb's USBDEVFS_CONNECT on release (auto-detach): no kernel
+            # driver to give the interface back to
             return 0, 0
         if name == "GET_SPEED":
             return 2, 0                       # USB_SPEED_FULL
@@ -583,8 +584,6 @@ def main(argv):
     ap.add_argument("--pid", type=lambda s: int(s, 16), default=0x0001)
     ap.add_argument("--region-size", type=int, default=0)
     ap.add_argument("--reenum-ms", type=int, default=300, help="how long a re-enumeration takes")
-    ap.add_argument("--stale-entry", action="store_true",
-                    help="send no 'remove' uevent when the device leaves")
     ap.add_argument("--out", help="write device 0's flash region here")
     ap.add_argument("--lib", default=str(ROOT / "build" / "libdfudev.so"))
     ap.add_argument("--limit", type=float, default=120, help="seconds before the child is killed")
