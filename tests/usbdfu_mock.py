@@ -15,7 +15,7 @@ own stdout and stderr are captured into the summary) and, with --out, writes dev
 flash region to a file.
 
 The flash region has the display board's application-slot geometry by default
-(docs: notes layout, 4,128,768 bytes in 4,096-byte pages, erased 0xFF). Time for the
+(4,128,768 bytes in 4,096-byte pages, erased 0xFF). Time for the
 state machine is the real monotonic clock in milliseconds: build/flash really waits
 the bwPollTimeout the device asks for.
 
@@ -50,7 +50,6 @@ import struct
 import subprocess
 import sys
 import time
-import zlib
 from pathlib import Path
 
 import gi
