@@ -79,6 +79,15 @@ static int step(engine *e, uint32_t input, uint32_t dt_ms)
     return -1;
 }
 
+/* The frames in flight acknowledged (at most the ack timeout): 0, or 1 after
+ * a message when the link had stopped. */
+static int finish_link(void)
+{
+    if (!link || link_finish(link) == 0) return 0;
+    fprintf(stderr, "emu: --link %s\n", link_error(link));
+    return 1;
+}
+
 /* The camera and time of the last frame, as build/render options. */
 static void print_view(const engine *e)
 {
@@ -127,6 +136,7 @@ static int run_headless(engine *e, const char *dir, long frames)
             return 1;
         }
     }
+    if (finish_link() != 0) return 1;
     if (dir)
         printf("emu: wrote %ld frames of a turn around the start to %s/frame_000.png .. frame_%03ld.png\n", frames,
                dir, frames - 1);
@@ -220,6 +230,7 @@ int main(int argc, char **argv)
         rc = 1;
     } else if (!headless && hal_sdl_init(scale, "bspvga") == 0) {
         rc = run_window(&e, frames);
+        if (rc == 0) rc = finish_link();
         hal_sdl_quit();
     } else {
         if (!headless)
@@ -228,10 +239,6 @@ int main(int argc, char **argv)
         rc = run_headless(&e, out, frames > 0 ? frames : FLY_FRAMES);
     }
     if (link) {
-        if (rc == 0 && link_finish(link) != 0) {
-            fprintf(stderr, "emu: --link %s\n", link_error(link));
-            rc = 1;
-        }
         link_print_summary(link, stdout);
         link_close(link);
     }
