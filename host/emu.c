@@ -49,7 +49,7 @@ static const char usage[] =
 #define FLY_FRAMES 36
 #define FLY_STEP_MS 83 /* a tenth of a turn per frame at the camera's turn speed */
 
-static link_sender *link; /* --link: the display board the frames also go to */
+static link_sender *linked; /* --link: the display board the frames also go to */
 
 static void print_counters(const engine *e)
 {
@@ -57,8 +57,8 @@ static void print_counters(const engine *e)
     for (int ev = 0; ev < HAL_EV_COUNT; ev++)
         printf(" %s=%llu", hal_event_name((hal_event)ev), (unsigned long long)hal_perf_event((hal_event)ev));
     printf(" bus_cycles=%llu", (unsigned long long)hal_perf_tsc());
-    if (link) {
-        const fl_encoder *en = &link->enc;
+    if (linked) {
+        const fl_encoder *en = &linked->enc;
         printf(" link_bytes=%u link_frames=%u link_keyframes=%u link_deltas=%u link_acks=%u link_timeouts=%u",
                (unsigned)en->bytes, (unsigned)en->frames, (unsigned)en->keyframes, (unsigned)en->deltas,
                (unsigned)en->acks, (unsigned)en->timeouts);
@@ -72,10 +72,10 @@ static void print_counters(const engine *e)
 static int step(engine *e, uint32_t input, uint32_t dt_ms)
 {
     eng_step(e, input, dt_ms);
-    if (!link) return 0;
+    if (!linked) return 0;
     fl_frame_info info = link_info_of(e);
-    if (link_frame(link, e->frame - 1u, hal_shown_page(), hal_get_palette(), &info) == 0) return 0;
-    fprintf(stderr, "emu: --link %s\n", link_error(link));
+    if (link_frame(linked, e->frame - 1u, hal_shown_page(), hal_get_palette(), &info) == 0) return 0;
+    fprintf(stderr, "emu: --link %s\n", link_error(linked));
     return -1;
 }
 
@@ -83,8 +83,8 @@ static int step(engine *e, uint32_t input, uint32_t dt_ms)
  * a message when the link had stopped. */
 static int finish_link(void)
 {
-    if (!link || link_finish(link) == 0) return 0;
-    fprintf(stderr, "emu: --link %s\n", link_error(link));
+    if (!linked || link_finish(linked) == 0) return 0;
+    fprintf(stderr, "emu: --link %s\n", link_error(linked));
     return 1;
 }
 
@@ -192,7 +192,7 @@ int main(int argc, char **argv)
             fprintf(stderr, "emu: --link %s\n", err);
             return 2;
         }
-        link = &the_link;
+        linked = &the_link;
     }
     uint8_t *blob = NULL;
     size_t len = default_scene_len;
@@ -225,8 +225,8 @@ int main(int argc, char **argv)
     }
 
     int rc = 0;
-    if (link && link_hello(link) != 0) {
-        fprintf(stderr, "emu: --link %s\n", link_error(link));
+    if (linked && link_hello(linked) != 0) {
+        fprintf(stderr, "emu: --link %s\n", link_error(linked));
         rc = 1;
     } else if (!headless && hal_sdl_init(scale, "bspvga") == 0) {
         rc = run_window(&e, frames);
@@ -235,12 +235,12 @@ int main(int argc, char **argv)
     } else {
         if (!headless)
             printf("emu: no display available (%s); rendering a fly-through headless instead\n", hal_sdl_error());
-        if (!out && !link) out = "build/flythrough";
+        if (!out && !linked) out = "build/flythrough";
         rc = run_headless(&e, out, frames > 0 ? frames : FLY_FRAMES);
     }
-    if (link) {
-        link_print_summary(link, stdout);
-        link_close(link);
+    if (linked) {
+        link_print_summary(linked, stdout);
+        link_close(linked);
     }
     free(work);
     free(blob);

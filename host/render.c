@@ -437,7 +437,7 @@ static void print_fx(const char *key, int32_t v, const char *sep)
     printf("\"%s\": %s%s", key, buf, sep);
 }
 
-static void print_json(const options *o, const engine *e, uint32_t crc, const link_sender *link)
+static void print_json(const options *o, const engine *e, uint32_t crc, const link_sender *sender)
 {
     const camera *c = &e->cam.view;
     uint64_t pixels = hal_perf_event(HAL_EV_PIXELS);
@@ -493,9 +493,9 @@ static void print_json(const options *o, const engine *e, uint32_t crc, const li
         first = 0;
     }
     printf("}");
-    if (link) {
+    if (sender) {
         printf(", \"link\": ");
-        link_print_json(link, stdout);
+        link_print_json(sender, stdout);
     }
     printf("}\n");
 }
@@ -527,8 +527,8 @@ int main(int argc, char **argv)
 
     char err[512];
     /* the port first: a PORT that does not open is a bad option, found before any work */
-    static link_sender link;
-    if (o.link && link_open(&link, o.link, o.baud, err, sizeof err) != 0) {
+    static link_sender sender;
+    if (o.link && link_open(&sender, o.link, o.baud, err, sizeof err) != 0) {
         fprintf(stderr, "render: --link %s\n", err);
         return 2;
     }
@@ -629,9 +629,9 @@ int main(int argc, char **argv)
             failed = fprintf(stderr, "render: %s: cannot write id buffer: %s\n", o.ids, strerror(errno));
         free(bytes);
     }
-    if (o.link && send_link(&link, &e, frame) != 0) failed = 1;
-    print_json(&o, &e, crc, o.link ? &link : NULL);
-    if (o.link) link_close(&link);
+    if (o.link && send_link(&sender, &e, frame) != 0) failed = 1;
+    print_json(&o, &e, crc, o.link ? &sender : NULL);
+    if (o.link) link_close(&sender);
     free(ids);
     free(file_objs);
     free(work);
