@@ -9,6 +9,7 @@ import json
 import os
 import re
 import select
+import shutil
 import socket
 import subprocess
 import sys
@@ -291,3 +292,24 @@ def test_help_names_link():
     for name in ("render", "emu"):
         proc = run([program(name, sanitized=False), "--help"])
         assert "--link PORT" in proc.stdout and "socket://HOST:PORT" in proc.stdout
+
+
+def test_emu_window_under_xvfb_sends_its_frames(tmp_path):
+    """The window run sends every frame it shows, as the headless one does."""
+    assert shutil.which("xvfb-run"), "xvfb-run missing: run make deps"
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY", "SDL_VIDEODRIVER")}
+    env["XDG_RUNTIME_DIR"] = "/tmp"
+    frames = 5
+    relay = Relay()
+    board = subprocess.Popen([program("display"), relay.dst_url, "--png", str(tmp_path / "png"), "--frames",
+                              str(frames), "--json", "--idle-timeout", "20"], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)
+    emu = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", program("emu", sanitized=False), DEFAULT,
+                          "--frames", str(frames), "--link", relay.src_url], capture_output=True, text=True, env=env,
+                         timeout=120)
+    out, err = board.communicate(timeout=60)
+    assert emu.returncode == 0, emu.stdout + emu.stderr
+    assert "no display available" not in emu.stdout
+    assert board.returncode == 0, err
+    assert json.loads(out)["frames_shown"] == frames
+    assert f"link {relay.src_url}: {frames} frames" in emu.stdout
