@@ -25,7 +25,9 @@ HAL_SRC   := hal/fb.c hal/perf.c
 NULL_SRC  := hal/ram_target.c hal/null/hal_null.c
 SDL_SRC   := hal/ram_target.c hal/sdl/hal_sdl.c
 BSPC_LIB  := $(filter-out tools/bspc/main.c,$(sort $(wildcard tools/bspc/*.c)))
-HOST_LIB  := host/png.c host/scene_file.c
+# The host programs' shared files; the frame link's sender (host/link_send.c,
+# build/render and build/emu --link) brings the link's sources along.
+HOST_LIB   = host/png.c host/scene_file.c host/port.c host/link_send.c $(sort $(LINK_SRC))
 FLOATFREE := firmware/% hal/fb.c hal/perf.c hal/ram_target.c hal/null/% hal/serial/% hal/mps2/% hal/bare/% hal/pcvga/% $(GEN)/%
 
 # Each subsystem with rules of its own keeps them in mk/NAME.mk. They may add
@@ -56,7 +58,7 @@ $(1)/render: $(call objs,$(1)/obj,host/render.c $(HOST_LIB) $(BSPC_LIB) $(FW_SRC
 	$$(CC) $(2) $$^ -o $$@ -lm
 $(1)/emu: $(call objs,$(1)/obj,host/emu.c $(GEN)/default_scene.c $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(SDL_SRC))
 	$$(CC) $(2) $$^ -o $$@ $$(SDL_LIBS) -lm
-$(1)/display: $(call objs,$(1)/obj,host/display.c host/png.c firmware/crc32.c $(HAL_SRC) $(SDL_SRC) $(sort $(LINK_SRC)))
+$(1)/display: $(call objs,$(1)/obj,host/display.c host/png.c host/port.c firmware/crc32.c $(HAL_SRC) $(SDL_SRC) $(sort $(LINK_SRC)))
 	$$(CC) $(2) $$^ -o $$@ $$(SDL_LIBS)
 # test_planar brings its own fake VGA target (hal_target_*): only fb.c and perf.c beside it
 $(1)/test_planar: $(call objs,$(1)/obj,tests/unit/test_planar.c $(HAL_SRC))

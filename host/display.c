@@ -4,15 +4,11 @@
  * requests, and shows each frame that passed every check in an SDL window or
  * writes it as a PNG file. Prints what it received. */
 #include <errno.h>
-#include <fcntl.h>
-#include <netdb.h>
 #include <poll.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/socket.h>
 #include <sys/stat.h>
-#include <termios.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -20,6 +16,7 @@
 #include "hal.h"
 #include "hal_sdl.h"
 #include "png.h"
+#include "port.h"
 
 static const char usage[] =
     "usage: display PORT [--png DIR] [--frames N] [--idle-timeout S] [--baud B] [--window] [--json]\n"
@@ -127,88 +124,6 @@ static void on_event(void *ctx, const fl_event *ev)
     }
 }
 
-static int open_socket(const char *spec, char *err, size_t errlen)
-{
-    char host[256];
-    const char *colon = strrchr(spec, ':');
-    if (!colon || colon == spec || (size_t)(colon - spec) >= sizeof host) {
-        snprintf(err, errlen, "socket://%s: expected socket://HOST:PORT", spec);
-        return -1;
-    }
-    memcpy(host, spec, (size_t)(colon - spec));
-    host[colon - spec] = '\0';
-    struct addrinfo hints = {0}, *res = NULL;
-    hints.ai_socktype = SOCK_STREAM;
-    int rc = getaddrinfo(host, colon + 1, &hints, &res);
-    if (rc != 0) {
-        snprintf(err, errlen, "socket://%s: %s", spec, gai_strerror(rc));
-        return -1;
-    }
-    int fd = -1;
-    for (struct addrinfo *a = res; a && fd < 0; a = a->ai_next) {
-        fd = socket(a->ai_family, a->ai_socktype, a->ai_protocol);
-        if (fd >= 0 && connect(fd, a->ai_addr, a->ai_addrlen) != 0) {
-            snprintf(err, errlen, "socket://%s: cannot connect: %s", spec, strerror(errno));
-            close(fd);
-            fd = -1;
-        }
-    }
-    freeaddrinfo(res);
-    return fd;
-}
-
-static speed_t baud_code(long baud)
-{
-    switch (baud) {
-    case 9600: return B9600;
-    case 19200: return B19200;
-    case 38400: return B38400;
-    case 57600: return B57600;
-    case 115200: return B115200;
-    case 230400: return B230400;
-    case 460800: return B460800;
-    case 921600: return B921600;
-    default: return 0;
-    }
-}
-
-/* Open PORT; sets *writable when acks can be sent back on it. */
-static int open_port(const char *port, long baud, int *writable, char *err, size_t errlen)
-{
-    *writable = 0;
-    if (!strcmp(port, "-")) return 0;
-    if (!strncmp(port, "socket://", 9)) {
-        int fd = open_socket(port + 9, err, errlen);
-        *writable = fd >= 0;
-        return fd;
-    }
-    int fd = open(port, O_RDWR | O_NOCTTY);
-    if (fd < 0 && (errno == EACCES || errno == EROFS || errno == EISDIR)) fd = open(port, O_RDONLY);
-    else if (fd >= 0) *writable = 1;
-    if (fd < 0) {
-        snprintf(err, errlen, "%s: cannot open: %s", port, strerror(errno));
-        return -1;
-    }
-    struct stat st;
-    if (fstat(fd, &st) == 0 && S_ISREG(st.st_mode)) *writable = 0; /* a captured stream */
-    if (isatty(fd)) {
-        struct termios t;
-        speed_t sp = baud_code(baud);
-        if (!sp) {
-            snprintf(err, errlen, "%s: unsupported speed %ld", port, baud);
-            close(fd);
-            return -1;
-        }
-        if (tcgetattr(fd, &t) == 0) {
-            cfmakeraw(&t);
-            cfsetispeed(&t, sp);
-            cfsetospeed(&t, sp);
-            tcsetattr(fd, TCSANOW, &t);
-        }
-    }
-    return fd;
-}
-
 static void print_summary(const board *b, int json)
 {
     const fl_counters *c = &b->dec.count;
@@ -277,7 +192,7 @@ int main(int argc, char **argv)
     static board b;
     static uint8_t frame[FL_FRAME_BYTES], work[FL_DEC_WORK_BYTES];
     const char *port = NULL;
-    long idle_s = 10, baud = 115200;
+    long idle_s = 10, baud = PORT_DEFAULT_BAUD;
     int json = 0, want_window = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -322,7 +237,7 @@ int main(int argc, char **argv)
         b.window = 0;
     }
     char err[512];
-    b.fd = open_port(port, baud, &b.writable, err, sizeof err);
+    b.fd = port_open(port, baud, &b.writable, err, sizeof err);
     if (b.fd < 0) {
         fprintf(stderr, "display: %s\n", err);
         return 1;

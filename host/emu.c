@@ -1,6 +1,7 @@
 /* emu.c - build/emu: the host-emulated run. The firmware engine on the SDL target:
  * a window scaled up, keyboard input, counters on demand. Without a display it
- * says so and renders a short scripted fly-through to PNG files instead. */
+ * says so and renders a short scripted fly-through to PNG files instead. With
+ * --link it also sends every frame over the frame link to a display board. */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -8,16 +9,20 @@
 #include <sys/stat.h>
 
 #include "engine.h"
+#include "fxtext.h"
 #include "hal.h"
 #include "hal_sdl.h"
+#include "link_info.h"
+#include "link_send.h"
 #include "png.h"
+#include "port.h"
 #include "scene_file.h"
 
 extern const uint8_t default_scene[];
 extern const uint32_t default_scene_len;
 
 static const char usage[] =
-    "usage: emu [SCENE] [--scale N] [--frames N] [--headless] [--out DIR] [--flat]\n"
+    "usage: emu [SCENE] [--scale N] [--frames N] [--headless] [--out DIR] [--flat] [--link PORT]\n"
     "\n"
     "Walk through SCENE (default: the built-in scene) in a window.\n"
     "SCENE is a compiled scene, a text scene, or FILE.wad:MAP (e.g. freedoom2.wad:MAP01).\n"
@@ -29,21 +34,70 @@ static const char usage[] =
     "\n"
     "  --scale N     window size factor (default 3)\n"
     "  --flat        draw a textured scene (a WAD map) in flat colours\n"
-    "  --frames N    quit after N frames (default: run until Esc)\n"
-    "  --headless    do not open a window: render the fly-through to PNG files\n"
-    "  --out DIR     where the headless fly-through goes (default build/flythrough)\n"
+    "  --frames N    quit after N frames (default: run until Esc; headless: 36)\n"
+    "  --headless    do not open a window: render a fly-through (a turn on the spot)\n"
+    "                to PNG files\n"
+    "  --out DIR     where the headless fly-through goes (default build/flythrough;\n"
+    "                with --link, PNG files only when --out is given)\n"
+    "  --link PORT   also send every frame over the frame link (docs/frame-link.md) to\n"
+    "                a display board: PORT as build/display takes it, a tty or pty\n"
+    "                (set raw at --baud) or socket://HOST:PORT. The counters gain the\n"
+    "                link's bytes, frames, keyframes, deltas and acks\n"
+    "  --baud B      serial speed for a tty PORT (default 115200)\n"
     "  -h, --help    this text\n";
 
 #define FLY_FRAMES 36
 #define FLY_STEP_MS 83 /* a tenth of a turn per frame at the camera's turn speed */
+
+static link_sender *linked; /* --link: the display board the frames also go to */
 
 static void print_counters(const engine *e)
 {
     printf("frame %u mode %s present %s:", e->frame, render_mode_name(e->mode), hal_present_name(e->present));
     for (int ev = 0; ev < HAL_EV_COUNT; ev++)
         printf(" %s=%llu", hal_event_name((hal_event)ev), (unsigned long long)hal_perf_event((hal_event)ev));
-    printf(" bus_cycles=%llu\n", (unsigned long long)hal_perf_tsc());
+    printf(" bus_cycles=%llu", (unsigned long long)hal_perf_tsc());
+    if (linked) {
+        const fl_encoder *en = &linked->enc;
+        printf(" link_bytes=%u link_frames=%u link_keyframes=%u link_deltas=%u link_acks=%u link_timeouts=%u",
+               (unsigned)en->bytes, (unsigned)en->frames, (unsigned)en->keyframes, (unsigned)en->deltas,
+               (unsigned)en->acks, (unsigned)en->timeouts);
+    }
+    printf("\n");
     fflush(stdout);
+}
+
+/* One frame: drawn and presented (eng_step), then sent when linked.
+ * 0, or -1 after a message when the link stopped. */
+static int step(engine *e, uint32_t input, uint32_t dt_ms)
+{
+    eng_step(e, input, dt_ms);
+    if (!linked) return 0;
+    fl_frame_info info = link_info_of(e);
+    if (link_frame(linked, e->frame - 1u, hal_shown_page(), hal_get_palette(), &info) == 0) return 0;
+    fprintf(stderr, "emu: --link %s\n", link_error(linked));
+    return -1;
+}
+
+/* The frames in flight acknowledged (at most the ack timeout): 0, or 1 after
+ * a message when the link had stopped. */
+static int finish_link(void)
+{
+    if (!linked || link_finish(linked) == 0) return 0;
+    fprintf(stderr, "emu: --link %s\n", link_error(linked));
+    return 1;
+}
+
+/* The camera and time of the last frame, as build/render options. */
+static void print_view(const engine *e)
+{
+    char x[48], y[48], z[48], a[48];
+    fxtext_format(e->cam.view.x, x, sizeof x);
+    fxtext_format(e->cam.view.y, y, sizeof y);
+    fxtext_format(e->cam.view.z, z, sizeof z);
+    fxtext_format(e->cam.view.angle_deg, a, sizeof a);
+    printf("emu: frame %u as build/render draws it: --at %s,%s,%s --angle %s --look %d --time %u\n", e->frame - 1u,
+           x, y, z, a, (int)e->cam.view.look, (unsigned)e->t_ms);
 }
 
 static int run_window(engine *e, long frames)
@@ -58,38 +112,43 @@ static int run_window(engine *e, long frames)
         if (dt < 1) dt = 1;
         if (dt > 100) dt = 100;
         hal_perf_reset();
-        eng_step(e, input, dt);
+        if (step(e, input, dt) != 0) return 1;
         if (input & HAL_KEY_PRINT_COUNTERS) print_counters(e);
     }
     return 0;
 }
 
-static int run_headless(engine *e, const char *dir)
+/* frames of a turn on the spot; to PNG files in dir unless dir is NULL */
+static int run_headless(engine *e, const char *dir, long frames)
 {
-    if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
+    if (dir && mkdir(dir, 0777) != 0 && errno != EEXIST) {
         fprintf(stderr, "emu: %s: cannot create: %s\n", dir, strerror(errno));
         return 1;
     }
     char path[4096];
-    for (int i = 0; i < FLY_FRAMES; i++) {
+    for (long i = 0; i < frames; i++) {
         hal_perf_reset();
-        eng_step(e, i == 0 ? 0 : HAL_KEY_TURN_LEFT, i == 0 ? 1 : FLY_STEP_MS);
-        snprintf(path, sizeof path, "%s/frame_%03d.png", dir, i);
+        if (step(e, i == 0 ? 0 : HAL_KEY_TURN_LEFT, i == 0 ? 1 : FLY_STEP_MS) != 0) return 1;
+        if (!dir) continue;
+        snprintf(path, sizeof path, "%s/frame_%03ld.png", dir, i);
         if (png_write_indexed(path, hal_shown_page(), HAL_WIDTH, HAL_HEIGHT, hal_get_palette()) != 0) {
             fprintf(stderr, "emu: %s: cannot write: %s\n", path, strerror(errno));
             return 1;
         }
     }
-    printf("emu: wrote %d frames of a turn around the start to %s/frame_000.png .. frame_%03d.png\n", FLY_FRAMES, dir,
-           FLY_FRAMES - 1);
+    if (finish_link() != 0) return 1;
+    if (dir)
+        printf("emu: wrote %ld frames of a turn around the start to %s/frame_000.png .. frame_%03ld.png\n", frames,
+               dir, frames - 1);
     print_counters(e);
+    print_view(e);
     return 0;
 }
 
 int main(int argc, char **argv)
 {
-    const char *spec = NULL, *out = "build/flythrough";
-    long frames = 0;
+    const char *spec = NULL, *out = NULL, *port = NULL;
+    long frames = 0, baud = PORT_DEFAULT_BAUD;
     int scale = HAL_SDL_DEFAULT_SCALE, headless = 0, flat = 0;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
@@ -105,6 +164,15 @@ int main(int argc, char **argv)
             frames = atol(argv[++i]);
         } else if (i + 1 < argc && !strcmp(argv[i], "--out")) {
             out = argv[++i];
+        } else if (i + 1 < argc && !strcmp(argv[i], "--link")) {
+            port = argv[++i];
+        } else if (i + 1 < argc && !strcmp(argv[i], "--baud")) {
+            char *end;
+            baud = strtol(argv[++i], &end, 10);
+            if (*end || baud <= 0) {
+                fprintf(stderr, "emu: --baud '%s': expected a speed in bits per second\n", argv[i]);
+                return 2;
+            }
         } else if (argv[i][0] == '-') {
             fprintf(stderr, "emu: unknown option '%s' (see --help)\n", argv[i]);
             return 2;
@@ -116,10 +184,19 @@ int main(int argc, char **argv)
         }
     }
 
+    char err[512];
+    /* the port first: a PORT that does not open is a bad option, found before any work */
+    static link_sender the_link;
+    if (port) {
+        if (link_open(&the_link, port, baud, err, sizeof err) != 0) {
+            fprintf(stderr, "emu: --link %s\n", err);
+            return 2;
+        }
+        linked = &the_link;
+    }
     uint8_t *blob = NULL;
     size_t len = default_scene_len;
     const void *data = default_scene;
-    char err[512];
     if (spec) {
         bspc_options opt = bspc_defaults();
         if (scene_file_load(spec, &opt, &blob, &len, err, sizeof err) != 0) {
@@ -147,14 +224,23 @@ int main(int argc, char **argv)
         return 1;
     }
 
-    int rc;
-    if (!headless && hal_sdl_init(scale, "bspvga") == 0) {
+    int rc = 0;
+    if (linked && link_hello(linked) != 0) {
+        fprintf(stderr, "emu: --link %s\n", link_error(linked));
+        rc = 1;
+    } else if (!headless && hal_sdl_init(scale, "bspvga") == 0) {
         rc = run_window(&e, frames);
+        if (rc == 0) rc = finish_link();
         hal_sdl_quit();
     } else {
         if (!headless)
             printf("emu: no display available (%s); rendering a fly-through headless instead\n", hal_sdl_error());
-        rc = run_headless(&e, out);
+        if (!out && !linked) out = "build/flythrough";
+        rc = run_headless(&e, out, frames > 0 ? frames : FLY_FRAMES);
+    }
+    if (linked) {
+        link_print_summary(linked, stdout);
+        link_close(linked);
     }
     free(work);
     free(blob);

@@ -12,8 +12,11 @@
 #include "fxtext.h"
 #include "hal.h"
 #include "hal_null.h"
+#include "link_info.h"
+#include "link_send.h"
 #include "objects.h"
 #include "png.h"
+#include "port.h"
 #include "scene_file.h"
 
 static const char usage[] =
@@ -43,6 +46,11 @@ static const char usage[] =
     "  --flat             draw a textured scene (a WAD map) in flat colours\n"
     "  --repeat N         render the same frame N times (default 1); counters are\n"
     "                     those of the last frame\n"
+    "  --link PORT        also send the frame over the frame link (docs/frame-link.md)\n"
+    "                     to a display board: PORT as build/display takes it, a tty or\n"
+    "                     pty (set raw at --baud) or socket://HOST:PORT. The JSON gains\n"
+    "                     \"link\": the link's bytes, frames, keyframes, deltas, acks\n"
+    "  --baud B           serial speed for a tty PORT (default 115200)\n"
     "  -h, --help         this text\n"
     "\n"
     "Moving objects and doors (docs/objects.md):\n"
@@ -80,6 +88,8 @@ typedef struct {
     uint32_t time_ms;
     int have_time, no_objects, flat;
     const char *objects; /* --objects FILE */
+    const char *link;    /* --link PORT */
+    long baud;
     door_opt *doors;     /* room for every argument */
     int ndoors;
 } options;
@@ -167,6 +177,12 @@ static int parse_args(options *o, int argc, char **argv)
                 return die("--time '%s': expected whole milliseconds 0..4294967295%s", val, "");
             o->time_ms = (uint32_t)v;
             o->have_time = 1;
+        } else if (!strcmp(a, "--link")) {
+            o->link = val;
+        } else if (!strcmp(a, "--baud")) {
+            char *end;
+            o->baud = strtol(val, &end, 10);
+            if (*end || o->baud <= 0) return die("--baud '%s': expected a speed in bits per second%s", val, "");
         } else if (!strcmp(a, "--objects")) {
             o->objects = val;
         } else if (!strcmp(a, "--door")) {
@@ -421,7 +437,7 @@ static void print_fx(const char *key, int32_t v, const char *sep)
     printf("\"%s\": %s%s", key, buf, sep);
 }
 
-static void print_json(const options *o, const engine *e, uint32_t crc)
+static void print_json(const options *o, const engine *e, uint32_t crc, const link_sender *sender)
 {
     const camera *c = &e->cam.view;
     uint64_t pixels = hal_perf_event(HAL_EV_PIXELS);
@@ -476,7 +492,23 @@ static void print_json(const options *o, const engine *e, uint32_t crc)
         print_fx(key, h, "");
         first = 0;
     }
-    printf("}}\n");
+    printf("}");
+    if (sender) {
+        printf(", \"link\": ");
+        link_print_json(sender, stdout);
+    }
+    printf("}\n");
+}
+
+/* --link: hello, palette and the frame as a keyframe, then its ack awaited
+ * (at most the ack timeout). 0, or -1 after a message naming the port. */
+static int send_link(link_sender *l, const engine *e, const uint8_t *frame)
+{
+    fl_frame_info info = link_info_of(e);
+    if (link_hello(l) == 0 && link_frame(l, 0, frame, hal_get_palette(), &info) == 0 && link_finish(l) == 0)
+        return 0;
+    fprintf(stderr, "render: --link %s\n", link_error(l));
+    return -1;
 }
 
 int main(int argc, char **argv)
@@ -487,12 +519,19 @@ int main(int argc, char **argv)
     o.present = HAL_PRESENT_FLIP;
     o.bspc = bspc_defaults();
     o.repeat = 1;
+    o.baud = PORT_DEFAULT_BAUD;
     door_opt doors[argc > 0 ? argc : 1];
     o.doors = doors;
     int rc = parse_args(&o, argc, argv);
     if (rc) return rc;
 
     char err[512];
+    /* the port first: a PORT that does not open is a bad option, found before any work */
+    static link_sender sender;
+    if (o.link && link_open(&sender, o.link, o.baud, err, sizeof err) != 0) {
+        fprintf(stderr, "render: --link %s\n", err);
+        return 2;
+    }
     uint8_t *blob;
     size_t len;
     if (scene_file_load(o.scene, &o.bspc, &blob, &len, err, sizeof err) != 0) {
@@ -590,7 +629,9 @@ int main(int argc, char **argv)
             failed = fprintf(stderr, "render: %s: cannot write id buffer: %s\n", o.ids, strerror(errno));
         free(bytes);
     }
-    print_json(&o, &e, crc);
+    if (o.link && send_link(&sender, &e, frame) != 0) failed = 1;
+    print_json(&o, &e, crc, o.link ? &sender : NULL);
+    if (o.link) link_close(&sender);
     free(ids);
     free(file_objs);
     free(work);

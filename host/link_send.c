@@ -1,0 +1,224 @@
+/* link_send.c - the host's frame-link present (see link_send.h). */
+#include "link_send.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "crc32.h"
+#include "port.h"
+
+static uint32_t now_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (uint32_t)((uint64_t)t.tv_sec * 1000u + (uint64_t)t.tv_nsec / 1000000u);
+}
+
+static void stop(link_sender *l, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void stop(link_sender *l, const char *fmt, ...)
+{
+    if (l->failed) return;
+    l->failed = 1;
+    int n = snprintf(l->err, sizeof l->err, "%s: ", l->port);
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(l->err + n, sizeof l->err - (size_t)n, fmt, ap);
+    va_end(ap);
+}
+
+static int receiver_gone(int err)
+{
+    return err == EPIPE || err == ECONNRESET || err == EIO || err == ENOTCONN || err == ENXIO;
+}
+
+/* Take what the receiver sent, without waiting, into pending (the encoder is
+ * fed between frames, never in the middle of one). EOF: it closed its end. */
+static void read_back(link_sender *l)
+{
+    while (!l->closed && l->npending < sizeof l->pending) {
+        ssize_t n = read(l->fd, l->pending + l->npending, sizeof l->pending - l->npending);
+        if (n > 0) {
+            l->npending += (uint32_t)n;
+        } else if (n < 0 && errno == EINTR) {
+            continue;
+        } else if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+            return;
+        } else {
+            l->closed = 1; /* EOF, or EIO from a pty whose other end closed */
+        }
+    }
+}
+
+static void feed_back(link_sender *l)
+{
+    fl_encoder *e = &l->enc;
+    uint32_t before = e->acks + e->keyreqs + e->palette_reqs;
+    read_back(l);
+    if (l->npending) fl_enc_receive(e, l->pending, l->npending);
+    l->npending = 0;
+    if (e->acks + e->keyreqs + e->palette_reqs != before) l->heard = 1;
+}
+
+/* The encoder's output: written out whole, waiting on the port (and reading
+ * what comes back meanwhile) while the receiver's buffers are full. */
+static void put(void *ctx, const uint8_t *p, uint32_t n)
+{
+    link_sender *l = ctx;
+    while (n > 0 && !l->failed) {
+        ssize_t w = write(l->fd, p, n);
+        if (w > 0) {
+            p += w;
+            n -= (uint32_t)w;
+            continue;
+        }
+        if (w < 0 && errno == EINTR) continue;
+        if (w < 0 && receiver_gone(errno)) {
+            stop(l, "the receiver went away (%s)", strerror(errno));
+            return;
+        }
+        if (w < 0 && errno != EAGAIN && errno != EWOULDBLOCK) {
+            stop(l, "cannot write: %s", strerror(errno));
+            return;
+        }
+        struct pollfd pf = {l->fd, (short)(POLLOUT | (l->npending < sizeof l->pending ? POLLIN : 0)), 0};
+        int r = poll(&pf, 1, LINK_STALL_MS);
+        if (r < 0 && errno == EINTR) continue;
+        if (r == 0) {
+            stop(l, "the receiver took no bytes for %d s", LINK_STALL_MS / 1000);
+            return;
+        }
+        if (pf.revents & POLLIN) read_back(l);
+        if ((pf.revents & (POLLERR | POLLHUP | POLLNVAL)) && !(pf.revents & POLLOUT)) {
+            stop(l, "the receiver went away");
+            return;
+        }
+    }
+}
+
+int link_open(link_sender *l, const char *port, long baud, char *err, size_t errlen)
+{
+    memset(l, 0, sizeof *l);
+    l->port = port;
+    int writable;
+    l->fd = port_open(port, baud, &writable, err, errlen);
+    if (l->fd < 0) return -1;
+    if (!writable) {
+        snprintf(err, errlen, "%s: frames cannot be sent on it (expected a tty, a pty or socket://HOST:PORT)",
+                 port);
+        if (l->fd > 0) close(l->fd);
+        return -1;
+    }
+    int flags = fcntl(l->fd, F_GETFL);
+    if (flags < 0 || fcntl(l->fd, F_SETFL, flags | O_NONBLOCK) != 0) {
+        snprintf(err, errlen, "%s: cannot make it non-blocking: %s", port, strerror(errno));
+        close(l->fd);
+        return -1;
+    }
+    signal(SIGPIPE, SIG_IGN);
+    fl_enc_init(&l->enc, put, l, l->scratch, sizeof l->scratch);
+    return 0;
+}
+
+int link_hello(link_sender *l)
+{
+    if (l->failed) return -1;
+    fl_enc_hello(&l->enc);
+    return l->failed ? -1 : 0;
+}
+
+/* Flow control once the receiver has answered (as the firmware's AUTO): a
+ * full window is waited out on the port, at most the encoder's ack timeout. */
+static void wait_window(link_sender *l)
+{
+    feed_back(l);
+    if (!l->heard) return;
+    while (!l->failed && !l->closed && !fl_enc_may_send(&l->enc, now_ms())) {
+        struct pollfd pf = {l->fd, POLLIN, 0};
+        int r = poll(&pf, 1, (int)l->enc.ack_timeout_ms);
+        if (r < 0 && errno != EINTR) {
+            stop(l, "cannot wait for acks: %s", strerror(errno));
+            return;
+        }
+        feed_back(l);
+    }
+}
+
+int link_frame(link_sender *l, uint32_t frame_no, const uint8_t *pixels, const uint8_t *palette,
+               const fl_frame_info *info)
+{
+    wait_window(l);
+    if (l->closed) stop(l, "the receiver closed the link");
+    if (l->failed) return -1;
+    if (!l->palette_sent || memcmp(l->palette, palette, sizeof l->palette)) {
+        memcpy(l->palette, palette, sizeof l->palette); /* the encoder keeps the pointer for requests */
+        fl_enc_palette(&l->enc, l->palette);
+        l->palette_sent = 1;
+    }
+    fl_frame_info fi = *info;
+    fi.crc = crc_update(0, pixels, FL_FRAME_BYTES);
+    fi.no_crc = 0;
+    int delta = l->have_prev && l->prev_no == frame_no - 1u;
+    fl_enc_frame(&l->enc, frame_no, pixels, delta ? l->prev : NULL, frame_no - 1u, &fi);
+    memcpy(l->prev, pixels, sizeof l->prev);
+    l->have_prev = 1;
+    l->prev_no = frame_no;
+    return l->failed ? -1 : 0;
+}
+
+int link_finish(link_sender *l)
+{
+    uint32_t t0 = now_ms();
+    feed_back(l);
+    while (!l->failed && !l->closed && l->enc.in_count > 0) {
+        uint32_t spent = now_ms() - t0;
+        if (spent >= l->enc.ack_timeout_ms) break;
+        struct pollfd pf = {l->fd, POLLIN, 0};
+        if (poll(&pf, 1, (int)(l->enc.ack_timeout_ms - spent)) < 0 && errno != EINTR) break;
+        feed_back(l);
+    }
+    return l->failed ? -1 : 0;
+}
+
+const char *link_error(const link_sender *l)
+{
+    return l->failed ? l->err : NULL;
+}
+
+void link_print_summary(const link_sender *l, FILE *f)
+{
+    const fl_encoder *e = &l->enc;
+    fprintf(f,
+            "link %s: %u frames (%u keyframes, %u deltas, %u raw), %u bytes; %u acks, %u keyframe requests, "
+            "%u timeouts, %u bad messages received\n",
+            l->port, (unsigned)e->frames, (unsigned)e->keyframes, (unsigned)e->deltas, (unsigned)e->raw_fallbacks,
+            (unsigned)e->bytes, (unsigned)e->acks, (unsigned)e->keyreqs, (unsigned)e->timeouts,
+            (unsigned)e->rx_bad);
+}
+
+void link_print_json(const link_sender *l, FILE *f)
+{
+    const fl_encoder *e = &l->enc;
+    fputs("{\"port\": \"", f);
+    for (const char *p = l->port; *p; p++) {
+        if (*p == '"' || *p == '\\') fputc('\\', f);
+        if ((unsigned char)*p >= 0x20) fputc(*p, f);
+    }
+    fprintf(f,
+            "\", \"bytes\": %u, \"frames\": %u, \"keyframes\": %u, \"deltas\": %u, \"raw\": %u, \"acks\": %u, "
+            "\"keyreqs\": %u, \"palette_reqs\": %u, \"timeouts\": %u, \"rx_bad\": %u, \"error\": %s}",
+            (unsigned)e->bytes, (unsigned)e->frames, (unsigned)e->keyframes, (unsigned)e->deltas,
+            (unsigned)e->raw_fallbacks, (unsigned)e->acks, (unsigned)e->keyreqs, (unsigned)e->palette_reqs,
+            (unsigned)e->timeouts, (unsigned)e->rx_bad, l->failed ? "true" : "false");
+}
+
+void link_close(link_sender *l)
+{
+    if (l->fd > 0) close(l->fd);
+    l->fd = -1;
+}
