@@ -225,9 +225,9 @@ def test_garbage_and_other_versions(tmp_path):
     rng = random.Random(5)
     garbage = bytes(rng.randrange(256) for _ in range(100000))
     hello = framelink.encode_message(framelink.MSG_HELLO, 0, bytes([1, 64, 1, 200, 0, 8, 16, 0, 4, 3]))
-    v2 = framelink.encode_message(framelink.MSG_HELLO, 0, bytes([1, 64, 1, 200, 0, 8, 16, 0, 4, 3]), version=2)
+    other = framelink.encode_message(framelink.MSG_HELLO, 0, bytes([1, 64, 1, 200, 0, 8, 16, 0, 4, 3]), version=framelink.VERSION + 1)
     short = framelink.encode_message(framelink.MSG_PALETTE, 0, bytes(10))
-    data = garbage + b"\x00" + v2 + short + hello + b"\x00\x00"
+    data = garbage + b"\x00" + other + short + hello + b"\x00\x00"
     c_events, c_tail = c_decode(data, tmp_path)
     p_events, p_tail, _ = py_decode(data)
     assert p_events == c_events and p_tail == c_tail

@@ -23,7 +23,7 @@ model's initial probabilities from streams, docs/frame-link.md "Model").
 import struct
 import zlib
 
-VERSION = 1
+VERSION = 2
 W, H = 320, 200
 FRAME_BYTES = W * H
 PALETTE_BYTES = 768
@@ -35,7 +35,7 @@ PAYLOAD_MAX = 65536
 MSG_MAX = HEADER_BYTES + PAYLOAD_MAX + CRC_BYTES
 
 MSG_HELLO, MSG_PALETTE, MSG_KEYFRAME, MSG_DELTA, MSG_ACK, MSG_KEYREQ = 1, 2, 3, 4, 5, 6
-METHOD_RAW, METHOD_EDGE = 0, 1
+METHOD_RAW, METHOD_EDGE, METHOD_RAW_HASH = 0, 1, 2
 HELLO_BYTES = 10
 BACK_BYTES = 5
 
@@ -239,6 +239,15 @@ def frame_check(frame):
     return _fmix(f)
 
 
+def pixel_hash(frame):
+    """The frame check of a RAW_HASH frame (fl_pixel_hash): each little-endian 32-bit word
+    v, h = (v ^ (h rotated right by 19)) * 0x9E3779B1, then _fmix."""
+    h = ROW_HASH0
+    for (v,) in struct.iter_unpack("<I", bytes(frame)):
+        h = ((v ^ (h >> 19 | h << 13)) * 0x9E3779B1) & M32
+    return _fmix(h)
+
+
 # Edges of a row: three lists, pk (next row's predicted x * 256 + colour), dv (256 * the
 # movement since the row above), vc (velocity class, 0 unknown).
 
@@ -408,7 +417,8 @@ def encode_message(mtype, frame_no, payload, version=VERSION):
     head = bytes((version, mtype)) + struct.pack("<I", frame_no & 0xFFFFFFFF) + bytes((n & 255, (n >> 8) & 255,
                                                                                          (n >> 16) & 255))
     body = head + bytes(payload)
-    return cobs_encode(body + struct.pack("<I", crc32(body))) + b"\x00"
+    covered = crc_bytes(body + bytes(CRC_BYTES))
+    return cobs_encode(body + struct.pack("<I", crc32(body[:covered]))) + b"\x00"
 
 
 def unpack_info(b):
@@ -466,12 +476,21 @@ class _Reader:
             self.broken = R_LONG
 
 
+def crc_bytes(buf):
+    """How many leading bytes of a message (CRC included) its CRC covers: all but the CRC, or
+    for a RAW_HASH keyframe the header and the payload up to its method byte (fl_msg_crc_bytes)."""
+    pre = HEADER_BYTES + FRAME_PRE + 1
+    if len(buf) == pre + FRAME_BYTES + CRC_BYTES and buf[1] == MSG_KEYFRAME and buf[pre - 1] == METHOD_RAW_HASH:
+        return pre
+    return len(buf) - CRC_BYTES
+
+
 def check_message(buf):
     """(None, (type, frame_no, payload)) or (reason, None) - fl_msg_check."""
     n = len(buf)
     if n < HEADER_BYTES + CRC_BYTES:
         return R_SHORT, None
-    if crc32(bytes(buf[:n - CRC_BYTES])) != struct.unpack_from("<I", buf, n - CRC_BYTES)[0]:
+    if crc32(bytes(buf[:crc_bytes(buf)])) != struct.unpack_from("<I", buf, n - CRC_BYTES)[0]:
         return R_CRC, None
     if buf[0] != VERSION:
         return R_VERSION, None
@@ -563,7 +582,8 @@ class Decoder:
         method = pl[pre - 1]
         base_no = 0 if key else struct.unpack_from("<I", pl, FRAME_PRE)[0]
         pic = pl[pre:]
-        if flags & ~1 or method > METHOD_EDGE or (method == METHOD_RAW and (not key or len(pic) != FRAME_BYTES)):
+        raw = method in (METHOD_RAW, METHOD_RAW_HASH)
+        if flags & ~1 or method > METHOD_RAW_HASH or (raw and (not key or len(pic) != FRAME_BYTES)):
             return self._bad(R_PAYLOAD)
         self._ok()
         if self.have_seen and _gt(frame_no, self.seen_no):
@@ -576,9 +596,9 @@ class Decoder:
         recon = None
         if not key and not (self.have_frame and base_no == self.shown_no):
             why = R_NO_BASE
-        elif method == METHOD_RAW:
+        elif raw:
             recon = pic
-            got = frame_check(recon)
+            got = pixel_hash(recon) if method == METHOD_RAW_HASH else frame_check(recon)
         else:
             try:
                 recon, got = decode_picture(pic, None if key else self.frame, self.stats)

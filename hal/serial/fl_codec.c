@@ -282,6 +282,70 @@ uint32_t fl_frame_check(const uint8_t *px)
     return fmix(f);
 }
 
+/* The RAW_HASH frame check: h = (word ^ (h rotated right by 19)) * odd, over the
+ * 16,000 words, then fmix. Each step is a bijection of h, so a difference that
+ * one word makes is never undone by the words after it; the rotation carries
+ * the high bits (which a multiply never moves down) back into the low ones.
+ * Two instructions a word on a Cortex-M3 (eor with a rotated operand, mul). */
+uint32_t fl_pixel_hash(const uint8_t *px)
+{
+    uint32_t h = ROW_HASH0;
+    if ((uintptr_t)px & 3u) {
+        for (uint32_t i = 0; i < FL_FRAME_BYTES; i += 4) {
+            uint32_t v = (uint32_t)px[i] | (uint32_t)px[i + 1] << 8 | (uint32_t)px[i + 2] << 16 |
+                         (uint32_t)px[i + 3] << 24;
+            h = (v ^ (h >> 19 | h << 13)) * 0x9E3779B1u;
+        }
+        return fmix(h);
+    }
+    typedef uint32_t u32a __attribute__((may_alias));
+    const u32a *w = (const u32a *)(const void *)px, *end = w + FL_FRAME_BYTES / 4;
+    for (; w < end; w += 4) {
+        h = (w[0] ^ (h >> 19 | h << 13)) * 0x9E3779B1u;
+        h = (w[1] ^ (h >> 19 | h << 13)) * 0x9E3779B1u;
+        h = (w[2] ^ (h >> 19 | h << 13)) * 0x9E3779B1u;
+        h = (w[3] ^ (h >> 19 | h << 13)) * 0x9E3779B1u;
+    }
+    return fmix(h);
+}
+
+/* Colour transitions of one row: the nonzero bytes of each word XOR the same
+ * word shifted by one pixel. */
+static uint32_t count_transitions(const uint8_t *row)
+{
+    uint32_t n = 0;
+    for (int x = 1; x < FL_W; x++) n += row[x] != row[x - 1];
+    return n;
+}
+
+static uint32_t count_transitions_words(const uint8_t *row)
+{
+    typedef uint32_t u32a __attribute__((may_alias));
+    const u32a *w = (const u32a *)(const void *)row;
+    uint32_t n = 0, prev = (uint32_t)row[0];
+    for (int i = 0; i < FL_W / 4; i++) {
+        uint32_t v = w[i], t = v ^ (v << 8 | prev);
+        prev = v >> 24;
+        t |= t >> 4;
+        t |= t >> 2;
+        t |= t >> 1;
+        n += ((t & 0x01010101u) * 0x01010101u) >> 24;
+    }
+    return n;
+}
+
+uint32_t fl_estimate_transitions(const uint8_t *px, const uint8_t *base)
+{
+    int aligned = (((uintptr_t)px | (uintptr_t)(base ? base : px)) & (uintptr_t)(WB - 1)) == 0;
+    uint32_t n = 0;
+    for (int y = 4; y < FL_H; y += 16) {
+        const uint8_t *row = px + y * FL_W;
+        if (base && rows_equal(row, base + y * FL_W, aligned)) continue;
+        n += aligned ? count_transitions_words(row) : count_transitions(row);
+    }
+    return n * 16;
+}
+
 /* ======================================================================== */
 /* Encoder                                                                  */
 /* ======================================================================== */

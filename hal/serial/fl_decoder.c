@@ -95,7 +95,8 @@ static void frame_msg(fl_decoder *d, const fl_msg *m)
     uint32_t base_no = key ? 0 : fl_get32(m->payload + FL_FRAME_PRE);
     const uint8_t *pic = m->payload + pre;
     uint32_t n = m->len - pre;
-    if ((flags & ~1u) || method > FL_METHOD_EDGE || (method == FL_METHOD_RAW && (!key || n != FL_FRAME_BYTES))) {
+    int raw = method == FL_METHOD_RAW || method == FL_METHOD_RAW_HASH;
+    if ((flags & ~1u) || method > FL_METHOD_RAW_HASH || (raw && (!key || n != FL_FRAME_BYTES))) {
         bad(d, FL_R_PAYLOAD);
         return;
     }
@@ -109,7 +110,7 @@ static void frame_msg(fl_decoder *d, const fl_msg *m)
     fl_reason why = FL_R_NONE;
     if (!key && !(d->have_frame && base_no == d->shown_no)) {
         why = FL_R_NO_BASE;
-    } else if (method == FL_METHOD_RAW) {
+    } else if (raw) {
         for (uint32_t i = 0; i < FL_FRAME_BYTES; i++) d->recon[i] = pic[i];
     } else if (fl_decode_picture(&d->coder, pic, n, key ? 0 : d->frame, d->recon)) {
         why = FL_R_DECODE;
@@ -117,7 +118,8 @@ static void frame_msg(fl_decoder *d, const fl_msg *m)
     if (why == FL_R_NONE) {
         /* end to end: the frame check always, the pixel CRC-32 when it was sent */
         uint32_t crc = crc_update(0, d->recon, FL_FRAME_BYTES);
-        if (fl_frame_check(d->recon) != check || (!info.no_crc && crc != info.crc)) why = FL_R_FRAME_CRC;
+        uint32_t got = method == FL_METHOD_RAW_HASH ? fl_pixel_hash(d->recon) : fl_frame_check(d->recon);
+        if (got != check || (!info.no_crc && crc != info.crc)) why = FL_R_FRAME_CRC;
         else info.crc = crc;
     }
 

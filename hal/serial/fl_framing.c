@@ -37,6 +37,51 @@ static void stuff(fl_writer *w, const uint8_t *p, uint32_t n)
     }
 }
 
+/* The first zero byte in [p, end), or end: a word at a time where p is aligned. */
+static const uint8_t *find_zero(const uint8_t *p, const uint8_t *end)
+{
+    typedef uint32_t u32a __attribute__((may_alias));
+    while (p < end && ((uintptr_t)p & 3u)) {
+        if (!*p) return p;
+        p++;
+    }
+    const u32a *w = (const u32a *)(const void *)p;
+    const u32a *wend = (const u32a *)(const void *)(p + ((uint32_t)(end - p) & ~3u));
+    for (; w < wend; w++) {
+        uint32_t v = *w;
+        if ((v - 0x01010101u) & ~v & 0x80808080u) break; /* a zero byte in v */
+    }
+    for (p = (const uint8_t *)w; p < end; p++)
+        if (!*p) return p;
+    return end;
+}
+
+/* COBS-stuff n bytes (no CRC update) without copying them: a block's bytes
+ * go to put straight from p, after those buffered before them; only a block
+ * the data ends in is buffered. */
+void fl_writer_direct(fl_writer *w, const uint8_t *p, uint32_t n)
+{
+    const uint8_t *end = p + n;
+    while (p < end) {
+        uint32_t room = 254u - w->n, left = (uint32_t)(end - p);
+        const uint8_t *lim = p + (left < room ? left : room), *z = find_zero(p, lim);
+        uint32_t run = (uint32_t)(z - p);
+        if (z == lim && z == end && run < room) { /* the data ends inside this block: keep it */
+            for (uint32_t i = 0; i < run; i++) w->blk[++w->n] = p[i];
+            return;
+        }
+        uint32_t full = z == lim && run == room; /* no zero: a full block */
+        w->blk[0] = (uint8_t)(full ? 0xFFu : w->n + run + 1u);
+        if (w->put) {
+            w->put(w->ctx, w->blk, (uint32_t)w->n + 1);
+            if (run) w->put(w->ctx, p, run);
+        }
+        w->bytes += (uint32_t)w->n + 1 + run;
+        w->n = 0;
+        p = z + (full ? 0 : 1);
+    }
+}
+
 void fl_writer_bytes(fl_writer *w, const uint8_t *p, uint32_t n)
 {
     w->crc = crc_update(w->crc, p, n);
@@ -126,10 +171,18 @@ int fl_reader_byte(fl_reader *r, uint8_t b)
     return 0;
 }
 
+uint32_t fl_msg_crc_bytes(const uint8_t *buf, uint32_t len)
+{
+    uint32_t pre = FL_HEADER_BYTES + FL_FRAME_PRE + 1;
+    if (len == pre + FL_FRAME_BYTES + FL_CRC_BYTES && buf[1] == FL_MSG_KEYFRAME && buf[pre - 1] == FL_METHOD_RAW_HASH)
+        return pre;
+    return len - FL_CRC_BYTES;
+}
+
 fl_reason fl_msg_check(const uint8_t *buf, uint32_t len, fl_msg *m)
 {
     if (len < FL_HEADER_BYTES + FL_CRC_BYTES) return FL_R_SHORT;
-    if (crc_update(0, buf, len - FL_CRC_BYTES) != fl_get32(buf + len - FL_CRC_BYTES)) return FL_R_CRC;
+    if (crc_update(0, buf, fl_msg_crc_bytes(buf, len)) != fl_get32(buf + len - FL_CRC_BYTES)) return FL_R_CRC;
     if (buf[0] != FL_VERSION) return FL_R_VERSION;
     uint32_t plen = (uint32_t)buf[6] | (uint32_t)buf[7] << 8 | (uint32_t)buf[8] << 16;
     if (plen != len - FL_HEADER_BYTES - FL_CRC_BYTES) return FL_R_LENGTH;

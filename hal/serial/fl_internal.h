@@ -30,6 +30,9 @@ void fl_writer_init(fl_writer *w, fl_put_fn put, void *ctx);
 void fl_writer_begin(fl_writer *w, uint8_t type, uint32_t frame_no, uint32_t payload_len);
 void fl_writer_bytes(fl_writer *w, const uint8_t *p, uint32_t n);
 void fl_writer_end(fl_writer *w);
+/* Payload bytes the message CRC does not cover (a RAW_HASH frame's pixels):
+ * stuffed straight from p, no copy. */
+void fl_writer_direct(fl_writer *w, const uint8_t *p, uint32_t n);
 /* A whole message with a small payload. */
 void fl_writer_message(fl_writer *w, uint8_t type, uint32_t frame_no, const uint8_t *payload, uint32_t n);
 
@@ -47,6 +50,10 @@ typedef struct {
     const uint8_t *payload;
     uint32_t len;
 } fl_msg;
+/* How many leading bytes of a message of len bytes (CRC included) its CRC
+ * covers: all but the CRC, or for a RAW_HASH keyframe the header and the
+ * payload up to its method byte (docs/frame-link.md, "Framing"). */
+uint32_t fl_msg_crc_bytes(const uint8_t *buf, uint32_t len);
 fl_reason fl_msg_check(const uint8_t *buf, uint32_t len, fl_msg *m);
 
 #endif

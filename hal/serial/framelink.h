@@ -24,7 +24,7 @@
 
 #include <stdint.h>
 
-#define FL_VERSION 1
+#define FL_VERSION 2 /* 2: method RAW_HASH (its message CRC leaves the pixels to the frame check) */
 #define FL_W 320
 #define FL_H 200
 #define FL_FRAME_BYTES (FL_W * FL_H)
@@ -49,7 +49,10 @@ enum {
 };
 
 /* Picture coding methods (the payload byte before the picture data). */
-enum { FL_METHOD_RAW = 0, FL_METHOD_EDGE = 1 };
+/* RAW_HASH: the 64,000 pixel bytes of a keyframe as they are; the frame check is
+ * fl_pixel_hash (not fl_frame_check), and the message CRC covers the header and the
+ * payload before the pixels only: the hash protects them, at a fraction of a CRC's cost. */
+enum { FL_METHOD_RAW = 0, FL_METHOD_EDGE = 1, FL_METHOD_RAW_HASH = 2 };
 
 /* What the receiver knows about a frame besides its pixels. */
 typedef struct {
@@ -138,6 +141,7 @@ typedef struct {
     uint32_t last_sent;      /* frame number of the last frame sent */
     uint32_t last_key;       /* frame number of the last keyframe sent */
     uint32_t since_key;      /* frames sent since that keyframe */
+    uint32_t last_coded;     /* coded bytes of the last frame's picture (0: it went raw) */
     uint32_t inflight[FL_WINDOW_MAX]; /* numbers of the frames sent and not yet acknowledged (FIFO) */
     uint8_t in_head, in_count;
     uint32_t stall_since_ms;
@@ -291,6 +295,17 @@ uint32_t fl_code_picture(fl_coder *c, const uint8_t *pixels, const uint8_t *base
 /* The frame check: a 32-bit hash of every row's colour transitions (docs/frame-link.md,
  * "Frame check"), which the encoder gets almost free from its scan. */
 uint32_t fl_frame_check(const uint8_t *pixels);
+
+/* The frame check of a RAW_HASH frame: a multiplicative hash of the pixels'
+ * 32-bit little-endian words (docs/frame-link.md, "Frame check"). Any change
+ * confined to one word always changes it. */
+uint32_t fl_pixel_hash(const uint8_t *pixels);
+
+/* About how many colour transitions a picture has that a delta against base
+ * (NULL: none) would code: those of every 16th row that differs from base,
+ * times 16. Cheap (13 rows); the encoder uses it to send a frame that would
+ * not fit its scratch buffer raw without trying to code it first. */
+uint32_t fl_estimate_transitions(const uint8_t *pixels, const uint8_t *base);
 
 /* Decode a method-EDGE picture of n bytes into out (64,000), with base for a
  * delta (NULL: keyframe). Returns 0, or -1 if the data is inconsistent. */

@@ -271,12 +271,36 @@ typedef struct {
     uint32_t check, crc, base_no;
 } frame_msg;
 
+/* The RAW_HASH frame check, written from docs/frame-link.md. */
+static uint32_t ref_pixel_hash(const uint8_t *px)
+{
+    uint32_t h = 0x811C9DC5u;
+    for (uint32_t i = 0; i < FL_FRAME_BYTES; i += 4) {
+        uint32_t w = (uint32_t)px[i] | (uint32_t)px[i + 1] << 8 | (uint32_t)px[i + 2] << 16 | (uint32_t)px[i + 3] << 24;
+        h = (w ^ (h >> 19 | h << 13)) * 0x9E3779B1u;
+    }
+    h ^= h >> 16;
+    h *= 0x85EBCA6Bu;
+    h ^= h >> 13;
+    h *= 0xC2B2AE35u;
+    return h ^ (h >> 16);
+}
+
+/* The check a frame message carries, of these pixels. */
+static uint32_t ref_check_of(uint8_t method, const uint8_t *px)
+{
+    return method == FL_METHOD_RAW_HASH ? ref_pixel_hash(px) : ref_frame_check(px);
+}
+
 static void current_frame_msg(const harness *h, frame_msg *m)
 {
     const uint8_t *b = h->d->rx.buf;
     uint32_t len = h->d->rx.len;
     REQUIRE(len >= FL_HEADER_BYTES + FL_CRC_BYTES);
-    REQUIRE(ref_crc(b, len - FL_CRC_BYTES) == fl_get32(b + len - FL_CRC_BYTES));
+    uint32_t raw_pre = FL_HEADER_BYTES + FL_FRAME_PRE + 1; /* a RAW_HASH keyframe's CRC stops at its method */
+    int raw_hash = len == raw_pre + FL_FRAME_BYTES + FL_CRC_BYTES && b[1] == FL_MSG_KEYFRAME &&
+                   b[raw_pre - 1] == FL_METHOD_RAW_HASH;
+    REQUIRE(ref_crc(b, raw_hash ? raw_pre : len - FL_CRC_BYTES) == fl_get32(b + len - FL_CRC_BYTES));
     REQUIRE(b[0] == FL_VERSION);
     uint32_t plen = (uint32_t)b[6] | (uint32_t)b[7] << 8 | (uint32_t)b[8] << 16;
     REQUIRE(plen == len - FL_HEADER_BYTES - FL_CRC_BYTES);
@@ -293,8 +317,8 @@ static void current_frame_msg(const harness *h, frame_msg *m)
     m->crc = fl_get32(m->pl + 22);
     m->base_no = m->type == FL_MSG_DELTA ? fl_get32(m->pl + FL_FRAME_PRE) : 0;
     m->method = m->pl[m->pre - 1];
-    REQUIRE(m->method == FL_METHOD_RAW || m->method == FL_METHOD_EDGE);
-    if (m->method == FL_METHOD_RAW) REQUIRE(m->type == FL_MSG_KEYFRAME && plen == m->pre + FL_FRAME_BYTES);
+    REQUIRE(m->method <= FL_METHOD_RAW_HASH);
+    if (m->method != FL_METHOD_EDGE) REQUIRE(m->type == FL_MSG_KEYFRAME && plen == m->pre + FL_FRAME_BYTES);
 }
 
 /* The ack of a frame message goes back before its event. */
@@ -314,9 +338,9 @@ static void on_frame(harness *h, const fl_event *ev)
 
     /* shown only if it passed every check it carries */
     uint32_t crc = ref_crc(h->frame, FL_FRAME_BYTES);
-    REQUIRE(ref_frame_check(h->frame) == m.check);
+    REQUIRE(ref_check_of(m.method, h->frame) == m.check);
     if (m.flags & 1u) REQUIRE(crc == m.crc);
-    if (m.method == FL_METHOD_RAW) REQUIRE(memcmp(h->frame, m.pl + m.pre, FL_FRAME_BYTES) == 0);
+    if (m.method != FL_METHOD_EDGE) REQUIRE(memcmp(h->frame, m.pl + m.pre, FL_FRAME_BYTES) == 0);
     if (m.type == FL_MSG_DELTA) REQUIRE(h->have_shown && m.base_no == h->shown_no);
 
     /* what the event says */
@@ -363,10 +387,10 @@ static void on_drop(harness *h, const fl_event *ev)
         break;
     case FL_R_FRAME_CRC:
         REQUIRE(m.type == FL_MSG_KEYFRAME || on_base);
-        if (m.method == FL_METHOD_RAW) {
+        if (m.method != FL_METHOD_EDGE) {
             /* a raw keyframe is its own reconstruction: dropped only if it fails a check */
             const uint8_t *px = m.pl + m.pre;
-            REQUIRE(ref_frame_check(px) != m.check || ((m.flags & 1u) && ref_crc(px, FL_FRAME_BYTES) != m.crc));
+            REQUIRE(ref_check_of(m.method, px) != m.check || ((m.flags & 1u) && ref_crc(px, FL_FRAME_BYTES) != m.crc));
         }
         break;
     default:

@@ -662,7 +662,7 @@ static void test_bad_input(void **state)
     int res = 0;
     for (size_t i = 0; i < s.len; i++) res = fl_reader_byte(&rd, s.p[i]);
     assert_int_equal(res, 1);
-    dec_msg[0] = 2; /* version 2 */
+    dec_msg[0] = FL_VERSION + 1; /* a version this decoder does not speak */
     fl_writer w;
     buf v = {0};
     fl_writer_init(&w, buf_put, &v);
@@ -735,6 +735,150 @@ static void test_framing(void **state)
     }
 }
 
+
+/* Re-seal a frame message (COBS-encoded, delimiter included) with another
+ * frame check and a message CRC that matches: a message that arrives intact
+ * but describes other pixels than it carries. */
+static void reseal(buf *msg, uint32_t check)
+{
+    static uint8_t m[FL_MSG_MAX];
+    fl_reader rd;
+    fl_reader_init(&rd, m, sizeof m);
+    int res = 0;
+    for (size_t i = 0; i < msg->len; i++) res = fl_reader_byte(&rd, msg->p[i]);
+    assert_int_equal(res, 1);
+    uint8_t *pl = m + FL_HEADER_BYTES;
+    pl[FL_INFO_BYTES + 1] = (uint8_t)check;
+    pl[FL_INFO_BYTES + 2] = (uint8_t)(check >> 8);
+    pl[FL_INFO_BYTES + 3] = (uint8_t)(check >> 16);
+    pl[FL_INFO_BYTES + 4] = (uint8_t)(check >> 24);
+    uint32_t covered = fl_msg_crc_bytes(m, rd.len), body = rd.len - FL_CRC_BYTES;
+    fl_writer w;
+    msg->len = 0;
+    fl_writer_init(&w, buf_put, msg);
+    fl_writer_bytes(&w, m, covered);
+    fl_writer_direct(&w, m + covered, body - covered);
+    fl_writer_end(&w);
+}
+
+/* Frame a (word-aligned) with one pixel changed at i, to any other value. */
+static void flip(uint8_t *dst, const uint8_t *a, uint32_t i)
+{
+    memcpy(dst, a, FL_FRAME_BYTES);
+    dst[i] = (uint8_t)(a[i] + 1 + rnd() % 255);
+}
+
+/* Send `shown` under the frame check of `drawn` (they differ in one pixel):
+ * the decoder must refuse it (FL_R_FRAME_CRC) and keep the frame before. */
+static void expect_refused(receiver *r, fl_encoder *enc, buf *s, uint32_t no, const uint8_t *shown, uint32_t check)
+{
+    static fl_frame_info info = {.no_crc = 1};
+    s->len = 0;
+    fl_enc_frame(enc, no, shown, 0, 0, &info);
+    reseal(s, check);
+    uint32_t shown_before = r->dec.count.frames_shown, dropped = r->dec.count.frames_dropped;
+    fl_dec_feed(&r->dec, s->p, (uint32_t)s->len);
+    assert_int_equal(r->dec.count.frames_shown, shown_before);
+    assert_int_equal(r->dec.count.frames_dropped, dropped + 1);
+}
+
+/* The end-to-end check without the pixel CRC-32: a frame that differs from the
+ * frame drawn in a single pixel, anywhere, is never shown. Coded (EDGE: the
+ * transition hash) and raw (RAW_HASH: the pixel hash) frames; every pixel for
+ * the pixel hash, the edges and a random sample through the decoder. */
+static void test_single_pixel_detected(void **state)
+{
+    (void)state;
+    static _Alignas(8) uint8_t flat[FL_FRAME_BYTES], tex[FL_FRAME_BYTES], bad[FL_FRAME_BYTES];
+    rng_state = 23;
+    for (int y = 0; y < FL_H; y++)
+        for (int x = 0; x < FL_W; x++) {
+            flat[y * FL_W + x] = (uint8_t)(x < 100 + y / 4 ? 3 : x < 250 ? 0 : 77);
+            tex[y * FL_W + x] = (uint8_t)rnd();
+        }
+    /* the pixel hash: every pixel */
+    uint32_t h = fl_pixel_hash(tex);
+    memcpy(bad, tex, FL_FRAME_BYTES);
+    for (uint32_t i = 0; i < FL_FRAME_BYTES; i++) {
+        uint8_t keep = bad[i];
+        bad[i] = (uint8_t)(keep ^ (1u << (i % 8)));
+        assert_true(fl_pixel_hash(bad) != h);
+        bad[i] = keep;
+    }
+    /* through the decoder: corners, first and last rows and columns, a sample */
+    uint32_t where[64 + 40 + 200], n = 0;
+    for (uint32_t x = 0; x < FL_W; x += 10) where[n++] = x, where[n++] = (FL_H - 1) * FL_W + x;
+    for (uint32_t y = 0; y < FL_H; y += 10) where[n++] = y * FL_W, where[n++] = y * FL_W + FL_W - 1;
+    while (n < sizeof where / sizeof where[0]) where[n++] = rnd() % FL_FRAME_BYTES;
+    uint32_t none[1] = {0};
+    receiver *r = receiver_new(none, 0);
+    r->dec.send_acks = 0;
+    static fl_encoder enc;
+    static uint8_t small[8192], large[70000];
+    buf s = {0};
+    for (int raw = 0; raw < 2; raw++) {
+        const uint8_t *a = raw ? tex : flat;
+        fl_enc_init(&enc, buf_put, &s, raw ? small : large, raw ? sizeof small : sizeof large);
+        uint32_t check = raw ? fl_pixel_hash(a) : fl_frame_check(a);
+        for (uint32_t k = 0; k < n; k++) {
+            flip(bad, a, where[k]);
+            expect_refused(r, &enc, &s, k, bad, check);
+            assert_int_equal(enc.raw_fallbacks, raw ? k + 1 : 0);
+        }
+    }
+    /* and the same frames with their own checks are shown */
+    s.len = 0;
+    static fl_frame_info info = {.no_crc = 1};
+    fl_enc_frame(&enc, 1000, tex, 0, 0, &info);
+    fl_dec_feed(&r->dec, s.p, (uint32_t)s.len);
+    assert_int_equal(r->dec.count.frames_shown, 1);
+    assert_memory_equal(r->dec.frame, tex, FL_FRAME_BYTES);
+    assert_int_equal(r->dec.shown_info.crc, crc_update(0, tex, FL_FRAME_BYTES)); /* filled in by the receiver */
+    free(s.p);
+    receiver_free(r);
+}
+
+/* fl_writer_direct (no copy) stuffs exactly as fl_writer_bytes: any length,
+ * alignment, bytes already buffered, zeros at every block edge. */
+static void test_direct_stuffing(void **state)
+{
+    (void)state;
+    static _Alignas(8) uint8_t data[1200];
+    rng_state = 5;
+    for (int pat = 0; pat < 4; pat++) {
+        for (uint32_t i = 0; i < sizeof data; i++)
+            data[i] = pat == 0 ? (uint8_t)(i % 255 + 1) : pat == 1 ? 0 : pat == 2 ? (uint8_t)(i % 7 ? 9 : 0)
+                                                                              : (uint8_t)(rnd() % 3 ? rnd() : 0);
+        for (uint32_t head = 0; head < 260; head += (head < 8 ? 1 : 61)) {
+            for (uint32_t off = 0; off < 4; off++) {
+                for (uint32_t len = 0; len < 1100; len += (len < 520 ? 1 : 97)) {
+                    buf a = {0}, b = {0};
+                    fl_writer wa, wb;
+                    fl_writer_init(&wa, buf_put, &a);
+                    fl_writer_init(&wb, buf_put, &b);
+                    for (uint32_t k = 0; k < head; k++) {
+                        uint8_t c = (uint8_t)(k % 5 ? k : 0);
+                        fl_writer_bytes(&wa, &c, 1);
+                        fl_writer_bytes(&wb, &c, 1);
+                    }
+                    uint32_t crc = wa.crc;
+                    fl_writer_bytes(&wa, data + off, len);
+                    wa.crc = crc; /* direct bytes are outside the CRC */
+                    fl_writer_direct(&wb, data + off, len);
+                    fl_writer_end(&wa);
+                    fl_writer_end(&wb);
+                    assert_int_equal(a.len, b.len);
+                    assert_int_equal(wa.bytes, wb.bytes);
+                    assert_memory_equal(a.p, b.p, a.len);
+                    free(a.p);
+                    free(b.p);
+                }
+                if (pat != 3 || head > 8) break;
+            }
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -743,7 +887,8 @@ int main(void)
         cmocka_unit_test(test_flow_control),      cmocka_unit_test(test_synthetic_pictures),
         cmocka_unit_test(test_raw_fallback),      cmocka_unit_test(test_wrong_base),
         cmocka_unit_test(test_bad_input),         cmocka_unit_test(test_forged_pictures),
-        cmocka_unit_test(test_framing),
+        cmocka_unit_test(test_framing),           cmocka_unit_test(test_single_pixel_detected),
+        cmocka_unit_test(test_direct_stuffing),
     };
     return cmocka_run_group_tests_name("framelink", tests, setup, teardown);
 }
