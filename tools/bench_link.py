@@ -10,11 +10,18 @@ or any file of raw 64,000-byte frames given with --raw), it reports:
     at level 9 - on each frame alone, and on each frame XORed with the frame before (the first
     frame alone) - and the frames per second 115,200 baud (8N1: 11,520 bytes/s) carries;
   * the encoder's instructions per frame on x86-64 (callgrind: fltool bench with --repeat 3
-    minus --repeat 1, halved; the whole fl_enc_frame: scan, coding, COBS, message CRC), and
-    what the CRC-32 of the 64,000 pixel bytes (firmware/crc32.c, for fl_frame_info.crc) adds;
-  * the same on the Cortex-M3 (QEMU mps2-an385 with build/insn_count.so, tools/flbench_m3:
-    the frames in slices of 40, each slice starting with a keyframe), checked to send the
-    very bytes the host encoder sends;
+    minus --repeat 1, halved; the whole fl_enc_frame: scan, coding, frame check, COBS, message
+    CRC), and what a pixel CRC-32 of the 64,000 bytes (firmware/crc32.c, fl_frame_info.crc) would
+    add: the firmware does not send one (no_crc), the frame check in every frame message protects
+    the frame end to end;
+  * the sending side's cost on the Cortex-M3, per frame of the textured and of the flat walk:
+    the encoder with its frame check (QEMU mps2-an385 with build/insn_count.so, tools/flbench_m3:
+    the frames in slices of 40, each slice starting with a keyframe, checked to send the very
+    bytes the host encoder sends) beside the render of the same camera by the rendering
+    firmware (make firmware SCENE=... into build/bench-link/fw, default modes and stream: run
+    with --at/--angle/--look of the frame's camera, --frames 2 --no-stream --no-tick, the second
+    frame's count between fw_mark_frame_begin and fw_mark_frame_end, as tools/qemu_plugin/
+    bench_m3.py counts), and their ratio against the goal of issue 18 (at most 10%);
   * the renderer's instructions per frame on x86-64 for a sample of the same frames (build/render
     with each frame's camera, --repeat 3 minus --repeat 1, halved), for the ratio;
   * textured against flat: the walk draws a WAD map textured (the tables above are of those
@@ -24,9 +31,11 @@ or any file of raw 64,000-byte frames given with --raw), it reports:
     1 Mbaud and 4 Mbaud (8N1) and USB full speed carry.
 
 Usage: bench_link.py [--raw FRAMES.raw] [--frames 200] [--out build/bench-link.md] [--no-m3]
+                     [--m3-every K] [--jobs 2]
 (make bench-link).
 """
 import argparse
+import concurrent.futures
 import json
 import os
 import re
@@ -35,6 +44,7 @@ import statistics
 import subprocess
 import sys
 import zlib
+from decimal import Decimal
 from pathlib import Path
 
 import armelf
@@ -110,6 +120,71 @@ def m3_counts(frames_raw, n, fltool):
     return enc, crc
 
 
+MODE_NAMES = {0: "spans", 1: "painter", 2: "direct"}  # firmware/render.c's mode_names, by number
+
+
+def firmware_elf(scene):
+    """The rendering firmware for scene, as make firmware builds it (default modes, frame-link stream)."""
+    out = BUILD / "bench-link" / "fw"
+    sh(["make", "-s", "--no-print-directory", "firmware", f"SCENE={scene}", f"ARM_OUT={out}"], cwd=ROOT)
+    return out / "firmware.elf"
+
+
+def m3_render(elf, lines, flat, every, jobs):
+    """Cortex-M3 instructions of the firmware's frame (input, render, present; no stream) at the camera of
+    every every-th line of frames.jsonl: {frame: count}."""
+    syms = armelf.symbols(elf)
+    plugin = (f"{BUILD / 'insn_count.so'},begin={syms['fw_mark_frame_begin'][0]:#x},"
+              f"end={syms['fw_mark_frame_end'][0]:#x}")
+    tmp = elf.parent / "insns"
+    tmp.mkdir(exist_ok=True)
+
+    def one(line):
+        c, k = line["camera"], line["frame"]
+        exact = [f"{Decimal(v):f}" for v in (c["x"], c["y"], c["z"])]  # 16.16 values: exact decimals
+        args = ["--at", ",".join(exact), "--angle", f"{Decimal(c['angle']):f}", "--look", str(c["look"]),
+                "--mode", MODE_NAMES[line["mode"]], "--frames", "2", "--no-stream", "--no-tick"] + \
+               (["--flat"] if flat else [])
+        out = tmp / f"{'flat' if flat else 'tex'}_{k}.txt"
+        proc = subprocess.run(["qemu-system-arm", "-M", "mps2-an385", "-nographic", "-monitor", "none", "-serial",
+                               "null", "-semihosting-config", "enable=on,target=native", "-kernel", str(elf),
+                               "-plugin", f"{plugin},out={out}", "-append", " ".join(args)],
+                              capture_output=True, text=True, timeout=600)
+        if proc.returncode != 0:
+            raise RuntimeError(f"firmware at frame {k}'s camera: {proc.stderr[-2000:]}")
+        counts = [int(r.split()[1]) for r in out.read_text().splitlines() if r and not r.startswith("#")]
+        return k, counts[-1]
+
+    with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
+        return dict(pool.map(one, lines[::every]))
+
+
+def cost_rows(walks, enc, render):
+    """Per walk: the encoder (with its frame check) against the render of the same frames, and the goal."""
+    out = ["| frames | M3 render (median / max) | M3 encoder + frame check (median / max) | "
+           "encoder / render (median / worst frame) | goal: at most 10% |",
+           "|---|---:|---:|---:|---|"]
+    verdicts = []
+    for name, _ in walks:
+        r = render[name]
+        e = {k: enc[name][k] for k in r}
+        ratios = [e[k] / r[k] for k in r]
+        med = statistics.median(ratios)
+        worst = max(r, key=lambda k: e[k] / r[k])
+        if med <= 0.10:
+            verdict = f"met: {(0.10 - med) * 100:.1f} points under"
+        else:
+            verdict = (f"missed by {(med - 0.10) * 100:.1f} points (the encoder would need "
+                       f"{fmt(statistics.median(e.values()) - 0.10 * statistics.median(r.values()))} fewer "
+                       f"instructions a frame at the medians)")
+        verdicts.append(f"- {name}: {verdict}; worst frame {worst}: {e[worst] / r[worst] * 100:.1f}% "
+                        f"({fmt(e[worst])} of {fmt(r[worst])}).")
+        out.append(f"| {name} | {fmt(statistics.median(r.values()))} / {fmt(max(r.values()))} | "
+                   f"**{fmt(statistics.median(e.values()))}** / {fmt(max(e.values()))} | **{med * 100:.1f}%** / "
+                   f"{max(ratios) * 100:.1f}% | {'met' if med <= 0.10 else 'missed'} |")
+    return out, verdicts
+
+
 def render_cost(render, scene, lines, sample):
     """x86 instructions of build/render per frame for a sample of the walk's cameras."""
     costs = []
@@ -164,7 +239,10 @@ def main(argv=None):
     ap.add_argument("--out", default=str(BUILD / "bench-link.md"))
     ap.add_argument("--no-m3", action="store_true", help="skip the Cortex-M3 counts")
     ap.add_argument("--no-callgrind", action="store_true", help="skip the x86 instruction counts")
-    ap.add_argument("--render-sample", type=int, default=8, help="walk frames whose render cost is measured")
+    ap.add_argument("--render-sample", type=int, default=8, help="walk frames whose x86 render cost is measured")
+    ap.add_argument("--m3-every", type=int, default=1, metavar="K",
+                    help="render every K-th walk frame on the Cortex-M3 for the ratio (default 1: all)")
+    ap.add_argument("-j", "--jobs", type=int, default=2, help="QEMU runs at once (default 2)")
     a = ap.parse_args(argv)
 
     fltool = BUILD / "fltool"
@@ -227,30 +305,54 @@ def main(argv=None):
         one_c = callgrind([fltool, "bench", raw_path, "--repeat", 1, "--crc"])
         three_c = callgrind([fltool, "bench", raw_path, "--repeat", 3, "--crc"])
         crc = (three_c - one_c) / (2 * n) - enc
-        out.append("Instructions per frame (the encoder: fl_enc_frame, everything from the pixels to the bytes "
-                   "handed to the UART; the pixel CRC-32: crc_update over the 64,000 bytes, for "
-                   "fl_frame_info.crc, which a sender may leave out with no_crc - the frame check protects "
-                   "the frame either way):\n")
-        out.append("| where | encoder | pixel CRC-32 (optional) | renderer (spans) | encoder / renderer |")
+        out.append("Instructions per frame on x86-64 (the encoder: fl_enc_frame, everything from the pixels to "
+                   "the bytes handed to the UART, the frame check included: row hashes of a coded frame, the word "
+                   "hash of a raw one (RAW_HASH); a pixel CRC-32, crc_update over the 64,000 bytes for "
+                   "fl_frame_info.crc, is what a sender would add to send one: the firmware does not, it sets "
+                   "no_crc):\n")
+        out.append("| where | encoder + frame check | pixel CRC-32 (not sent) | renderer (direct) | encoder / renderer |")
         out.append("|---|---|---|---|---|")
         rend = render_cost(BUILD / "render", a.scene, lines, a.render_sample) if lines and not a.raw else []
         rmed = statistics.median(rend) if rend else 0
         ratio = f"{enc / rmed * 100:.1f}%" if rmed else "-"
-        out.append(f"| x86-64 (callgrind) | **{fmt(enc)}** | {fmt(crc)} | {fmt(rmed) if rmed else '-'} "
+        out.append(f"| x86-64 (callgrind, textured) | **{fmt(enc)}** | {fmt(crc)} | {fmt(rmed) if rmed else '-'} "
                    f"(median of {len(rend)} frames) | {ratio} |")
-        if not a.no_m3 and shutil.which("qemu-system-arm") and (BUILD / "insn_count.so").exists():
-            e3, c3 = m3_counts(raw, n, fltool)
-            m3r = ""
-            bm = BUILD / "bench-m3.md"
-            if bm.exists():
-                m = re.search(r"freedoom2\.wad:MAP01[^|]*\|\s*([\d,]+)", bm.read_text())
-                if m:
-                    m3r = m.group(1)
-            r3 = f"{statistics.mean(e3) / int(m3r.replace(',', '')) * 100:.1f}% (of the MAP01 start view)" if m3r else "-"
-            out.append(f"| Cortex-M3 (QEMU, instructions) | **{fmt(statistics.mean(e3))}** (median "
-                       f"{fmt(statistics.median(e3))}, max {fmt(max(e3))}) | {fmt(statistics.mean(c3))} | "
-                       f"{m3r + ' (MAP01 start, build/bench-m3.md)' if m3r else '-'} | {r3} |")
-            out.append("\nThe Cortex-M3 image sent exactly the bytes the host encoder sends for the same frames.")
+    if not a.no_m3 and shutil.which("qemu-system-arm") and (BUILD / "insn_count.so").exists():
+        sets = walks or [("frames", None)]
+        enc3, crc3, rend3 = {}, {}, {}
+        for name, d in sets:
+            data = raw if d is None else (d / "frames.raw").read_bytes()
+            e3, c3 = m3_counts(data, n, fltool)
+            enc3[name] = dict(enumerate(e3))
+            crc3[name] = c3
+        out.append(f"\n## The sending side's cost on the Cortex-M3\n")
+        out.append("Instructions per frame on the Cortex-M3 (QEMU mps2-an385, build/insn_count.so). Encoder + frame "
+                   "check: fl_enc_frame in tools/flbench_m3 (the firmware's 8,192-byte scratch, keyframe every 64, "
+                   "no_crc as the firmware sends; the frames in slices of 40, each starting with a keyframe; bytes "
+                   "handed to the UART are counted, not sent), which sent exactly the bytes the host encoder sends. "
+                   "Render: the rendering firmware as make firmware builds it for the scene (build/bench-link/fw), "
+                   "run at the frame's camera (--at, --angle, --look, the walk's render mode, --flat for the flat "
+                   "walk, --frames 2 --no-stream --no-tick), the second frame's instructions between its frame "
+                   "markers (input, render, present: as tools/qemu_plugin/bench_m3.py counts). The firmware renders "
+                   "things from their initial state; the walk's things may have moved on by a frame.\n")
+        if walks and lines:
+            elf = firmware_elf(a.scene)
+            for name, d in walks:
+                rend3[name] = m3_render(elf, lines[:n], "flat" in name, a.m3_every, a.jobs)
+            sample = (f"every frame ({n})" if a.m3_every == 1 else
+                      f"every {a.m3_every}th frame ({len(rend3[walks[0][0]])} of {n}; --m3-every)")
+            out.append(f"Frames compared: {sample}.\n")
+            rows, verdicts = cost_rows(walks, enc3, rend3)
+            out += rows
+            out.append("\nGoal (issue 18): encoder plus frame check at most 10% of the frame's render, judged on the "
+                       "median over the frames of the per-frame ratio:\n")
+            out += verdicts
+        else:
+            for name, _ in sets:
+                e = list(enc3[name].values())
+                out.append(f"- {name}: encoder + frame check median {fmt(statistics.median(e))}, max {fmt(max(e))}")
+        c_all = [c for v in crc3.values() for c in v]
+        out.append(f"\nA pixel CRC-32 (not sent by the firmware) would add {fmt(statistics.mean(c_all))} a frame.")
     if walks:
         out.append("")
         out += textured_table(textured_rows(fltool, walks, work), n, a.scene)
