@@ -664,7 +664,10 @@ uint32_t fl_code_picture(fl_coder *c, const uint8_t *px, const uint8_t *base, ui
         f = mix(f ^ h);
         int same = base && (!hashes || c->row_hash[y] == h) && rows_equal(row, base + y * FL_W, aligned);
         c->row_hash[y] = h;
-        if (r->overflow) continue; /* no room: only the check is still wanted */
+        if (r->overflow) { /* no room: the frame goes raw, with another check */
+            c->hashes_valid = 0;
+            return 0;
+        }
         int c0 = row[0], t = trow + kind * (ROW_KINDS + 1);
         if (same) {
             kind = ROW_SAME;

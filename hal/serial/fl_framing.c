@@ -47,6 +47,15 @@ static const uint8_t *find_zero(const uint8_t *p, const uint8_t *end)
     }
     const u32a *w = (const u32a *)(const void *)p;
     const u32a *wend = (const u32a *)(const void *)(p + ((uint32_t)(end - p) & ~3u));
+    /* four words per test (one load-multiple on a Cortex-M3): a word's
+     * (v - 0x01010101) & ~v & 0x80808080 is nonzero exactly when it holds a
+     * zero byte, so the OR of four says whether any of them does */
+    for (; w + 4 <= wend; w += 4) {
+        uint32_t a = w[0], b = w[1], c = w[2], d = w[3];
+        uint32_t z = ((a - 0x01010101u) & ~a) | ((b - 0x01010101u) & ~b) | ((c - 0x01010101u) & ~c) |
+                     ((d - 0x01010101u) & ~d);
+        if (z & 0x80808080u) break; /* then the word loop below finds which */
+    }
     for (; w < wend; w++) {
         uint32_t v = *w;
         if ((v - 0x01010101u) & ~v & 0x80808080u) break; /* a zero byte in v */
@@ -56,15 +65,46 @@ static const uint8_t *find_zero(const uint8_t *p, const uint8_t *end)
     return end;
 }
 
+typedef uint32_t fl_u32a __attribute__((may_alias));
+
+/* The zero bytes of v: 0x80 in each, exactly (no borrow from a byte below). */
+static inline uint32_t zero_bytes(uint32_t v)
+{
+    return ~(((v & 0x7F7F7F7Fu) + 0x7F7F7F7Fu) | v | 0x7F7F7F7Fu);
+}
+
+/* find_zero for data whose every word lies inside it (start and length
+ * multiples of four): p need not be aligned, the word holding it is read with
+ * the bytes before p masked off, so a zero costs no byte loop. */
+static const uint8_t *find_zero_words(const uint8_t *p, const uint8_t *end)
+{
+    const fl_u32a *w = (const fl_u32a *)(const void *)((uintptr_t)p & ~(uintptr_t)3);
+    uint32_t m = zero_bytes(*w) & (0xFFFFFFFFu << (8u * ((uintptr_t)p & 3u)));
+    if (!m) {
+        for (w++; (const uint8_t *)(w + 4) <= end; w += 4) { /* as find_zero's */
+            uint32_t a = w[0], b = w[1], c = w[2], d = w[3];
+            uint32_t z = ((a - 0x01010101u) & ~a) | ((b - 0x01010101u) & ~b) | ((c - 0x01010101u) & ~c) |
+                         ((d - 0x01010101u) & ~d);
+            if (z & 0x80808080u) break;
+        }
+        for (; (const uint8_t *)w < end && !(m = zero_bytes(*w)); w++) {
+        }
+        if (!m) return end;
+    }
+    const uint8_t *z = (const uint8_t *)w + (__builtin_ctz(m) >> 3);
+    return z < end ? z : end;
+}
+
 /* COBS-stuff n bytes (no CRC update) without copying them: a block's bytes
  * go to put straight from p, after those buffered before them; only a block
  * the data ends in is buffered. */
 void fl_writer_direct(fl_writer *w, const uint8_t *p, uint32_t n)
 {
     const uint8_t *end = p + n;
+    int words = (((uintptr_t)p | n) & 3u) == 0;
     while (p < end) {
         uint32_t room = 254u - w->n, left = (uint32_t)(end - p);
-        const uint8_t *lim = p + (left < room ? left : room), *z = find_zero(p, lim);
+        const uint8_t *lim = p + (left < room ? left : room), *z = words ? find_zero_words(p, lim) : find_zero(p, lim);
         uint32_t run = (uint32_t)(z - p);
         if (z == lim && z == end && run < room) { /* the data ends inside this block: keep it */
             for (uint32_t i = 0; i < run; i++) w->blk[++w->n] = p[i];

@@ -288,7 +288,9 @@ void fl_info_unpack(fl_frame_info *info, const uint8_t *in);
 /* Code a picture (method EDGE): the range-coded bits for pixels, a delta
  * against base when base != NULL. Writes at most cap bytes to out; returns the
  * byte count, or 0 if it did not fit. *check receives fl_frame_check(pixels)
- * either way. */
+ * when it fits; a picture that does not is given up at the row it overflows
+ * in (its frame goes raw, checked by fl_pixel_hash), and the coder keeps no
+ * row hashes from it. */
 uint32_t fl_code_picture(fl_coder *c, const uint8_t *pixels, const uint8_t *base, uint8_t *out, uint32_t cap,
                          uint32_t *check);
 
