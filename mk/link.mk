@@ -8,7 +8,9 @@
 #   make bench-link       bytes per frame of a MAP01 fly-through (textured, and flat:
 #                         fps at 115,200 baud .. USB full speed) against raw and zlib -9,
 #                         and the encoder's instructions per frame on x86-64 (callgrind)
-#                         and on the Cortex-M3 (QEMU + build/insn_count.so)
+#                         and on the Cortex-M3 (QEMU + build/insn_count.so), there beside
+#                         the rendering firmware's instructions for the same cameras
+#                         (build/bench-link/fw), against the goal of at most 10%
 #                         -> build/bench-link.md
 
 LINK_SRC := $(sort $(wildcard hal/serial/*.c))
