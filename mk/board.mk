@@ -35,6 +35,18 @@ BOARD_CFLAGS = $(ARM_CFLAGS) -Ihal/board
 board_ld = -T hal/mps2/mps2.ld -Wl,--gc-sections -Wl,--defsym=MPS2_ROM_ORIGIN=$(1) -Wl,--defsym=MPS2_ROM_BYTES=$(2) \
            -Wl,--defsym=MPS2_RAM_BYTES=$(BOARD_RAM_BYTES) -Wl,--defsym=MPS2_STACK_BYTES=$(BOARD_STACK_BYTES)
 
+# hal/board is a target like the others: no floating point (the links below check
+# the images for soft-float helpers too).
+.PHONY: nofloat-board
+nofloat: nofloat-board
+nofloat-board: $(GEN)/fx_tables.c
+	@printf 'hal/board: '; NOFLOAT_INC='-Ihal/mps2 -Ihal/serial -Ihal/board' tools/check_nofloat.sh hal/board/main.c hal/board/board_args.c
+	@printf 'hal/board (bootloader): '; NOFLOAT_INC='-Ihal/mps2 -Ihal/board' tools/check_nofloat.sh hal/board/boot.c
+
+# No image may link libgcc's floating-point helpers.
+board_nofloat = helpers=$$($(ARMNM) $(1) | awk '{print $$NF}' | grep -E $(ARM_FLOAT_HELPERS)); \
+	if [ -n "$$helpers" ]; then echo "board: $(1) links floating-point helpers: $$helpers"; rm -f $(1); exit 1; fi
+
 .PHONY: display-board run-board bench-board
 display-board: $(BOARD_OUT)/display-board.elf $(BOARD_OUT)/board-boot.elf $(BOARD_OUT)/display-board.bin \
                $(BOARD_OUT)/display-board.dfu
@@ -47,12 +59,14 @@ $(BOARD_OBJ)/%.o: %.c
 $(BOARD_OUT)/display-board.elf: $(patsubst %.c,$(BOARD_OBJ)/%.o,$(BOARD_APP_SRC)) hal/mps2/mps2.ld
 	$(ARMCC) $(BOARD_CFLAGS) $(call board_ld,0x00010000,0x003EF000) -Wl,-Map=$(BOARD_OUT)/display-board.map \
 	  $(filter %.o,$^) -lgcc -o $@
+	@$(call board_nofloat,$@)
 	@$(ARMSIZE) $@ | sed 's/^/board: /'
 	@need=$$(($$($(ARMNM) $@ | awk '$$3=="__ram_need"{print "0x"$$1}'))); \
 	echo "board: RAM $$need of $(BOARD_RAM_BYTES) bytes: stack $(BOARD_STACK_BYTES), pages + palette + display start 128772, the rest .data/.bss (the link message, the decoder)"
 
 $(BOARD_OUT)/board-boot.elf: $(patsubst %.c,$(BOARD_OBJ)/%.o,$(BOARD_BOOT_SRC)) hal/mps2/mps2.ld
 	$(ARMCC) $(BOARD_CFLAGS) $(call board_ld,0x00000000,0x00010000) $(filter %.o,$^) -lgcc -o $@
+	@$(call board_nofloat,$@)
 	@$(ARMSIZE) $@ | sed 's/^/board: /'
 
 $(BOARD_OUT)/%.app.bin: $(BOARD_OUT)/%.elf

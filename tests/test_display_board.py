@@ -16,7 +16,7 @@ from conftest import BUILD, ROOT, program, run
 
 sys.path.insert(0, str(ROOT / "tools"))
 from armelf import symbol  # noqa: E402
-from boardrig import ARM, Board, frames_of, sender  # noqa: E402
+from boardrig import ARM, Board, finish_sender, frames_of, sender  # noqa: E402
 from capture import MODES, PRESENTS  # noqa: E402
 from fxtext import fx_text  # noqa: E402
 
@@ -59,8 +59,7 @@ def stream_into_board(image, fw_elf, tmp_path, frames=FRAMES):
     try:
         snd = sender(fw_elf, board.tcp_port, f"--frames {frames} --acks on")
         board.wait_for(r"board: done:[^\n]*\n", 120)
-        out, _ = snd.communicate(timeout=60)
-        assert snd.returncode == 0, out.decode(errors="replace")
+        finish_sender(snd, frames)
         board.qmp("stop")
         start = struct.unpack("<I", board.pmem(symbol(board_elf, "mps2_display_start"), 4, tmp_path / "ds.bin"))[0]
         assert start in (0, 1)

@@ -9,6 +9,7 @@ shows on semihosting (hal/board/main.c); QMP (a unix socket) stops it and reads 
 import json
 import os
 import re
+import select
 import shutil
 import socket
 import subprocess
@@ -132,6 +133,26 @@ class Board:
 
 
 def sender(elf, tcp_port, args):
-    """The rendering firmware (hal/mps2) with its UART0 a TCP client of the board's."""
-    cmd = BASE + ["-kernel", str(elf), "-serial", f"tcp:127.0.0.1:{tcp_port}"] + (["-append", args] if args else [])
+    """The rendering firmware (hal/mps2) with its UART0 a TCP client of the board's. It lingers
+    (--linger 60000) after its last frame: the kernel's socket buffers take megabytes of frames
+    ahead of the board, and QEMU drops what the board has not read yet when the sender's end of
+    the connection closes. Stop it (finish_sender) once the board has shown what it wanted."""
+    cmd = BASE + ["-kernel", str(elf), "-serial", f"tcp:127.0.0.1:{tcp_port}", "-append", f"{args} --linger 60000"]
     return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+
+
+def finish_sender(proc, frames, timeout=60):
+    """Wait until the sender has sent its frames (its link summary line), stop it, return its output."""
+    text = b""
+    deadline = time.time() + timeout
+    while time.time() < deadline and proc.poll() is None and f"link: {frames} frames".encode() not in text:
+        r, _, _ = select.select([proc.stdout], [], [], 0.2)
+        if r:
+            text += os.read(proc.stdout.fileno(), 4096)
+    if proc.poll() is None:
+        proc.kill()
+    text += proc.communicate()[0]
+    out = text.decode(errors="replace")
+    if f"firmware: link: {frames} frames" not in out:
+        raise RuntimeError(f"the sender did not send {frames} frames:\n{out}")
+    return out
