@@ -16,7 +16,7 @@ from conftest import BUILD, ROOT, program, run
 
 sys.path.insert(0, str(ROOT / "tools"))
 from armelf import symbol  # noqa: E402
-from boardrig import ARM, Board, finish_sender, frames_of, sender  # noqa: E402
+from boardrig import ARM, Board, Sender, frames_of  # noqa: E402
 from capture import MODES, PRESENTS  # noqa: E402
 from fxtext import fx_text  # noqa: E402
 
@@ -57,16 +57,16 @@ def stream_into_board(image, fw_elf, tmp_path, frames=FRAMES):
     board = Board(image, f"--frames {frames}", tmp=tmp_path)
     snd = None
     try:
-        snd = sender(fw_elf, board.tcp_port, f"--frames {frames} --acks on")
+        snd = Sender(fw_elf, board.tcp_port, f"--frames {frames} --acks on", tmp=tmp_path)
+        snd.finish(frames)
         board.wait_for(r"board: done:[^\n]*\n", 120)
-        finish_sender(snd, frames)
         board.qmp("stop")
         start = struct.unpack("<I", board.pmem(symbol(board_elf, "mps2_display_start"), 4, tmp_path / "ds.bin"))[0]
         assert start in (0, 1)
         page = board.pmem(symbol(board_elf, "mps2_vram1" if start else "mps2_vram0"), 64000, tmp_path / "page.bin")
         text = board.text
     finally:
-        if snd and snd.poll() is None:
+        if snd:
             snd.kill()
         board.kill()
         board.wait()

@@ -132,27 +132,45 @@ class Board:
             self.proc.kill()
 
 
-def sender(elf, tcp_port, args):
-    """The rendering firmware (hal/mps2) with its UART0 a TCP client of the board's. It lingers
-    (--linger 60000) after its last frame: the kernel's socket buffers take megabytes of frames
-    ahead of the board, and QEMU drops what the board has not read yet when the sender's end of
-    the connection closes. Stop it (finish_sender) once the board has shown what it wanted."""
-    cmd = BASE + ["-kernel", str(elf), "-serial", f"tcp:127.0.0.1:{tcp_port}", "-append", f"{args} --linger 60000"]
-    return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+class Sender:
+    """The rendering firmware (hal/mps2) with its UART0 a TCP client of the board's.
 
+    The kernel's socket buffers take megabytes of frames ahead of a slow board, and QEMU drops
+    what the board has not read yet when the sender's end of the connection closes. So the sender
+    lingers after its last frame, and finish() pauses it over QMP (its socket stays open) once it
+    has sent everything; kill() it when the board has shown what it wanted."""
 
-def finish_sender(proc, frames, timeout=60):
-    """Wait until the sender has sent its frames (its link summary line), stop it, return its output."""
-    text = b""
-    deadline = time.time() + timeout
-    while time.time() < deadline and proc.poll() is None and f"link: {frames} frames".encode() not in text:
-        r, _, _ = select.select([proc.stdout], [], [], 0.2)
-        if r:
-            text += os.read(proc.stdout.fileno(), 4096)
-    if proc.poll() is None:
-        proc.kill()
-    text += proc.communicate()[0]
-    out = text.decode(errors="replace")
-    if f"firmware: link: {frames} frames" not in out:
-        raise RuntimeError(f"the sender did not send {frames} frames:\n{out}")
-    return out
+    def __init__(self, elf, tcp_port, args, tmp="/tmp"):
+        self.qmp_path = str(Path(tmp) / f"sender-qmp-{os.getpid()}-{id(self)}.sock")
+        cmd = BASE + ["-kernel", str(elf), "-serial", f"tcp:127.0.0.1:{tcp_port}",
+                      "-qmp", f"unix:{self.qmp_path},server=on,wait=off", "-append", f"{args} --linger 60000"]
+        self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+        self.text = ""
+
+    def finish(self, frames, timeout=120):
+        """Wait for the sender's link summary (all frames sent), pause it; returns its output."""
+        want = f"firmware: link: {frames} frames"
+        buf = b""
+        deadline = time.time() + timeout
+        while time.time() < deadline and self.proc.poll() is None and want.encode() not in buf:
+            r, _, _ = select.select([self.proc.stdout], [], [], 0.2)
+            if r:
+                buf += os.read(self.proc.stdout.fileno(), 4096)
+        self.text = buf.decode(errors="replace")
+        if want not in self.text:
+            self.kill()
+            raise RuntimeError(f"the sender did not send {frames} frames:\n{self.text}")
+        with socket.socket(socket.AF_UNIX) as s:
+            s.connect(self.qmp_path)
+            f = s.makefile("rw")
+            f.readline()
+            for cmd in ("qmp_capabilities", "stop"):
+                f.write(json.dumps({"execute": cmd}) + "\n")
+                f.flush()
+                f.readline()
+        return self.text
+
+    def kill(self):
+        if self.proc.poll() is None:
+            self.proc.kill()
+        self.proc.wait()

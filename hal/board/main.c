@@ -87,11 +87,13 @@ static void log_frame(const fl_event *ev, uint32_t seg)
 static void log_summary(void)
 {
     const fl_counters *c = &dec.count;
+    uint32_t stack = (uint32_t)((uintptr_t)__stack_top - (uintptr_t)__stack_limit);
     log_printf("board: done: %u frames shown, %u dropped, %u missed, %u bad messages, %u resyncs, "
-               "%u keyframe requests, %u acks, %u bytes, %u UART overruns\n",
+               "%u keyframe requests, %u acks, %u bytes, %u UART overruns; stack used %u of %u bytes\n",
                (unsigned)c->frames_shown, (unsigned)c->frames_dropped, (unsigned)c->frames_missed,
                (unsigned)c->msgs_bad, (unsigned)c->resyncs, (unsigned)c->keyreqs_sent, (unsigned)c->acks_sent,
-               (unsigned)c->bytes, (unsigned)uart_rx_overruns());
+               (unsigned)c->bytes, (unsigned)uart_rx_overruns(), (unsigned)(stack - mps2_stack_unused()),
+               (unsigned)stack);
 }
 
 int main(void)
