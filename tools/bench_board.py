@@ -136,7 +136,7 @@ def main():
                      f"{HZ / r['median']:.1f} | {HZ / r['max']:.1f} |")
         print(r["sent"], file=sys.stderr)
         print(r["summary"], file=sys.stderr)
-    lines += ["", "Where they go (the plugin's profile, by function; all marked messages, hello and palette too, "
+    lines += ["", "Where they go (the plugin's profile, by the object file the code comes from; all marked messages, hello and palette too, "
               "per frame shown):", "", "| part | " + " | ".join("flat" if f else "textured" for f, _ in results) + " |",
               "|---|" + "---:|" * len(results)]
     for label in [p for p, _ in PARTS] + [OTHER]:
