@@ -4,6 +4,7 @@ link over TCP from a second QEMU and shows the frames; the page it shows, read o
 memory over QMP, is bit-identical to build/render's frame for the camera the link carried. A
 damaged application or an erased valid mark is refused by the bootloader, which never jumps.
 """
+import re
 import shutil
 import struct
 import subprocess
@@ -52,13 +53,14 @@ def host_frame(scene, f, tmp_path):
 
 def stream_into_board(image, fw_elf, tmp_path, frames=FRAMES):
     """Boot image as the board, stream frames in from the rendering firmware, stop the board over QMP.
-    Returns (board log, the frames it logged, the display-start register, the page it shows)."""
+    Returns (board log, the frames it logged, the display-start register, the page it shows, the
+    sender's output)."""
     board_elf = ARM / "display-board.elf"
     board = Board(image, f"--frames {frames}", tmp=tmp_path)
     snd = None
     try:
         snd = Sender(fw_elf, board.tcp_port, f"--frames {frames} --acks on", tmp=tmp_path)
-        snd.finish(frames)
+        sent = snd.finish(frames)
         board.wait_for(r"board: done:[^\n]*\n", 120)
         board.qmp("stop")
         start = struct.unpack("<I", board.pmem(symbol(board_elf, "mps2_display_start"), 4, tmp_path / "ds.bin"))[0]
@@ -70,14 +72,17 @@ def stream_into_board(image, fw_elf, tmp_path, frames=FRAMES):
             snd.kill()
         board.kill()
         board.wait()
-    return text, frames_of(text), start, page
+    return text, frames_of(text), start, page, sent
 
 
 def test_rendering_firmware_streams_into_the_board(built, tmp_path):
     """Two QEMUs over TCP; the page the board shows is build/render's frame for the camera it logged."""
     fw_elf, image = built
-    text, frames, start, page = stream_into_board(image, fw_elf, tmp_path)
+    text, frames, start, page, sent = stream_into_board(image, fw_elf, tmp_path)
     assert "bootloader: application valid" in text
+    # the board's acks reached the sender: it kept sending within its window of 4 frames
+    acks = int(re.search(r"firmware: link: .*?; (\d+) acks", sent).group(1))
+    assert acks >= FRAMES - 4, sent
     assert [f["frame"] for f in frames] == list(range(FRAMES)), text
     assert f"board: done: {FRAMES} frames shown, 0 dropped, 0 missed, 0 bad messages" in text, text
     # every frame flips to the other page: the one rebuilt while the old one stayed on screen
