@@ -115,38 +115,35 @@ int main(void)
                (unsigned)(uintptr_t)mps2_vram0, (unsigned)(uintptr_t)mps2_vram1,
                (unsigned)(uintptr_t)&mps2_display_start, args.frames ? "showing a set number of frames" : "running");
 
-    static uint8_t buf[64]; /* what has arrived, taken from the ring in chunks */
-    uint32_t len = 0, pos = 0, seg = 0;
+    uint32_t seg = 0;
     int in_seg = 0;
     for (;;) {
-        if (pos == len) {
-            pos = 0;
-            len = uart_read(buf, sizeof buf);
-            if (len == 0) {
-                /* sleep until a byte comes; with interrupts masked across the check, one
-                 * that arrives just before the WFI still wakes it */
-                __asm__ volatile("cpsid i" ::: "memory");
-                if (!uart_rx_ready()) __asm__ volatile("wfi");
-                __asm__ volatile("cpsie i" ::: "memory");
-                continue;
+        uint8_t buf[64];
+        uint32_t n = 0;
+        int c, end = 0;
+        /* a chunk of what has arrived, up to a message's delimiter */
+        while (n < sizeof buf && (c = uart_getc()) >= 0) {
+            buf[n++] = (uint8_t)c;
+            if (c == 0) {
+                end = 1;
+                break;
             }
         }
-        /* up to and including the next delimiter: the end of a message */
-        uint32_t end = pos;
-        while (end < len && buf[end] != 0) end++;
-        int delim = end < len;
-        end += (uint32_t)delim;
+        if (n == 0) {
+            /* sleep until a byte comes; with interrupts masked across the check, one
+             * that arrives just before the WFI still wakes it */
+            __asm__ volatile("cpsid i" ::: "memory");
+            if (!uart_rx_ready()) __asm__ volatile("wfi");
+            __asm__ volatile("cpsie i" ::: "memory");
+            continue;
+        }
         if (!in_seg) {
-            if (delim && end - pos == 1) { /* an empty segment: nothing to mark */
-                pos = end;
-                continue;
-            }
+            if (end && n == 1) continue; /* an empty segment: nothing to mark */
             fw_mark_frame_begin(seg);
             in_seg = 1;
         }
-        fl_dec_feed(&dec, buf + pos, end - pos);
-        pos = end;
-        if (!delim) continue;
+        fl_dec_feed(&dec, buf, n);
+        if (!end) continue;
         fw_mark_frame_end(seg);
         in_seg = 0;
         if (shown.pending) {

@@ -110,15 +110,6 @@ int uart_getc(void)
     return c;
 }
 
-uint32_t uart_read(uint8_t *dst, uint32_t max)
-{
-    uint32_t tail = rx_tail, head = rx_head, n = 0;
-    while (n < max && tail != head) dst[n++] = rx_ring[tail++ % RX_RING];
-    rx_tail = tail;
-    if (n && rx_held) rx_resume();
-    return n;
-}
-
 int uart_rx_ready(void)
 {
     return rx_tail != rx_head;

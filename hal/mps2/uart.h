@@ -28,7 +28,6 @@ void uart_write(const void *p, size_t n);
 void uart_puts(const char *s);       /* text, '\n' sent as "\r\n" */
 void uart_flush(void);               /* wait until the last byte has left the TX buffer */
 int uart_getc(void);                 /* next received byte, or -1 if none is waiting */
-uint32_t uart_read(uint8_t *dst, uint32_t max); /* up to max received bytes waiting; returns how many */
 int uart_rx_ready(void);             /* 1 if a received byte is waiting */
 uint32_t uart_rx_overruns(void);     /* received bytes the hardware dropped (overrun) */
 
