@@ -131,6 +131,8 @@ help:
 	@echo "make firmware   build/arm/firmware.elf for QEMU mps2-an385, built for its scene (SCENE=, FULL=1,"
 	@echo "                CAMPATH=, FW_MODES=direct,...); all its RAM within RAM_BYTES=200000 or refused;"
 	@echo "                make run-firmware"
+	@echo "make display-board  the display board (hal/board): build/arm/display-board.bin (DFU bootloader +"
+	@echo "                application + valid mark, 4 MiB flash) and .dfu; make run-board; make bench-board"
 	@echo "make pcvga      build/pcvga/kernel.elf: the bare PC kernel (multiboot, VGA mode 13h) for"
 	@echo "                qemu-system-i386 (SCENE=, FULL=1, CAMPATH=, PC_MODES=); make run-pcvga [RUN_ARGS=...];"
 	@echo "                make bench-pcvga (write counters per present mode)"

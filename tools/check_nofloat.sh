@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # check_nofloat.sh FILE... - fail if any firmware/HAL source can use floating point.
+# NOFLOAT_INC: more -I options for the Cortex-M3 compile (a target's headers).
 #  1. no 'float' or 'double' token in the code (comments removed by the preprocessor);
 #  2. (the host build compiles these files with -mgeneral-regs-only, which rejects
 #     floating-point arithmetic that survives optimisation);
@@ -29,7 +30,7 @@ if command -v arm-none-eabi-gcc >/dev/null; then
   for f in "${arm_srcs[@]}"; do
     o="$tmp/$(echo "$f" | tr '/' '_').o"
     if ! arm-none-eabi-gcc -std=c11 -O2 -mcpu=cortex-m3 -mthumb -mfloat-abi=soft -ffreestanding \
-         -fno-strict-aliasing -fno-tree-loop-distribute-patterns -Ifirmware -Ihal -Ihal/null -Ihal/bare -c "$f" -o "$o"; then
+         -fno-strict-aliasing -fno-tree-loop-distribute-patterns -Ifirmware -Ihal -Ihal/null -Ihal/bare ${NOFLOAT_INC:-} -c "$f" -o "$o"; then
       echo "nofloat: $f does not compile for Cortex-M3"; fail=1; continue
     fi
     objs+=("$o")

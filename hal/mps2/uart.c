@@ -27,6 +27,7 @@
 static volatile uint8_t rx_ring[RX_RING];
 static volatile uint32_t rx_head, rx_tail; /* head: written by the IRQ; tail: by uart_getc */
 static volatile uint32_t rx_dropped;
+static volatile uint8_t rx_held; /* a byte waits in the data register: the ring was full */
 
 void uart_init(void)
 {
@@ -36,6 +37,7 @@ void uart_init(void)
     UART_INTSTATUS = 0xFu;
     rx_head = rx_tail = 0;
     rx_dropped = 0;
+    rx_held = 0;
     UART_CTRL = CTRL_TX_EN | CTRL_RX_EN | CTRL_RX_INT_EN | CTRL_RX_OVR_INT_EN;
     NVIC_ISER0 = 1u << MPS2_IRQ_UART0_RX;
 }
@@ -67,13 +69,50 @@ void uart_flush(void)
     }
 }
 
+/* Move received bytes from the data register into the ring while it has room.
+ * Returns 1 if a byte is left in the register because the ring is full. */
+static int rx_drain(void)
+{
+    while (UART_STATE & STATE_RX_FULL) {
+        uint32_t head = rx_head;
+        if (head - rx_tail >= RX_RING) return 1;
+        rx_ring[head % RX_RING] = (uint8_t)UART_DATA;
+        rx_head = head + 1;
+    }
+    return 0;
+}
+
+/* The ring was full: a byte waits in the data register with the RX interrupt
+ * off, so the sender is held back instead of losing bytes (QEMU takes no more
+ * from its backend while the register is full). Called with room in the ring. */
+static void rx_resume(void)
+{
+    __asm__ volatile("cpsid i" ::: "memory");
+    if (!rx_drain()) {
+        rx_held = 0;
+        UART_CTRL |= CTRL_RX_INT_EN;
+        /* a byte that came between the drain and the enable raised no interrupt */
+        if (rx_drain()) {
+            UART_CTRL &= ~CTRL_RX_INT_EN;
+            rx_held = 1;
+        }
+    }
+    __asm__ volatile("cpsie i" ::: "memory");
+}
+
 int uart_getc(void)
 {
     uint32_t tail = rx_tail;
     if (tail == rx_head) return -1;
     uint8_t c = rx_ring[tail % RX_RING];
     rx_tail = tail + 1;
+    if (rx_held) rx_resume();
     return c;
+}
+
+int uart_rx_ready(void)
+{
+    return rx_tail != rx_head;
 }
 
 uint32_t uart_rx_overruns(void)
@@ -91,14 +130,8 @@ void uart0_rx_irq(void)
         rx_dropped++;
         UART_STATE = STATE_RX_OVERRUN;
     }
-    while (UART_STATE & STATE_RX_FULL) {
-        uint8_t c = (uint8_t)UART_DATA;
-        uint32_t head = rx_head;
-        if (head - rx_tail < RX_RING) {
-            rx_ring[head % RX_RING] = c;
-            rx_head = head + 1;
-        } else {
-            rx_dropped++;
-        }
+    if (rx_drain()) {
+        UART_CTRL &= ~CTRL_RX_INT_EN;
+        rx_held = 1;
     }
 }

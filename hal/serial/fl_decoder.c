@@ -24,6 +24,14 @@ void fl_dec_init(fl_decoder *d, uint8_t *frame, uint8_t *work, fl_event_fn on_ev
     d->window = 4;
 }
 
+void fl_dec_init_pages(fl_decoder *d, uint8_t *page0, uint8_t *page1, uint8_t *work, fl_event_fn on_event,
+                       void *ev_ctx, fl_put_fn back_put, void *back_ctx)
+{
+    fl_dec_init(d, page0, work, on_event, ev_ctx, back_put, back_ctx);
+    d->recon = page1;
+    d->flip = 1;
+}
+
 static void emit(fl_decoder *d, fl_event *ev)
 {
     if (d->on_event) d->on_event(d->ev_ctx, ev);
@@ -126,7 +134,13 @@ static void frame_msg(fl_decoder *d, const fl_msg *m)
     fl_event ev;
     if (why == FL_R_NONE) {
         /* shown: it passed every check */
-        for (uint32_t i = 0; i < FL_FRAME_BYTES; i++) d->frame[i] = d->recon[i];
+        if (d->flip) {
+            uint8_t *shown = d->recon;
+            d->recon = d->frame;
+            d->frame = shown;
+        } else {
+            for (uint32_t i = 0; i < FL_FRAME_BYTES; i++) d->frame[i] = d->recon[i];
+        }
         d->have_frame = 1;
         d->shown_no = m->frame_no;
         d->shown_info = info;

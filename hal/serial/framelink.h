@@ -248,12 +248,13 @@ typedef struct {
 
 typedef struct {
     uint8_t *frame;          /* caller's 64,000 bytes: the frame shown */
-    uint8_t *recon;          /* reconstruction (in work) */
+    uint8_t *recon;          /* reconstruction (in work, or the hidden page: fl_dec_init_pages) */
     fl_reader rx;
     fl_event_fn on_event;
     void *ev_ctx;
     fl_writer back;          /* receiver -> sender messages */
     uint8_t send_acks;       /* default 1 */
+    uint8_t flip;            /* fl_dec_init_pages: a frame is shown by swapping frame and recon */
 
     uint8_t have_frame, have_palette, have_hello, waiting_key, last_bad, have_seen;
     uint8_t window;          /* from hello (default 4) */
@@ -275,6 +276,17 @@ typedef struct {
  * the decoder sends to the sender. */
 void fl_dec_init(fl_decoder *d, uint8_t *frame, uint8_t *work, fl_event_fn on_event, void *ev_ctx,
                  fl_put_fn back_put, void *back_ctx);
+
+/* Bytes of work memory a page-flipping decoder needs: one message. */
+#define FL_DEC_PAGES_WORK_BYTES (FL_MSG_MAX)
+
+/* Start a receiver that rebuilds each frame straight into a hidden page and
+ * shows it by a flip, with no 64,000-byte copy: page0 and page1 (64,000 bytes
+ * each) take turns. d->frame is the page shown (page0 at first), d->recon the
+ * hidden one, which holds anything, even a frame that failed its checks. work:
+ * FL_DEC_PAGES_WORK_BYTES. Otherwise as fl_dec_init. */
+void fl_dec_init_pages(fl_decoder *d, uint8_t *page0, uint8_t *page1, uint8_t *work, fl_event_fn on_event,
+                       void *ev_ctx, fl_put_fn back_put, void *back_ctx);
 
 /* Feed received bytes, any chunking. Events are reported as messages complete. */
 void fl_dec_feed(fl_decoder *d, const uint8_t *p, uint32_t n);

@@ -361,6 +361,65 @@ static void noisy_link(uint32_t per, int kind, uint32_t nframes, uint32_t clean,
     free(sent);
 }
 
+/* Page flipping (fl_dec_init_pages, the display board's decoder): fed the same
+ * damaged stream, it sends the same events and counts the same as the copying
+ * decoder, shows exactly the same frames, each in the page that was hidden
+ * until then, and never writes the page on show while a frame is rebuilt. */
+static void test_page_flipping(void **state)
+{
+    (void)state;
+    buf s = {0}, d = {0};
+    encode_walk(&s, 16, NULL);
+    rng_state = 4242;
+    damage(s.p, s.len, &d, 3000, 4);
+    receiver *ref = receiver_new(walk_crc, NF);
+    fl_dec_feed(&ref->dec, d.p, (uint32_t)d.len);
+
+    receiver *r = receiver_new(walk_crc, NF);
+    uint8_t *pages = malloc(2u * FL_FRAME_BYTES);
+    memset(pages, 0x5A, 2u * FL_FRAME_BYTES);
+    uint8_t *msg = malloc(FL_DEC_PAGES_WORK_BYTES);
+    fl_dec_init_pages(&r->dec, pages, pages + FL_FRAME_BYTES, msg, on_event, &r->w, buf_put, &r->back);
+    assert_ptr_equal(r->dec.frame, pages);
+    uint32_t shown_before = 0, flips = 0;
+    uint8_t *on_show = r->dec.frame;
+    uint32_t shown_crc = crc_update(0, on_show, FL_FRAME_BYTES);
+    for (size_t off = 0; off < d.len; off += 40) {
+        uint32_t n = (uint32_t)(d.len - off < 40 ? d.len - off : 40);
+        fl_dec_feed(&r->dec, d.p + off, n);
+        if (r->dec.count.frames_shown != shown_before) {
+            /* a frame was shown, in the other page (40 bytes hold the end of one frame message
+             * at most: the shortest is 46 bytes on the wire) */
+            assert_true(r->dec.frame != on_show);
+            assert_true(r->dec.frame == pages || r->dec.frame == pages + FL_FRAME_BYTES);
+            assert_true(r->dec.recon == on_show);
+            flips++;
+        } else {
+            /* nothing shown: the page on show is untouched */
+            assert_true(r->dec.frame == on_show);
+            assert_int_equal(crc_update(0, on_show, FL_FRAME_BYTES), shown_crc);
+        }
+        shown_before = r->dec.count.frames_shown;
+        on_show = r->dec.frame;
+        shown_crc = crc_update(0, on_show, FL_FRAME_BYTES);
+    }
+    check_accounting(r);
+    assert_int_equal(flips, r->dec.count.frames_shown);
+    assert_true(r->dec.count.frames_shown > NF / 2);
+    assert_true(r->dec.count.msgs_bad > 0);
+    assert_int_equal(r->w.log_hash, ref->w.log_hash);
+    assert_memory_equal(&r->dec.count, &ref->dec.count, sizeof r->dec.count);
+    assert_int_equal(r->back.len, ref->back.len);
+    assert_memory_equal(r->back.p, ref->back.p, r->back.len);
+    assert_memory_equal(r->dec.frame, ref->frame, FL_FRAME_BYTES);
+    free(msg);
+    free(pages);
+    receiver_free(r);
+    receiver_free(ref);
+    free(s.p);
+    free(d.p);
+}
+
 static void test_fault_injection(void **state)
 {
     (void)state;
@@ -897,7 +956,7 @@ int main(void)
         cmocka_unit_test(test_raw_fallback),      cmocka_unit_test(test_wrong_base),
         cmocka_unit_test(test_bad_input),         cmocka_unit_test(test_forged_pictures),
         cmocka_unit_test(test_framing),           cmocka_unit_test(test_single_pixel_detected),
-        cmocka_unit_test(test_direct_stuffing),
+        cmocka_unit_test(test_direct_stuffing),     cmocka_unit_test(test_page_flipping),
     };
     return cmocka_run_group_tests_name("framelink", tests, setup, teardown);
 }
