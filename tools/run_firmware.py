@@ -128,6 +128,8 @@ def run_pty(cmd, qmp_path):
         while proc.poll() is None and not pts_held_by_other(pts, proc.pid):
             time.sleep(0.1)
         if proc.poll() is None:
+            # a reader flushes what is pending as it opens (pyserial does): let it finish first
+            time.sleep(0.3)
             say(f"a reader has {pts} open: the firmware starts")
             qmp_cont(qmp_path)
         status = proc.wait()
