@@ -182,6 +182,14 @@ static int hello_unpack(fl_hello *h, const uint8_t *p, uint32_t n)
     return 0;
 }
 
+/* By bytes: a struct copy this size becomes a memcpy call, and the targets link no libc. */
+static void hello_copy(fl_hello *to, const fl_hello *from)
+{
+    uint8_t *t = (uint8_t *)to;
+    const uint8_t *f = (const uint8_t *)from;
+    for (uint32_t i = 0; i < sizeof *to; i++) t[i] = f[i];
+}
+
 static void message(fl_decoder *d, const uint8_t *buf, uint32_t len)
 {
     fl_msg m;
@@ -205,7 +213,7 @@ static void message(fl_decoder *d, const uint8_t *buf, uint32_t len)
         event0(&ev, FL_EV_HELLO);
         ev.type = m.type;
         ev.frame_no = m.frame_no;
-        ev.hello = d->hello;
+        hello_copy(&ev.hello, &d->hello);
         emit(d, &ev);
         return;
     case FL_MSG_PALETTE:
