@@ -32,7 +32,8 @@ static const char usage[] =
     "  --frames N         stop after N frames shown (default: until the stream ends)\n"
     "  --idle-timeout S   stop when nothing arrives for S seconds (default 10)\n"
     "  --baud B           serial speed for a tty (default 115200)\n"
-    "  --json             print the final counters as one JSON object on stdout\n"
+    "  --json             print the final counters and the scene the sender named (scene,\n"
+    "                     scene_crc32: its compiled blob's CRC-32) as one JSON object on stdout\n"
     "  -h, --help         this text\n"
     "\n"
     "A frame is shown only if its message passed its CRC and its rebuilt pixels match\n"
@@ -119,22 +120,36 @@ static void on_event(void *ctx, const fl_event *ev)
     case FL_EV_FRAME:
         show_frame(b, ev);
         break;
+    case FL_EV_HELLO:
+        if (ev->hello.scene_name[0])
+            fprintf(stderr, "display: the sender draws scene %s (blob CRC-32 %08x)\n", ev->hello.scene_name,
+                    (unsigned)ev->hello.scene_crc);
+        break;
     default:
         break;
     }
 }
 
+/* s as a JSON string's contents (the decoder let only printable ASCII through). */
+static void json_chars(const char *s)
+{
+    for (; *s; s++) printf(*s == '"' || *s == '\\' ? "\\%c" : "%c", *s);
+}
+
 static void print_summary(const board *b, int json)
 {
     const fl_counters *c = &b->dec.count;
+    const fl_hello *h = &b->dec.hello; /* the last HELLO's ("", 0 when none came or it named no scene) */
     unsigned long per_frame = b->shown ? (unsigned long)(b->frame_bytes / (uint64_t)b->shown) : 0;
     if (json) {
         printf("{\"frames_shown\": %ld, \"frames_no_palette\": %ld, \"frames_dropped\": %u, "
                "\"frames_missed\": %u, \"msgs_ok\": %u, \"msgs_bad\": %u, \"resyncs\": %u, "
                "\"keyreqs_sent\": %u, \"palreqs_sent\": %u, \"acks_sent\": %u, \"bytes\": %u, "
-               "\"bytes_per_frame\": %lu}\n",
+               "\"bytes_per_frame\": %lu, \"hellos\": %u, \"scene\": \"",
                b->shown, b->no_palette, c->frames_dropped, c->frames_missed, c->msgs_ok, c->msgs_bad, c->resyncs,
-               c->keyreqs_sent, c->palreqs_sent, c->acks_sent, c->bytes, per_frame);
+               c->keyreqs_sent, c->palreqs_sent, c->acks_sent, c->bytes, per_frame, c->hellos);
+        json_chars(h->scene_name);
+        printf("\", \"scene_crc32\": \"%08x\"}\n", (unsigned)h->scene_crc);
     } else {
         fprintf(stderr,
                 "display: %ld frames shown, %ld not shown for want of a palette, %u bad messages, "
@@ -142,6 +157,8 @@ static void print_summary(const board *b, int json)
                 "shown)\n",
                 b->shown, b->no_palette, c->msgs_bad, c->frames_dropped, c->frames_missed, c->resyncs,
                 c->keyreqs_sent, c->bytes, per_frame);
+        if (h->scene_name[0])
+            fprintf(stderr, "display: scene %s, blob CRC-32 %08x\n", h->scene_name, (unsigned)h->scene_crc);
     }
 }
 

@@ -20,6 +20,8 @@
 
 extern const uint8_t default_scene[];
 extern const uint32_t default_scene_len;
+/* the built-in scene's source (the Makefile compiles it into build/default.bsc) */
+#define DEFAULT_SCENE_NAME "tests/scenes/default.scene"
 
 static const char usage[] =
     "usage: emu [SCENE] [--scale N] [--frames N] [--headless] [--out DIR] [--flat] [--link PORT]\n"
@@ -225,7 +227,7 @@ int main(int argc, char **argv)
     }
 
     int rc = 0;
-    if (linked && link_hello(linked) != 0) {
+    if (linked && link_hello(linked, spec ? spec : DEFAULT_SCENE_NAME, data, len) != 0) {
         fprintf(stderr, "emu: --link %s\n", link_error(linked));
         rc = 1;
     } else if (!headless && hal_sdl_init(scale, "bspvga") == 0) {

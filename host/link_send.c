@@ -125,9 +125,10 @@ int link_open(link_sender *l, const char *port, long baud, char *err, size_t err
     return 0;
 }
 
-int link_hello(link_sender *l)
+int link_hello(link_sender *l, const char *scene, const uint8_t *blob, size_t blob_len)
 {
     if (l->failed) return -1;
+    fl_enc_scene(&l->enc, scene, crc_update(0, blob, blob_len));
     fl_enc_hello(&l->enc);
     return l->failed ? -1 : 0;
 }

@@ -49,8 +49,10 @@ typedef struct {
  * SIGPIPE for the process: a vanished receiver is reported by link_frame. */
 int link_open(link_sender *l, const char *port, long baud, char *err, size_t errlen);
 
-/* Start the session: the HELLO message (the one place that sends it). */
-int link_hello(link_sender *l);
+/* Start the session: the HELLO message (the one place that sends it), naming
+ * the scene as it was given (a file or WAD:MAP) and the CRC-32 of its compiled
+ * blob, so that what the receiver records reproduces the frames. */
+int link_hello(link_sender *l, const char *scene, const uint8_t *blob, size_t blob_len);
 
 /* Send frame frame_no (64,000 pixels) in palette (768 bytes; sent first when it
  * is new or changed). info: camera and modes; its crc is computed here. A delta

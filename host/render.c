@@ -502,10 +502,11 @@ static void print_json(const options *o, const engine *e, uint32_t crc, const li
 
 /* --link: hello, palette and the frame as a keyframe, then its ack awaited
  * (at most the ack timeout). 0, or -1 after a message naming the port. */
-static int send_link(link_sender *l, const engine *e, const uint8_t *frame)
+static int send_link(link_sender *l, const engine *e, const uint8_t *frame, const char *scene,
+                     const uint8_t *blob, size_t blob_len)
 {
     fl_frame_info info = link_info_of(e);
-    if (link_hello(l) == 0 && link_frame(l, 0, frame, hal_get_palette(), &info) == 0 && link_finish(l) == 0)
+    if (link_hello(l, scene, blob, blob_len) == 0 && link_frame(l, 0, frame, hal_get_palette(), &info) == 0 && link_finish(l) == 0)
         return 0;
     fprintf(stderr, "render: --link %s\n", link_error(l));
     return -1;
@@ -629,7 +630,7 @@ int main(int argc, char **argv)
             failed = fprintf(stderr, "render: %s: cannot write id buffer: %s\n", o.ids, strerror(errno));
         free(bytes);
     }
-    if (o.link && send_link(&sender, &e, frame) != 0) failed = 1;
+    if (o.link && send_link(&sender, &e, frame, o.scene, blob, len) != 0) failed = 1;
     print_json(&o, &e, crc, o.link ? &sender : NULL);
     if (o.link) link_close(&sender);
     free(ids);

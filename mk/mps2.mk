@@ -23,10 +23,15 @@
 #          areas) PSRAM at 0x21000000, up to 16 MB.
 #          STACK_BYTES (default 9216, with FULL=1 12288): the stack (the firmware
 #          reports its high-water mark).
-#   make run-firmware [UART=FILE|stdio] [RUN_ARGS="--frames 10 ..."]
-#       runs it in qemu-system-arm; the UART (the frame stream) goes to
-#       build/arm/uart.bin (or stdout with UART=stdio), the firmware's messages
-#       (semihosting) to the terminal; QEMU's exit status is the firmware's.
+#   make run-firmware [UART=FILE|stdio | PORT=tcp:N|tcp:HOST:N|pty] [RUN_ARGS="--frames 10 ..."]
+#       runs the firmware last built in qemu-system-arm (no rebuild unless a
+#       build setting such as SCENE= is given again) and says which scene it
+#       holds (tools/run_firmware.py). The UART (the frame stream) goes to
+#       build/arm/uart.bin, or to stdout alone with UART=stdio (everything else
+#       on stderr), or to a TCP server that waits for its reader (PORT=tcp:N),
+#       or to a pty, QEMU paused until a reader opens it (PORT=pty). The
+#       firmware's messages (semihosting) go to stderr; QEMU's exit status is
+#       the firmware's.
 #   make insn-plugin  -> build/insn_count.so
 #   make bench-m3 [BENCH_M3_ARGS=...]  instructions per frame on the Cortex-M3 per render mode,
 #                     world alone and with things, and the stages of the frame, for the bench and
@@ -198,9 +203,19 @@ $(ARM_OUT)/firmware.elf: $(ARM_OBJS) hal/mps2/mps2.ld $(ARM_OUT)/config
 MPS2_QEMU = $(QEMU_ARM) -M mps2-an385 -nographic -monitor none \
             -semihosting-config enable=on,target=native -kernel $(ARM_OUT)/firmware.elf
 
-run-firmware: $(ARM_OUT)/firmware.elf
-	@echo "mps2: UART -> $(UART); firmware messages below; exit status = the firmware's"
-	$(MPS2_QEMU) -serial $(if $(filter stdio,$(UART)),stdio,file:$(UART)) $(if $(RUN_ARGS),-append '$(RUN_ARGS)')
+# run-firmware runs the firmware last built, as it is (tools/run_firmware.py says which scene it
+# holds): a later `make run-firmware` without SCENE= must not rebuild it for the default scene.
+# Only a build setting given on the command line rebuilds first, with make's output on stderr:
+# stdout carries nothing but the UART with UART=stdio.
+FW_BUILD_VARS := SCENE FULL CAMPATH WORK_BYTES STREAM FW_MODES RAM_BYTES STACK_BYTES FLAT DIRECT_FACES DIRECT_EDGES
+FW_BUILD_GIVEN := $(strip $(foreach v,$(FW_BUILD_VARS),$(if $(filter command line,$(origin $(v))),$(v))))
+RUN_PY := $(if $(wildcard $(PY)),$(PY),python3)
+PORT ?=
+run-firmware:
+	@$(if $(FW_BUILD_GIVEN),$(MAKE) --no-print-directory firmware >&2 &&) \
+	$(RUN_PY) tools/run_firmware.py --elf $(ARM_OUT)/firmware.elf --qemu '$(QEMU_ARM)' \
+	  --uart '$(UART)' $(if $(PORT),--port '$(PORT)') \
+	  $(if $(RUN_ARGS),--args '$(RUN_ARGS)')
 
 # ---- instruction counts (TCG plugin) ----------------------------------------------
 $(BUILD)/insn_count.so: tools/qemu_plugin/insn_count.c tools/qemu_plugin/qemu_plugin_api.h

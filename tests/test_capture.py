@@ -49,10 +49,10 @@ def captured(kind, tmp_path, frames=FRAMES, relay_rate=None, args=None):
 
 
 def host_frame(rec, tmp_path):
-    """build/render's frame for the captured camera, on the scene built into the firmware."""
+    """build/render's frame for the captured camera and the scene the capture names (render_args
+    alone, run from the repository's root)."""
     raw = tmp_path / f"host_{rec['frame']}.bin"
-    j = json.loads(run([program("render", sanitized=False), ARM / "scene.bsc", *rec["render_args"],
-                        "--raw", raw]).stdout)
+    j = json.loads(run([program("render", sanitized=False), *rec["render_args"], "--raw", raw], cwd=ROOT).stdout)
     return j, raw.read_bytes()
 
 
@@ -62,6 +62,11 @@ def test_capture_is_bit_identical_to_the_host(firmware, tmp_path, kind):
     assert status == 0, log
     assert summary["frames_captured"] == FRAMES and summary["msgs_bad"] == 0, summary
     assert [r["frame"] for r in records] == list(range(FRAMES))
+    # the capture names the scene built into the firmware, and its compiled blob's CRC-32
+    crc = "%08x" % zlib.crc32((ARM / "scene.bsc").read_bytes())
+    assert {(r["scene"], r["scene_crc32"]) for r in records} == {("tests/scenes/default.scene", crc)}
+    assert (summary["scene"], summary["scene_crc32"]) == ("tests/scenes/default.scene", crc)
+    assert records[0]["render_args"][0] == "tests/scenes/default.scene"
     for rec in records:
         j, pixels = host_frame(rec, tmp_path)
         assert j["crc32"] == rec["crc32"], rec
@@ -191,3 +196,28 @@ def test_capture_skips_frames_before_the_palette(tmp_path):
     assert all(read_png_indexed(p)[3] == palette for p in pngs)
     records = [json.loads(line) for line in (tmp_path / "cap" / "frames.jsonl").read_text().splitlines()]
     assert [r["frame"] for r in records] == [3, 4, 5]
+
+
+def test_capture_render_reproduces_a_frame(firmware, tmp_path):
+    """tools/capture.py --render FRAME redraws a captured frame with build/render from the scene the
+    capture names and says it matches; a frame whose captured pixels differ, or whose scene's blob
+    CRC-32 differs from the captured one, is reported."""
+    status, summary, records, log, _ = captured("tcp", tmp_path, frames=5)
+    assert status == 0 and summary["frames_captured"] == 5, log
+    cap = tmp_path / "cap"
+    tool = [sys.executable, str(ROOT / "tools/capture.py")]
+    ok = subprocess.run(tool + ["--render", "4", "--out", str(cap)], capture_output=True, text=True, cwd=tmp_path)
+    assert ok.returncode == 0 and "frame 4: match" in ok.stderr, ok.stderr
+    assert "warning" not in ok.stderr
+    # another scene CRC recorded: a warning; another pixel CRC recorded: a mismatch
+    lines = (cap / "frames.jsonl").read_text().splitlines()
+    rec = json.loads(lines[4])
+    rec["scene_crc32"] = "12345678"
+    rec["crc32"] = "%08x" % (int(rec["crc32"], 16) ^ 1)
+    lines[4] = json.dumps(rec)
+    (cap / "frames.jsonl").write_text("\n".join(lines) + "\n")
+    bad = subprocess.run(tool + ["--render", "4", "--out", str(cap)], capture_output=True, text=True, cwd=tmp_path)
+    assert bad.returncode == 1 and "MISMATCH" in bad.stderr, bad.stderr
+    assert "warning" in bad.stderr and "12345678" in bad.stderr
+    missing = subprocess.run(tool + ["--render", "99", "--out", str(cap)], capture_output=True, text=True)
+    assert missing.returncode == 1 and "frame 99 is not in" in missing.stderr

@@ -10,10 +10,11 @@
  *       --flat draws a textured scene in its flat colours (the cameras are
  *       the same: drawing does not steer the walk).
  *   fltool encode FRAMES.raw --out STREAM [--info FRAMES.jsonl] [--palette P.bin]
- *                 [--key-interval N] [--scratch BYTES] [--sizes]
+ *                 [--key-interval N] [--scratch BYTES] [--sizes] [--scene NAME [--scene-crc HEX]]
  *       Encodes the frames with the C encoder (hello, palette, then one frame
  *       message each: keyframe or delta against the previous frame) into a byte
- *       stream file. --sizes prints one JSON line per frame (bytes on the wire,
+ *       stream file; its hello names the scene NAME, blob CRC-32 HEX (default:
+ *       none). --sizes prints one JSON line per frame (bytes on the wire,
  *       keyframe or not).
  *   fltool decode STREAM [--chunk N] [--frames-out FILE]
  *       Feeds the stream to the C decoder (in chunks of N bytes, default 4096)
@@ -254,7 +255,8 @@ static void parse_info(const char *line, fl_frame_info *fi)
 
 static int cmd_encode(int argc, char **argv, int bench)
 {
-    const char *in = NULL, *out = NULL, *infof = NULL, *palf = NULL;
+    const char *in = NULL, *out = NULL, *infof = NULL, *palf = NULL, *scene_name = NULL;
+    unsigned long scene_crc = 0;
     long key_interval = 64, scratch_bytes = 16384, repeat = 1, limit = -1;
     int sizes = 0, with_crc = 0, no_crc = 0;
     for (int i = 0; i < argc; i++) {
@@ -268,6 +270,8 @@ static int cmd_encode(int argc, char **argv, int bench)
         else if (!strcmp(argv[i], "--sizes")) sizes = 1;
         else if (!strcmp(argv[i], "--crc")) with_crc = 1;
         else if (!strcmp(argv[i], "--no-crc")) no_crc = 1;
+        else if (!strcmp(argv[i], "--scene") && i + 1 < argc) scene_name = argv[++i];
+        else if (!strcmp(argv[i], "--scene-crc") && i + 1 < argc) scene_crc = strtoul(argv[++i], NULL, 16);
         else if (argv[i][0] != '-' && !in) in = argv[i];
         else return usage();
     }
@@ -319,6 +323,7 @@ static int cmd_encode(int argc, char **argv, int bench)
         if (bench) fl_enc_init(&enc, put_count, &counted, scratch, (uint32_t)scratch_bytes);
         else fl_enc_init(&enc, put_file, fo, scratch, (uint32_t)scratch_bytes);
         enc.key_interval = (uint32_t)key_interval;
+        fl_enc_scene(&enc, scene_name, (uint32_t)scene_crc);
         fl_enc_hello(&enc);
         fl_enc_palette(&enc, pal);
         for (long k = 0; k < nframes; k++) {
@@ -367,9 +372,11 @@ static void on_event(void *ctx, const fl_event *ev)
     switch (ev->kind) {
     case FL_EV_HELLO:
         printf("{\"event\": \"hello\", \"frame\": %u, \"version\": %u, \"width\": %u, \"height\": %u, \"gun_bits\": %u, "
-               "\"key_interval\": %u, \"window\": %u, \"methods\": %u}\n",
+               "\"key_interval\": %u, \"window\": %u, \"methods\": %u, \"scene\": \"",
                (unsigned)ev->frame_no, ev->hello.version, ev->hello.width, ev->hello.height, ev->hello.gun_bits,
                ev->hello.key_interval, ev->hello.window, ev->hello.methods);
+        for (const char *q = ev->hello.scene_name; *q; q++) printf(*q == '"' || *q == '\\' ? "\\%c" : "%c", *q);
+        printf("\", \"scene_crc32\": \"%08x\"}\n", (unsigned)ev->hello.scene_crc);
         break;
     case FL_EV_PALETTE:
         printf("{\"event\": \"palette\", \"frame\": %u, \"crc32\": \"%08x\"}\n", (unsigned)ev->frame_no,

@@ -36,7 +36,9 @@ MSG_MAX = HEADER_BYTES + PAYLOAD_MAX + CRC_BYTES
 
 MSG_HELLO, MSG_PALETTE, MSG_KEYFRAME, MSG_DELTA, MSG_ACK, MSG_KEYREQ = 1, 2, 3, 4, 5, 6
 METHOD_RAW, METHOD_EDGE, METHOD_RAW_HASH = 0, 1, 2
-HELLO_BYTES = 10
+HELLO_CAPS = 10          # the capabilities: all a HELLO held before scene names
+HELLO_MIN = HELLO_CAPS + 5  # then the scene's blob CRC (u32), its name's length (u8), the name
+SCENE_NAME_MAX = 63
 BACK_BYTES = 5
 
 REASONS = ["none", "framing", "short", "long", "crc", "version", "length", "type", "payload",
@@ -512,6 +514,30 @@ def _gt(a, b):
     return d != 0 and d < 0x80000000
 
 
+def unpack_hello(pl):
+    """A HELLO payload as a dict, or None if invalid: the 10 capability bytes alone (a sender from
+    before scene names: no scene), or followed by the scene's blob CRC, the name's length (at most
+    63, exactly the bytes that follow) and the name (printable ASCII)."""
+    if len(pl) == HELLO_CAPS:
+        crc, name = 0, b""
+    elif HELLO_MIN <= len(pl) <= HELLO_MIN + SCENE_NAME_MAX and len(pl) == HELLO_MIN + pl[HELLO_CAPS + 4]:
+        crc, name = struct.unpack_from("<I", pl, HELLO_CAPS)[0], pl[HELLO_MIN:]
+        if any(c < 0x20 or c > 0x7E for c in name):
+            return None
+    else:
+        return None
+    ver, w, h, gun, ki, win, methods = struct.unpack_from("<BHHBHBB", pl)
+    return {"version": ver, "width": w, "height": h, "gun_bits": gun, "key_interval": ki, "window": win,
+            "methods": methods, "scene": name.decode("ascii"), "scene_crc32": f"{crc:08x}"}
+
+
+def pack_hello(key_interval=64, window=4, methods=3, scene="", scene_crc=0):
+    """A HELLO payload as fl_enc_hello sends it (scene truncated and made printable likewise)."""
+    name = bytes(c if 0x20 <= c <= 0x7E else 0x3F for c in scene.encode("utf-8")[:SCENE_NAME_MAX])
+    return (struct.pack("<BHHBHBB", VERSION, W, H, 8, min(key_interval, 0xFFFF), window, methods) +
+            struct.pack("<IB", scene_crc, len(name)) + name)
+
+
 class Decoder:
     """The receiving end. back(bytes), if given, receives the acks and keyframe requests."""
 
@@ -642,13 +668,13 @@ class Decoder:
             return self._bad(why)
         mtype, frame_no, pl = msg
         if mtype == MSG_HELLO:
-            if len(pl) != HELLO_BYTES:
+            hello = unpack_hello(pl)
+            if hello is None:
                 return self._bad(R_PAYLOAD)
             self._ok()
             self.counters["hellos"] += 1
-            ver, w, h, gun, ki, win, methods = struct.unpack("<BHHBHBB", pl)
-            self.hello = {"version": ver, "width": w, "height": h, "gun_bits": gun, "key_interval": ki,
-                          "window": win, "methods": methods}
+            self.hello = hello
+            win = hello["window"]
             self.window = win if win else 4
             self.have_frame = False
             self.have_seen = False
@@ -673,7 +699,8 @@ class Decoder:
 
     def feed(self, data):
         """Feed bytes; returns the events they completed, in order:
-        {"event": "hello", "frame", "version", "width", "height", "gun_bits", "key_interval", "window", "methods"}
+        {"event": "hello", "frame", "version", "width", "height", "gun_bits", "key_interval", "window", "methods",
+         "scene": name ("" when not said), "scene_crc32": 8 hex digits of the scene blob's CRC-32 ("00000000": not said)}
         {"event": "palette", "frame", "crc32", "palette": 768 bytes}
         {"event": "frame", "frame", "keyframe", "info": {x, y, z, angle, look, mode, present, crc32, no_crc},
          "pixels": the 64,000 bytes shown}      (.frame is the latest frame shown, after the whole call)

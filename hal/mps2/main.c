@@ -20,6 +20,7 @@
 
 #include "args.h"
 #include "campath.h"
+#include "crc32.h"
 #include "engine.h"
 #include "fixed_view.h"
 #include "hal.h"
@@ -116,14 +117,16 @@ int main(void)
      * console only: text between its messages would cost the receiver a bad
      * message. Errors before that point go to both. */
     if (!args.no_stream && !stream_text_ok()) log_set_sinks(LOG_TO_SEMIHOST);
-    log_printf("firmware: mps2-an385 Cortex-M3; scene %s (%u bytes, work %u of %u bytes, world state %u); "
+    /* the blob's CRC names exactly what was built in: the hello carries it, a capture checks it */
+    uint32_t scene_crc = crc_update(0, fw_scene, fw_scene_len);
+    log_printf("firmware: mps2-an385 Cortex-M3; scene %s (%u bytes, CRC-32 %08x, work %u of %u bytes, world state %u); "
                "%s %u frames; mode %s, present %s; stream %s\n",
-               fw_scene_name, (unsigned)fw_scene_len, (unsigned)need, (unsigned)fw_work_bytes,
+               fw_scene_name, (unsigned)fw_scene_len, (unsigned)scene_crc, (unsigned)need, (unsigned)fw_work_bytes,
                (unsigned)obj_state_bytes(&e.sc),
                fixed_view ? "fixed view," : path->name, (unsigned)frames, render_mode_name(e.mode),
                hal_present_name(e.present), args.no_stream ? "off" : stream_kind());
 
-    if (!args.no_stream && stream_begin(&e) != 0) {
+    if (!args.no_stream && stream_begin(&e, fw_scene_name, scene_crc) != 0) {
         log_printf("firmware: the frame link did not start\n");
         return FW_EXIT_LINK;
     }

@@ -26,8 +26,10 @@ typedef enum { STREAM_ACKS_AUTO, STREAM_ACKS_ON, STREAM_ACKS_OFF } stream_acks;
 
 void stream_set_acks(stream_acks mode);
 
-/* Before the first frame: hello, palette. Returns 0 or -1. */
-int stream_begin(const engine *e);
+/* Before the first frame: hello (naming the scene: its name and the CRC-32 of
+ * its compiled blob, which a capture records to reproduce the frames), palette.
+ * Returns 0 or -1. */
+int stream_begin(const engine *e, const char *scene_name, uint32_t scene_crc);
 
 /* Send the page shown now as frame frame_no, with its information, after the
  * frame before it. Returns 0, or -1 if the link failed. */

@@ -77,12 +77,13 @@ void stream_set_acks(stream_acks mode)
     st.acks = mode;
 }
 
-int stream_begin(const engine *e)
+int stream_begin(const engine *e, const char *scene_name, uint32_t scene_crc)
 {
     (void)e;
     st.heard = 0;
     st.have_prev = 0;
     fl_enc_init(&enc, put, 0, scratch, sizeof scratch);
+    fl_enc_scene(&enc, scene_name, scene_crc);
     fl_enc_hello(&enc);
     fl_enc_palette(&enc, hal_get_palette()); /* mps2_palette: stays valid */
     return 0;

@@ -38,9 +38,11 @@ void stream_set_acks(stream_acks mode)
     (void)mode; /* no acks in this encoding */
 }
 
-int stream_begin(const engine *e)
+int stream_begin(const engine *e, const char *scene_name, uint32_t scene_crc)
 {
     (void)e;
+    (void)scene_name; /* raw records have no place for the scene */
+    (void)scene_crc;
     uart_write("RAWP", 4);
     uart_write(hal_get_palette(), HAL_PALETTE_BYTES);
     return 0;

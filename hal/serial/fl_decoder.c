@@ -6,7 +6,6 @@
 #include "crc32.h"
 #include "fl_internal.h"
 
-#define HELLO_BYTES 10
 #define BACK_BYTES 5
 
 void fl_dec_init(fl_decoder *d, uint8_t *frame, uint8_t *work, fl_event_fn on_event, void *ev_ctx,
@@ -175,6 +174,38 @@ static void frame_msg(fl_decoder *d, const fl_msg *m)
     }
 }
 
+/* A HELLO's payload into h: the capabilities alone (a sender from before scene
+ * names: no scene), or with the scene, whose name must have the length it
+ * says, at most FL_SCENE_NAME_MAX, all printable. Returns 0, or -1 if invalid. */
+static int hello_unpack(fl_hello *h, const uint8_t *p, uint32_t n)
+{
+    if (n != FL_HELLO_CAPS && (n < FL_HELLO_MIN || n != FL_HELLO_MIN + (uint32_t)p[FL_HELLO_CAPS + 4] ||
+                               n > FL_HELLO_MAX))
+        return -1;
+    uint32_t len = n == FL_HELLO_CAPS ? 0 : n - FL_HELLO_MIN;
+    for (uint32_t i = 0; i < len; i++)
+        if (!fl_name_char_ok(p[FL_HELLO_MIN + i])) return -1;
+    h->version = p[0];
+    h->width = (uint16_t)fl_get16(p + 1);
+    h->height = (uint16_t)fl_get16(p + 3);
+    h->gun_bits = p[5];
+    h->key_interval = (uint16_t)fl_get16(p + 6);
+    h->window = p[8];
+    h->methods = p[9];
+    h->scene_crc = n == FL_HELLO_CAPS ? 0 : fl_get32(p + FL_HELLO_CAPS);
+    for (uint32_t i = 0; i < len; i++) h->scene_name[i] = (char)p[FL_HELLO_MIN + i];
+    h->scene_name[len] = '\0';
+    return 0;
+}
+
+/* By bytes: a struct copy this size becomes a memcpy call, and the targets link no libc. */
+static void hello_copy(fl_hello *to, const fl_hello *from)
+{
+    uint8_t *t = (uint8_t *)to;
+    const uint8_t *f = (const uint8_t *)from;
+    for (uint32_t i = 0; i < sizeof *to; i++) t[i] = f[i];
+}
+
 static void message(fl_decoder *d, const uint8_t *buf, uint32_t len)
 {
     fl_msg m;
@@ -186,16 +217,9 @@ static void message(fl_decoder *d, const uint8_t *buf, uint32_t len)
     fl_event ev;
     switch (m.type) {
     case FL_MSG_HELLO:
-        if (m.len != HELLO_BYTES) break;
+        if (hello_unpack(&d->hello, m.payload, m.len)) break;
         good(d);
         d->count.hellos++;
-        d->hello.version = m.payload[0];
-        d->hello.width = (uint16_t)fl_get16(m.payload + 1);
-        d->hello.height = (uint16_t)fl_get16(m.payload + 3);
-        d->hello.gun_bits = m.payload[5];
-        d->hello.key_interval = (uint16_t)fl_get16(m.payload + 6);
-        d->hello.window = m.payload[8];
-        d->hello.methods = m.payload[9];
         d->have_hello = 1;
         d->window = d->hello.window ? d->hello.window : 4;
         /* a new session: frame numbers start again, the old frame is no base */
@@ -205,7 +229,7 @@ static void message(fl_decoder *d, const uint8_t *buf, uint32_t len)
         event0(&ev, FL_EV_HELLO);
         ev.type = m.type;
         ev.frame_no = m.frame_no;
-        ev.hello = d->hello;
+        hello_copy(&ev.hello, &d->hello);
         emit(d, &ev);
         return;
     case FL_MSG_PALETTE:

@@ -1,9 +1,8 @@
-/* fl_encoder.c - the sending end of the frame link (runs on the target): hello,
- * palette, keyframe or delta per frame, acks and keyframe requests from the
+/* fl_encoder.c - the sending end of the frame link (runs on the target): hello
+ * (with the scene's name and blob CRC), palette, keyframe or delta per frame, acks and keyframe requests from the
  * receiver, and the flow-control window. docs/frame-link.md, "Sender". */
 #include "fl_internal.h"
 
-#define HELLO_BYTES 10
 #define BACK_BYTES 5 /* ACK and KEYREQ payloads */
 
 void fl_enc_init(fl_encoder *e, fl_put_fn put, void *ctx, uint8_t *scratch, uint32_t scratch_bytes)
@@ -24,9 +23,19 @@ static uint32_t next_frame_no(const fl_encoder *e)
     return e->sent_any ? e->last_sent + 1 : 0;
 }
 
+void fl_enc_scene(fl_encoder *e, const char *name, uint32_t blob_crc)
+{
+    uint32_t n = 0;
+    /* only printable ASCII goes on the wire: the receiver refuses a HELLO with anything else */
+    for (; name && name[n] && n < FL_SCENE_NAME_MAX; n++)
+        e->scene_name[n] = fl_name_char_ok((uint8_t)name[n]) ? name[n] : '?';
+    e->scene_len = (uint8_t)n;
+    e->scene_crc = blob_crc;
+}
+
 void fl_enc_hello(fl_encoder *e)
 {
-    uint8_t h[HELLO_BYTES];
+    uint8_t h[FL_HELLO_MAX];
     h[0] = FL_VERSION;
     fl_put16(h + 1, FL_W);
     fl_put16(h + 3, FL_H);
@@ -34,7 +43,10 @@ void fl_enc_hello(fl_encoder *e)
     fl_put16(h + 6, e->key_interval > 0xFFFF ? 0xFFFF : e->key_interval);
     h[8] = e->window;
     h[9] = (1u << FL_METHOD_RAW) | (1u << FL_METHOD_EDGE) | (1u << FL_METHOD_RAW_HASH);
-    fl_writer_message(&e->w, FL_MSG_HELLO, next_frame_no(e), h, HELLO_BYTES);
+    fl_put32(h + FL_HELLO_CAPS, e->scene_crc);
+    h[FL_HELLO_CAPS + 4] = e->scene_len;
+    for (uint32_t i = 0; i < e->scene_len; i++) h[FL_HELLO_MIN + i] = (uint8_t)e->scene_name[i];
+    fl_writer_message(&e->w, FL_MSG_HELLO, next_frame_no(e), h, FL_HELLO_MIN + e->scene_len);
     e->bytes = e->w.bytes;
     e->force_key = 1; /* a hello starts a session: the receiver forgets its base */
 }

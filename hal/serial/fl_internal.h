@@ -25,6 +25,18 @@ static inline uint32_t fl_get32(const uint8_t *p)
     return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
 }
 
+/* HELLO payload: the capabilities (FL_HELLO_CAPS bytes: all a sender before
+ * scene names sent), then the scene's blob CRC (u32), its name's length (u8)
+ * and the name. */
+#define FL_HELLO_CAPS 10
+#define FL_HELLO_MIN (FL_HELLO_CAPS + 5)
+#define FL_HELLO_MAX (FL_HELLO_MIN + FL_SCENE_NAME_MAX)
+
+static inline int fl_name_char_ok(uint8_t c)
+{
+    return c >= 0x20 && c <= 0x7E;
+}
+
 /* Writer: begin a message (header), add payload bytes, end it (CRC, delimiter). */
 void fl_writer_init(fl_writer *w, fl_put_fn put, void *ctx);
 void fl_writer_begin(fl_writer *w, uint8_t type, uint32_t frame_no, uint32_t payload_len);

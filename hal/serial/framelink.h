@@ -37,6 +37,7 @@
 #define FL_PAYLOAD_MAX 65536u      /* largest payload a receiver accepts */
 #define FL_MSG_MAX (FL_HEADER_BYTES + FL_PAYLOAD_MAX + FL_CRC_BYTES)
 #define FL_WINDOW_MAX 32           /* largest flow-control window */
+#define FL_SCENE_NAME_MAX 63       /* longest scene name a HELLO carries */
 
 /* Message types. */
 enum {
@@ -66,7 +67,7 @@ typedef struct {
                           * check still protects the frame; the receiver fills crc in) */
 } fl_frame_info;
 
-/* Sender capabilities (the HELLO payload). */
+/* Sender capabilities and the scene it draws (the HELLO payload). */
 typedef struct {
     uint8_t version;       /* protocol version the sender speaks */
     uint16_t width, height;
@@ -74,6 +75,8 @@ typedef struct {
     uint16_t key_interval; /* a keyframe at least every this many frames (0: only when needed) */
     uint8_t window;        /* frames the sender keeps in flight unacknowledged */
     uint8_t methods;       /* bit per FL_METHOD_* it may use */
+    uint32_t scene_crc;    /* crc_update(0, blob) of the scene's compiled blob; 0: not said */
+    char scene_name[FL_SCENE_NAME_MAX + 1]; /* printable ASCII, NUL-terminated; "": not said */
 } fl_hello;
 
 /* Output: the callee must take all n bytes (copy them out; p is reused). */
@@ -146,6 +149,11 @@ typedef struct {
     uint8_t in_head, in_count;
     uint32_t stall_since_ms;
 
+    /* the scene named in HELLO (fl_enc_scene) */
+    uint32_t scene_crc;
+    uint8_t scene_len;
+    char scene_name[FL_SCENE_NAME_MAX];
+
     /* counters */
     uint32_t frames, keyframes, deltas, raw_fallbacks, bytes;
     uint32_t acks, keyreqs, palette_reqs, timeouts, rx_bad;
@@ -163,7 +171,13 @@ typedef struct {
  * the wire, streamed straight from the pixels). Sends nothing. */
 void fl_enc_init(fl_encoder *e, fl_put_fn put, void *ctx, uint8_t *scratch, uint32_t scratch_bytes);
 
-/* Send HELLO (capabilities; frame field = next frame number). */
+/* Name the scene the frames are drawn from, for the HELLOs sent after it: its
+ * name (NUL-terminated; the first FL_SCENE_NAME_MAX bytes are kept, a byte that
+ * is not printable ASCII becomes '?'; NULL: none) and crc_update(0, blob, len)
+ * of its compiled blob. A sender that never calls it names no scene ("", 0). */
+void fl_enc_scene(fl_encoder *e, const char *name, uint32_t blob_crc);
+
+/* Send HELLO (capabilities and scene; frame field = next frame number). */
 void fl_enc_hello(fl_encoder *e);
 
 /* Send the palette (768 bytes, r g b, 8 bits per gun). The pointer is kept to

@@ -902,6 +902,97 @@ static void test_single_pixel_detected(void **state)
     assert_int_equal(r->dec.count.frames_shown, 1);
     assert_memory_equal(r->dec.frame, tex, FL_FRAME_BYTES);
     assert_int_equal(r->dec.shown_info.crc, crc_update(0, tex, FL_FRAME_BYTES)); /* filled in by the receiver */
+/* ---- HELLO: the scene's name and blob CRC ------------------------------------ */
+
+/* Feed one HELLO with payload pl (n bytes) to r; returns whether it was taken. */
+static int feed_hello(receiver *r, const uint8_t *pl, uint32_t n)
+{
+    buf b = {0};
+    fl_writer w;
+    fl_writer_init(&w, buf_put, &b);
+    fl_writer_message(&w, FL_MSG_HELLO, 0, pl, n);
+    uint32_t before = r->dec.count.hellos;
+    fl_dec_feed(&r->dec, b.p, (uint32_t)b.len);
+    free(b.p);
+    return r->dec.count.hellos == before + 1;
+}
+
+static void test_hello_scene(void **state)
+{
+    (void)state;
+    uint32_t none[1] = {0};
+    receiver *r = receiver_new(none, 0);
+    static fl_encoder enc;
+    static uint8_t scratch[1024];
+    buf s = {0};
+    fl_enc_init(&enc, buf_put, &s, scratch, sizeof scratch);
+    /* a sender that names no scene */
+    fl_enc_hello(&enc);
+    fl_dec_feed(&r->dec, s.p, (uint32_t)s.len);
+    assert_int_equal(r->dec.count.hellos, 1);
+    assert_string_equal(r->dec.hello.scene_name, "");
+    assert_int_equal(r->dec.hello.scene_crc, 0);
+    /* named */
+    s.len = 0;
+    fl_enc_scene(&enc, "freedoom2.wad:MAP01", 0xDEADBEEFu);
+    fl_enc_hello(&enc);
+    fl_dec_feed(&r->dec, s.p, (uint32_t)s.len);
+    assert_int_equal(r->dec.count.hellos, 2);
+    assert_string_equal(r->dec.hello.scene_name, "freedoom2.wad:MAP01");
+    assert_int_equal(r->dec.hello.scene_crc, 0xDEADBEEFu);
+    assert_int_equal(r->dec.hello.width, FL_W);
+    /* too long: the first 63 bytes; bytes that are not printable ASCII become '?' */
+    char longname[200];
+    memset(longname, 'a', sizeof longname - 1);
+    longname[sizeof longname - 1] = '\0';
+    longname[0] = '\n';
+    longname[1] = (char)0xC3;
+    s.len = 0;
+    fl_enc_scene(&enc, longname, 7);
+    fl_enc_hello(&enc);
+    fl_dec_feed(&r->dec, s.p, (uint32_t)s.len);
+    assert_int_equal(r->dec.count.hellos, 3);
+    assert_int_equal(strlen(r->dec.hello.scene_name), FL_SCENE_NAME_MAX);
+    assert_memory_equal(r->dec.hello.scene_name, "??aaa", 5);
+    /* NULL: no scene again */
+    s.len = 0;
+    fl_enc_scene(&enc, NULL, 0);
+    fl_enc_hello(&enc);
+    fl_dec_feed(&r->dec, s.p, (uint32_t)s.len);
+    assert_string_equal(r->dec.hello.scene_name, "");
+    assert_int_equal(r->dec.count.msgs_bad, 0);
+
+    /* the 10-byte HELLO of a sender from before scene names: taken, no scene */
+    uint8_t pl[FL_HELLO_MAX + 8] = {FL_VERSION, 64, 1, 200, 0, 8, 16, 0, 4, 3};
+    assert_true(feed_hello(r, pl, FL_HELLO_CAPS));
+    assert_string_equal(r->dec.hello.scene_name, "");
+    assert_int_equal(r->dec.hello.window, 4);
+    /* a good one by hand, then each way of breaking it */
+    pl[10] = 0x78, pl[11] = 0x56, pl[12] = 0x34, pl[13] = 0x12;
+    pl[14] = 3;
+    memcpy(pl + 15, "abc", 3);
+    assert_true(feed_hello(r, pl, 18));
+    assert_string_equal(r->dec.hello.scene_name, "abc");
+    assert_int_equal(r->dec.hello.scene_crc, 0x12345678u);
+    uint32_t bad = r->dec.count.msgs_bad;
+    assert_false(feed_hello(r, pl, 17));  /* shorter than its length byte says */
+    assert_false(feed_hello(r, pl, 19));  /* longer */
+    assert_false(feed_hello(r, pl, 11));  /* between the two layouts */
+    assert_false(feed_hello(r, pl, 14));
+    pl[16] = 0;                           /* a NUL in the name */
+    assert_false(feed_hello(r, pl, 18));
+    pl[16] = 0x7F;                        /* not printable */
+    assert_false(feed_hello(r, pl, 18));
+    pl[16] = 0x80;
+    assert_false(feed_hello(r, pl, 18));
+    pl[14] = FL_SCENE_NAME_MAX + 1;       /* too long, though consistent */
+    memset(pl + 15, 'x', FL_SCENE_NAME_MAX + 1);
+    assert_false(feed_hello(r, pl, FL_HELLO_MIN + FL_SCENE_NAME_MAX + 1));
+    assert_int_equal(r->dec.count.msgs_bad, bad + 8);
+    assert_string_equal(r->dec.hello.scene_name, "abc"); /* a refused HELLO changes nothing */
+    pl[14] = FL_SCENE_NAME_MAX;
+    assert_true(feed_hello(r, pl, FL_HELLO_MAX));
+    assert_int_equal(strlen(r->dec.hello.scene_name), FL_SCENE_NAME_MAX);
     free(s.p);
     receiver_free(r);
 }
@@ -957,6 +1048,7 @@ int main(void)
         cmocka_unit_test(test_bad_input),         cmocka_unit_test(test_forged_pictures),
         cmocka_unit_test(test_framing),           cmocka_unit_test(test_single_pixel_detected),
         cmocka_unit_test(test_direct_stuffing),     cmocka_unit_test(test_page_flipping),
+        cmocka_unit_test(test_hello_scene),
     };
     return cmocka_run_group_tests_name("framelink", tests, setup, teardown);
 }
