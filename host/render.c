@@ -502,11 +502,12 @@ static void print_json(const options *o, const engine *e, uint32_t crc, const li
 
 /* --link: hello, palette and the frame as a keyframe, then its ack awaited
  * (at most the ack timeout). 0, or -1 after a message naming the port. */
-static int send_link(link_sender *l, const engine *e, const uint8_t *frame, const char *scene,
+static int send_link(link_sender *l, const engine *e, const uint8_t *frame, const char *scene_name,
                      const uint8_t *blob, size_t blob_len)
 {
     fl_frame_info info = link_info_of(e);
-    if (link_hello(l, scene, blob, blob_len) == 0 && link_frame(l, 0, frame, hal_get_palette(), &info) == 0 && link_finish(l) == 0)
+    if (link_hello(l, scene_name, blob, blob_len) == 0 && link_frame(l, 0, frame, hal_get_palette(), &info) == 0 &&
+        link_finish(l) == 0)
         return 0;
     fprintf(stderr, "render: --link %s\n", link_error(l));
     return -1;
