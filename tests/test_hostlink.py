@@ -15,6 +15,7 @@ import subprocess
 import sys
 import threading
 import time
+import zlib
 
 import pytest
 
@@ -174,6 +175,11 @@ def test_render_link_sends_one_keyframe_that_decodes_to_its_frame(tmp_path, flat
     info = frame["info"]
     assert info["crc32"] == j["crc32"] and info["mode"] == ["spans", "painter", "direct"].index(j["mode"])  # render.h
     assert j["textured"] == (0 if flat else 1)
+    # the hello names the scene as given and the CRC-32 of the blob it compiles to
+    blob = tmp_path / "scene.bsc"
+    run([program("bspc", sanitized=False), MAP01, "-o", blob])
+    assert events[0]["scene"] == MAP01
+    assert events[0]["scene_crc32"] == f"{zlib.crc32(blob.read_bytes()):08x}"
 
 
 def test_render_link_over_tcp_without_acks_still_finishes(tmp_path):

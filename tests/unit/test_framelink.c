@@ -902,6 +902,51 @@ static void test_single_pixel_detected(void **state)
     assert_int_equal(r->dec.count.frames_shown, 1);
     assert_memory_equal(r->dec.frame, tex, FL_FRAME_BYTES);
     assert_int_equal(r->dec.shown_info.crc, crc_update(0, tex, FL_FRAME_BYTES)); /* filled in by the receiver */
+    free(s.p);
+    receiver_free(r);
+}
+
+/* fl_writer_direct (no copy) stuffs exactly as fl_writer_bytes: any length,
+ * alignment, bytes already buffered, zeros at every block edge. */
+static void test_direct_stuffing(void **state)
+{
+    (void)state;
+    static _Alignas(8) uint8_t data[1200];
+    rng_state = 5;
+    for (int pat = 0; pat < 4; pat++) {
+        for (uint32_t i = 0; i < sizeof data; i++)
+            data[i] = pat == 0 ? (uint8_t)(i % 255 + 1) : pat == 1 ? 0 : pat == 2 ? (uint8_t)(i % 7 ? 9 : 0)
+                                                                              : (uint8_t)(rnd() % 3 ? rnd() : 0);
+        for (uint32_t head = 0; head < 260; head += (head < 8 ? 1 : 61)) {
+            for (uint32_t off = 0; off < 4; off++) {
+                for (uint32_t len = 0; len < 1100; len += (len < 520 ? 1 : 97)) {
+                    buf a = {0}, b = {0};
+                    fl_writer wa, wb;
+                    fl_writer_init(&wa, buf_put, &a);
+                    fl_writer_init(&wb, buf_put, &b);
+                    for (uint32_t k = 0; k < head; k++) {
+                        uint8_t c = (uint8_t)(k % 5 ? k : 0);
+                        fl_writer_bytes(&wa, &c, 1);
+                        fl_writer_bytes(&wb, &c, 1);
+                    }
+                    uint32_t crc = wa.crc;
+                    fl_writer_bytes(&wa, data + off, len);
+                    wa.crc = crc; /* direct bytes are outside the CRC */
+                    fl_writer_direct(&wb, data + off, len);
+                    fl_writer_end(&wa);
+                    fl_writer_end(&wb);
+                    assert_int_equal(a.len, b.len);
+                    assert_int_equal(wa.bytes, wb.bytes);
+                    assert_memory_equal(a.p, b.p, a.len);
+                    free(a.p);
+                    free(b.p);
+                }
+                if (pat != 3 || head > 8) break;
+            }
+        }
+    }
+}
+
 /* ---- HELLO: the scene's name and blob CRC ------------------------------------ */
 
 /* Feed one HELLO with payload pl (n bytes) to r; returns whether it was taken. */
@@ -997,47 +1042,6 @@ static void test_hello_scene(void **state)
     receiver_free(r);
 }
 
-/* fl_writer_direct (no copy) stuffs exactly as fl_writer_bytes: any length,
- * alignment, bytes already buffered, zeros at every block edge. */
-static void test_direct_stuffing(void **state)
-{
-    (void)state;
-    static _Alignas(8) uint8_t data[1200];
-    rng_state = 5;
-    for (int pat = 0; pat < 4; pat++) {
-        for (uint32_t i = 0; i < sizeof data; i++)
-            data[i] = pat == 0 ? (uint8_t)(i % 255 + 1) : pat == 1 ? 0 : pat == 2 ? (uint8_t)(i % 7 ? 9 : 0)
-                                                                              : (uint8_t)(rnd() % 3 ? rnd() : 0);
-        for (uint32_t head = 0; head < 260; head += (head < 8 ? 1 : 61)) {
-            for (uint32_t off = 0; off < 4; off++) {
-                for (uint32_t len = 0; len < 1100; len += (len < 520 ? 1 : 97)) {
-                    buf a = {0}, b = {0};
-                    fl_writer wa, wb;
-                    fl_writer_init(&wa, buf_put, &a);
-                    fl_writer_init(&wb, buf_put, &b);
-                    for (uint32_t k = 0; k < head; k++) {
-                        uint8_t c = (uint8_t)(k % 5 ? k : 0);
-                        fl_writer_bytes(&wa, &c, 1);
-                        fl_writer_bytes(&wb, &c, 1);
-                    }
-                    uint32_t crc = wa.crc;
-                    fl_writer_bytes(&wa, data + off, len);
-                    wa.crc = crc; /* direct bytes are outside the CRC */
-                    fl_writer_direct(&wb, data + off, len);
-                    fl_writer_end(&wa);
-                    fl_writer_end(&wb);
-                    assert_int_equal(a.len, b.len);
-                    assert_int_equal(wa.bytes, wb.bytes);
-                    assert_memory_equal(a.p, b.p, a.len);
-                    free(a.p);
-                    free(b.p);
-                }
-                if (pat != 3 || head > 8) break;
-            }
-        }
-    }
-}
-
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1047,7 +1051,7 @@ int main(void)
         cmocka_unit_test(test_raw_fallback),      cmocka_unit_test(test_wrong_base),
         cmocka_unit_test(test_bad_input),         cmocka_unit_test(test_forged_pictures),
         cmocka_unit_test(test_framing),           cmocka_unit_test(test_single_pixel_detected),
-        cmocka_unit_test(test_direct_stuffing),     cmocka_unit_test(test_page_flipping),
+        cmocka_unit_test(test_direct_stuffing),   cmocka_unit_test(test_page_flipping),
         cmocka_unit_test(test_hello_scene),
     };
     return cmocka_run_group_tests_name("framelink", tests, setup, teardown);
