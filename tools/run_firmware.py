@@ -165,7 +165,10 @@ def main(argv=None):
     except (LookupError, ValueError, OSError, subprocess.CalledProcessError) as e:
         say(f"{elf}: cannot read its scene ({e})")
     if a.port == "pty":
-        return run_pty(qemu_cmd(a.qemu, elf, "pty", a.args), str(elf.parent / "qmp.sock"))
+        # QEMU drops what its pty's reader has not read yet when it exits: unless told
+        # otherwise, the firmware lingers a second after its last frame (needs the tick)
+        args = a.args if "--linger" in a.args or "--no-tick" in a.args else (a.args + " --linger 1000").strip()
+        return run_pty(qemu_cmd(a.qemu, elf, "pty", args), str(elf.parent / "qmp.sock"))
     if a.port.startswith("tcp:"):
         try:
             serial, url = tcp_serial(a.port)
