@@ -637,6 +637,20 @@ static __attribute__((noinline)) void enc_row(row_enc *s, int c0ref)
     s->out->n = (uint32_t)(op - s->out->pk);
 }
 
+/* After row y: is the picture's coding on course to overflow cap? Checked every
+ * 8 rows from row GIVE_UP_FROM on: the bytes so far, spread over all the rows,
+ * above GIVE_UP_MARGIN / 4 of cap. A frame that would overflow is given up a
+ * fraction of the way in instead of at its last rows (its frame goes raw); one
+ * whose detail sits in its top rows may be given up though it would fit. */
+#define GIVE_UP_FROM 31
+#define GIVE_UP_MARGIN 5
+FORCE_INLINE int gives_up(const rc_enc *r, uint32_t cap, int y)
+{
+    if (y < GIVE_UP_FROM || (y & 7) != 7) return 0;
+    uint32_t used = (uint32_t)(r->p - r->start);
+    return used * (4u * FL_H) > cap * GIVE_UP_MARGIN * (uint32_t)(y + 1);
+}
+
 uint32_t fl_code_picture(fl_coder *c, const uint8_t *px, const uint8_t *base, uint8_t *out, uint32_t cap,
                          uint32_t *check)
 {
@@ -696,6 +710,10 @@ uint32_t fl_code_picture(fl_coder *c, const uint8_t *px, const uint8_t *base, ui
             nxt = tmp;
         }
         c0ref = c0;
+        if (gives_up(r, cap, y)) {
+            c->hashes_valid = 0;
+            return 0;
+        }
     }
     *check = fmix(f);
     c->hashes_of = px;
