@@ -9,6 +9,16 @@
  * offset and every index are validated before the renderer touches it.
  *
  * Coordinates and heights are 16.16 (fx_t) map units: x east, y north, z up.
+ *
+ * Every field that refers to other records says so in brackets at the end of
+ * its comment, and tests/test_scene_indices.py corrupts each such field of the
+ * first and last record of its type from this list, so a new one is tested too:
+ *   [index: SECS]           below the count of section SCN_SEC_SECS (or below a number)
+ *   [index: SECS or NONE]   that, or the value NONE
+ *   [child]                 a node index, or SCN_LEAF_BIT | a leaf index
+ *   [range: SECS]           on "first, num": records [first, first + num) of SECS
+ *   [range: SECS, EXPR]     on "first": [first, first + EXPR of the record's fields)
+ *   [count of FIELD]        the num of a range annotated on FIELD
  */
 #ifndef SCN_FORMAT_H
 #define SCN_FORMAT_H
@@ -44,7 +54,7 @@ enum scn_section_id {
     SCN_SEC_MODELS,   /* scn_model[] (docs/objects.md) */
     SCN_SEC_MVERTS,   /* scn_mvert[]: model vertices, model by model */
     SCN_SEC_FACES,    /* scn_face[]: model faces, model by model */
-    SCN_SEC_FINDEX,   /* uint32_t[]: face vertex numbers, relative to the model's first vertex */
+    SCN_SEC_FINDEX,   /* uint32_t[]: face vertex numbers, relative to the model's first vertex [index: the model's vertices] */
     SCN_SEC_OBJECTS,  /* scn_object[]: placed objects */
     SCN_SEC_NEEDS,    /* scn_needs[1]: what the scene needs (docs/needs.md) */
     /* A textured scene's look (docs/textures.md); every count is 0 in a flat-shaded scene. */
@@ -71,8 +81,8 @@ typedef struct {
     uint32_t flags;        /* reserved, 0 */
     int32_t player_x, player_y; /* 16.16 */
     int32_t player_angle;       /* degrees, 16.16, 0 = east, counter-clockwise */
-    uint32_t player_sector;     /* sector of the player start, or SCN_NONE */
-    uint32_t root;              /* node index, or SCN_LEAF_BIT | leaf index */
+    uint32_t player_sector;     /* sector of the player start, or SCN_NONE [index: SECTORS or SCN_NONE] */
+    uint32_t root;              /* node index, or SCN_LEAF_BIT | leaf index [child] */
     uint32_t max_depth;         /* longest root-to-leaf path, in nodes */
     scn_section sec[SCN_SEC_COUNT];
 } scn_header;
@@ -93,35 +103,35 @@ typedef struct {
 enum { SCN_PART_UPPER, SCN_PART_MIDDLE, SCN_PART_LOWER };
 
 typedef struct {
-    uint32_t v1, v2;      /* vertex indices; the front side is on the right going v1 -> v2 */
-    uint32_t sector[2];   /* front, back (SCN_NONE: one-sided) */
+    uint32_t v1, v2;      /* vertex indices; the front side is on the right going v1 -> v2 [index: VERTICES] */
+    uint32_t sector[2];   /* front, back (SCN_NONE: one-sided) [index: SECTORS or SCN_NONE] */
     uint8_t color[2][3];  /* [side][SCN_PART_*] */
     uint16_t flags;       /* reserved, 0 */
 } scn_line;
 
 typedef struct {
-    uint32_t v1, v2; /* vertex indices; the seg faces right going v1 -> v2 */
-    uint32_t line;   /* linedef index */
-    uint32_t side;   /* 0 front, 1 back of the linedef */
+    uint32_t v1, v2; /* vertex indices; the seg faces right going v1 -> v2 [index: VERTICES] */
+    uint32_t line;   /* linedef index [index: LINES] */
+    uint32_t side;   /* 0 front, 1 back of the linedef [index: 2] */
 } scn_seg;
 
 typedef struct {
     int32_t x, y, dx, dy;  /* partition line through (x,y) along (dx,dy), 16.16; front = right side */
     int32_t bbox[2][4];    /* [child][top, bottom, left, right]: ymax, ymin, xmin, xmax, 16.16 */
-    uint32_t child[2];     /* 0 front (right), 1 back; SCN_LEAF_BIT marks a leaf */
+    uint32_t child[2];     /* 0 front (right), 1 back; SCN_LEAF_BIT marks a leaf [child] */
 } scn_node;
 
 typedef struct {
-    uint32_t first_seg, num_segs; /* segs[first_seg .. first_seg + num_segs) */
-    uint32_t sector;              /* the leaf's sector (SCN_NONE if it has none) */
-    uint32_t first_pvert, num_pverts; /* floor polygon in pverts[] (0 pverts if degenerate) */
+    uint32_t first_seg, num_segs; /* segs[first_seg .. first_seg + num_segs) [range: SEGS] */
+    uint32_t sector;              /* the leaf's sector (SCN_NONE if it has none) [index: SECTORS or SCN_NONE] */
+    uint32_t first_pvert, num_pverts; /* floor polygon in pverts[] (0 pverts if degenerate) [range: PVERTS] */
 } scn_leaf;
 
 /* A model: convex parts made of faces over its vertices (model space: x forward,
  * y left, z up, 16.16, |v| <= SCN_MODEL_MAX units). */
 typedef struct {
-    uint32_t first_vert, num_verts; /* mverts[first_vert ..), at most SCN_MAX_MODEL_VERTS */
-    uint32_t first_face, num_faces; /* faces[first_face ..), at most SCN_MAX_MODEL_FACES */
+    uint32_t first_vert, num_verts; /* mverts[first_vert ..), at most SCN_MAX_MODEL_VERTS [range: MVERTS] */
+    uint32_t first_face, num_faces; /* faces[first_face ..), at most SCN_MAX_MODEL_FACES [range: FACES] */
     int32_t radius;                 /* 16.16: largest horizontal distance of a vertex from the origin */
     int32_t zmin, zmax;             /* 16.16: lowest and highest vertex */
 } scn_model;
@@ -131,8 +141,8 @@ typedef struct {
 } scn_mvert;
 
 typedef struct {
-    uint32_t first_index; /* findex[first_index .. + num_index): vertex numbers within the model */
-    uint16_t num_index;   /* 3 .. SCN_MAX_FACE_VERTS, counter-clockwise seen from outside */
+    uint32_t first_index; /* findex[first_index .. + num_index): vertex numbers within the model [range: FINDEX, num_index] */
+    uint16_t num_index;   /* 3 .. SCN_MAX_FACE_VERTS, counter-clockwise seen from outside [count of first_index] */
     uint8_t colour;
     uint8_t part;         /* convex part of the model it belongs to */
 } scn_face;
@@ -140,10 +150,10 @@ typedef struct {
 enum { SCN_PATH_NONE, SCN_PATH_CIRCLE, SCN_PATH_LINE };
 
 typedef struct {
-    uint32_t model;
+    uint32_t model;     /* [index: MODELS] */
     int32_t x, y, z;    /* 16.16: the origin at time 0 (circle: the circle's centre) */
     int32_t yaw;        /* degrees, 16.16 */
-    uint32_t path;      /* SCN_PATH_* */
+    uint32_t path;      /* SCN_PATH_* [index: 3] */
     int32_t pa, pb;     /* 16.16: circle radius, 0; line DX, DY */
     uint32_t period_ms; /* one turn or one round trip; > 0 when path != SCN_PATH_NONE */
     int32_t spin;       /* degrees per second, 16.16 */
@@ -156,7 +166,7 @@ typedef struct {
 #define SCN_TEX_MAX_BITS 10    /* a texture is at most 1024 x 1024 texels */
 
 typedef struct {
-    uint32_t sky_tex;   /* scn_texture index of the sky, or SCN_TEX_NONE */
+    uint32_t sky_tex;   /* scn_texture index of the sky, or SCN_TEX_NONE [index: TEXTURES or SCN_TEX_NONE] */
     uint32_t flags;     /* reserved, 0 */
 } scn_look;
 
@@ -168,9 +178,9 @@ typedef struct {
  * that is not a power of two is padded to the next one by repeating rows from
  * the top. A flat is 64 x 64 with u = map x, v = -map y (Doom's alignment). */
 typedef struct {
-    uint32_t first;          /* first texel in SCN_SEC_TEXELS */
+    uint32_t first;          /* first texel in SCN_SEC_TEXELS [range: TEXELS, 1 << (wbits + hbits)] */
     uint8_t wbits, hbits;    /* 0 .. SCN_TEX_MAX_BITS */
-    uint8_t colour;          /* palette index nearest the texture's mean colour */
+    uint8_t colour;          /* palette index nearest the texture's mean colour [index: PALETTE] */
     uint8_t reserved;        /* 0 */
     uint16_t height;         /* rows as the WAD gives them (<= 2^hbits): Doom's pegging counts these */
     uint16_t reserved2;      /* 0 */
@@ -187,13 +197,13 @@ typedef struct {
     int32_t ux, uy;     /* 2.30 */
     int32_t u0;         /* 16.16 */
     int32_t row_off;    /* 16.16: the side's y offset (added to every part's texture row) */
-    uint16_t tex[3];    /* [SCN_PART_*]: scn_texture index, or SCN_TEX_NONE */
+    uint16_t tex[3];    /* [SCN_PART_*]: scn_texture index, or SCN_TEX_NONE [index: TEXTURES or SCN_TEX_NONE] */
     uint8_t flags;      /* SCN_SIDE_* */
     int8_t light_adj;   /* Doom's fake contrast in light levels: -1 along x (east-west), +1 along y, else 0 */
 } scn_side;
 
 typedef struct {
-    uint16_t floor_tex, ceil_tex; /* scn_texture index, or SCN_TEX_NONE (a sky ceiling: the sky) */
+    uint16_t floor_tex, ceil_tex; /* scn_texture index, or SCN_TEX_NONE (a sky ceiling: the sky) [index: TEXTURES or SCN_TEX_NONE] */
 } scn_plane;
 
 /* What a scene needs of a renderer, written by the compiler's analysis

@@ -259,6 +259,48 @@ def test_back_channel_messages():
     assert types == [(framelink.MSG_ACK, 7, 1), (framelink.MSG_KEYREQ, 7, 1 | 2)]
 
 
+def bound_patterns(n):
+    """n bytes: no zero, all zeros, a zero every third byte, one zero at the end."""
+    return [bytes(i % 255 + 1 for i in range(n)), bytes(n), bytes(0 if i % 3 == 0 else i & 255 or 1 for i in range(n)),
+            bytes([7]) * (n - 1) + bytes(1) if n else b""]
+
+
+@pytest.mark.parametrize("cap", [1, 2, 3, 253, 254, 255, 256, 508, 509, 1000])
+def test_reader_bound(cap):
+    """The Python reader (fl_reader's twin) with messages of cap - 1, cap and cap + 1 bytes: the
+    first two arrive whole, the third is refused as too long, and the next message is read."""
+    for n in (cap - 1, cap, cap + 1):
+        for data in bound_patterns(n):
+            r = framelink._Reader(cap)
+            fits = data[:cap - 1]
+            stream = framelink.cobs_encode(data) + b"\x00" + framelink.cobs_encode(fits) + b"\x00"
+            results = []
+            for b in stream:
+                res = r.byte(b)
+                if res:
+                    results.append((res, bytes(r.buf)))
+                assert len(r.buf) <= cap
+            if n <= cap:
+                assert results[0] == (1, data), (cap, n)
+            else:
+                assert results[0][0] == -framelink.R_LONG, (cap, n)
+            assert results[1:] == [(1, fits)], (cap, n)
+
+
+@pytest.mark.parametrize("extra", [-1, 0, 1])
+def test_decoder_message_bound(extra):
+    """The Python decoder's message buffer (MSG_MAX): a keyframe of MSG_MAX + 1 bytes is refused as
+    too long; one of MSG_MAX or MSG_MAX - 1 bytes is read whole and judged by what it holds."""
+    payload = bound_patterns(framelink.PAYLOAD_MAX + extra)[2]
+    dec = framelink.Decoder(send_acks=False)
+    evs = dec.feed(framelink.encode_message(framelink.MSG_KEYFRAME, 7, payload))
+    assert len(evs) >= 1
+    if extra > 0:
+        assert evs == [{"event": "bad", "reason": "long"}]
+    else:
+        assert evs[0]["event"] in ("bad", "drop") and evs[0]["reason"] not in ("long", "framing"), evs[0]
+
+
 def test_cobs_bounded_overhead():
     for n in (0, 1, 253, 254, 255, 508, 1000):
         for payload in (bytes(n), bytes([7]) * n, bytes(range(256)) * (n // 256) + bytes(n % 256)):

@@ -804,6 +804,180 @@ static void test_framing(void **state)
 }
 
 
+/* ---- every reader's bound: messages of cap - 1, cap and cap + 1 bytes ---------- */
+
+/* COBS as docs/frame-link.md writes it, independent of fl_writer: blocks of at
+ * most 254 data bytes, each after a code byte, then the 0x00 delimiter. */
+static void cobs_message(buf *out, const uint8_t *p, uint32_t n)
+{
+    uint8_t blk[255];
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        if (p[i] == 0) { /* a block ended by a zero */
+            blk[0] = (uint8_t)(k + 1);
+            buf_put(out, blk, k + 1);
+            k = 0;
+            continue;
+        }
+        blk[++k] = p[i];
+        if (k == 254) { /* a full block: no zero ends it */
+            blk[0] = 0xFF;
+            buf_put(out, blk, 255);
+            k = 0;
+        }
+    }
+    blk[0] = (uint8_t)(k + 1);
+    buf_put(out, blk, k + 1);
+    uint8_t z = 0;
+    buf_put(out, &z, 1);
+}
+
+/* n bytes of pattern pat: no zero, all zeros, zeros every 3, a zero at the end */
+static void pattern(uint8_t *p, uint32_t n, int pat)
+{
+    for (uint32_t i = 0; i < n; i++)
+        p[i] = pat == 0 ? (uint8_t)(i % 255 + 1) : pat == 1 ? 0 : pat == 2 ? (uint8_t)(i % 3 ? i : 0) : (uint8_t)(i + 1 < n ? 7 : 0);
+}
+
+/* fl_reader over a buffer of exactly cap bytes (malloc'd, so that ASan sees a
+ * byte past it): messages up to cap bytes arrive whole, one more is refused as
+ * too long and writes nothing, and the reader takes the next message. */
+static void test_reader_bound(void **state)
+{
+    (void)state;
+    static const uint32_t caps[] = {1, 2, 3, 253, 254, 255, 256, 508, 509, 1000};
+    uint8_t *msg = malloc(1100);
+    for (size_t c = 0; c < sizeof caps / sizeof caps[0]; c++) {
+        uint32_t cap = caps[c];
+        for (int pat = 0; pat < 4; pat++) {
+            for (uint32_t n = cap - 1; n <= cap + 1; n++) {
+                uint8_t *rbuf = malloc(cap);
+                buf s = {0};
+                pattern(msg, n, pat);
+                cobs_message(&s, msg, n);
+                cobs_message(&s, msg, cap - 1); /* a message that fits, after it */
+                fl_reader rd;
+                fl_reader_init(&rd, rbuf, cap);
+                int res = 0, got = 0;
+                size_t i = 0;
+                for (; i < s.len && !res; i++) res = fl_reader_byte(&rd, s.p[i]);
+                if (n <= cap) {
+                    assert_int_equal(res, 1);
+                    assert_int_equal(rd.len, n);
+                    assert_memory_equal(rbuf, msg, n);
+                } else {
+                    assert_int_equal(res, -(int)FL_R_LONG);
+                }
+                assert_true(rd.len <= cap);
+                for (res = 0; i < s.len; i++) res = fl_reader_byte(&rd, s.p[i]), got += res == 1;
+                assert_int_equal(got, 1);
+                assert_int_equal(rd.len, cap - 1);
+                assert_memory_equal(rbuf, msg, cap - 1);
+                free(s.p);
+                free(rbuf);
+            }
+        }
+    }
+    free(msg);
+}
+
+static fl_reason last_reason;
+static fl_event_kind last_kind;
+static void note_event(void *ctx, const fl_event *ev)
+{
+    (void)ctx;
+    last_kind = ev->kind;
+    last_reason = ev->reason;
+}
+
+/* A keyframe message of header + payload + CRC = len bytes with a good CRC. */
+static void message_of(buf *s, uint32_t len, uint8_t type)
+{
+    uint32_t n = len - FL_HEADER_BYTES - FL_CRC_BYTES;
+    uint8_t *payload = malloc(n);
+    pattern(payload, n, 2);
+    fl_writer w;
+    fl_writer_init(&w, buf_put, s);
+    fl_writer_message(&w, type, 7, payload, n);
+    free(payload);
+}
+
+/* The decoder's message buffer (FL_MSG_MAX), in both its set-ups: the page
+ * flipper's work memory is that buffer alone, malloc'd to its size. A message
+ * one byte too long is refused as too long; the longest one is read whole and
+ * refused only for what it says (a keyframe of random bytes). */
+static void test_decoder_message_bound(void **state)
+{
+    (void)state;
+    uint8_t *pages = malloc(2u * FL_FRAME_BYTES);
+    uint8_t *work = malloc(FL_DEC_PAGES_WORK_BYTES);
+    receiver *r = receiver_new(NULL, 0);
+    for (int flip = 0; flip < 2; flip++) {
+        fl_decoder *d = flip ? &r->dec : malloc(sizeof *d);
+        if (flip) fl_dec_init_pages(d, pages, pages + FL_FRAME_BYTES, work, note_event, NULL, NULL, NULL);
+        else fl_dec_init(d, r->frame, r->work, note_event, NULL, NULL, NULL);
+        for (uint32_t len = FL_MSG_MAX - 1; len <= FL_MSG_MAX + 1; len++) {
+            buf s = {0};
+            message_of(&s, len, FL_MSG_KEYFRAME);
+            uint32_t bad = d->count.msgs_bad;
+            last_reason = FL_R_NONE;
+            last_kind = FL_EV_OTHER;
+            fl_dec_feed(d, s.p, (uint32_t)s.len);
+            assert_true(last_kind == FL_EV_BAD || last_kind == FL_EV_DROP);
+            if (len > FL_MSG_MAX) {
+                assert_int_equal(d->count.msgs_bad, bad + 1);
+                assert_int_equal(last_kind, FL_EV_BAD);
+                assert_int_equal(last_reason, FL_R_LONG);
+            } else {
+                assert_int_not_equal(last_reason, FL_R_LONG);
+                assert_int_not_equal(last_reason, FL_R_FRAMING);
+            }
+            assert_true(d->rx.len <= FL_MSG_MAX);
+            free(s.p);
+        }
+        if (!flip) free(d);
+    }
+    receiver_free(r);
+    free(work);
+    free(pages);
+}
+
+/* The sender's back-channel reader (rx_buf, 64 bytes): messages of 63, 64 and
+ * 65 bytes are each one bad message (no back message is that long), nothing
+ * past rx_buf changes, and a keyframe request after them is taken. */
+static void test_encoder_back_bound(void **state)
+{
+    (void)state;
+    static fl_encoder enc;
+    static uint8_t scratch[4096];
+    fl_enc_init(&enc, NULL, NULL, scratch, sizeof scratch);
+    const size_t after = offsetof(fl_encoder, rx_buf) + sizeof enc.rx_buf;
+    uint8_t *before = malloc(sizeof enc - after);
+    memcpy(before, (uint8_t *)&enc + after, sizeof enc - after);
+    uint32_t cap = sizeof enc.rx_buf;
+    for (uint32_t len = cap - 1; len <= cap + 1; len++) {
+        buf s = {0};
+        message_of(&s, len, FL_MSG_ACK);
+        uint32_t bad = enc.rx_bad;
+        for (size_t i = 0; i < s.len; i++) fl_enc_receive(&enc, s.p + i, 1);
+        assert_int_equal(enc.rx_bad, bad + 1);
+        assert_true(enc.rx.len <= cap);
+        assert_memory_equal((uint8_t *)&enc + after, before, sizeof enc - after);
+        free(s.p);
+    }
+    buf s = {0};
+    uint8_t req[5] = {1, 0, 0, 0, 0};
+    fl_writer w;
+    fl_writer_init(&w, buf_put, &s);
+    fl_writer_message(&w, FL_MSG_KEYREQ, 0, req, sizeof req);
+    uint32_t bad = enc.rx_bad;
+    fl_enc_receive(&enc, s.p, (uint32_t)s.len);
+    assert_int_equal(enc.rx_bad, bad);
+    assert_int_equal(enc.keyreqs, 1);
+    free(s.p);
+    free(before);
+}
+
 /* Re-seal a frame message (COBS-encoded, delimiter included) with another
  * frame check and a message CRC that matches: a message that arrives intact
  * but describes other pixels than it carries. */
@@ -1052,7 +1226,8 @@ int main(void)
         cmocka_unit_test(test_bad_input),         cmocka_unit_test(test_forged_pictures),
         cmocka_unit_test(test_framing),           cmocka_unit_test(test_single_pixel_detected),
         cmocka_unit_test(test_direct_stuffing),   cmocka_unit_test(test_page_flipping),
-        cmocka_unit_test(test_hello_scene),
+        cmocka_unit_test(test_hello_scene),       cmocka_unit_test(test_reader_bound),
+        cmocka_unit_test(test_decoder_message_bound), cmocka_unit_test(test_encoder_back_bound),
     };
     return cmocka_run_group_tests_name("framelink", tests, setup, teardown);
 }

@@ -665,6 +665,100 @@ static void test_inverse_depth_order(void **state)
     }
 }
 
+/* objd_front's ties, case by case, on planes written in view space (x right,
+ * y up, z ahead; the centre of pixel (px, py) looks along (2 px + 1 - 320,
+ * 2 VIEW_CY - 1 - 2 py, 320)). Pixel (160, VIEW_CY) looks along (1, -1, 320):
+ * a floor H below the eye and a wall facing the eye at Z = 320 H meet on that
+ * ray, so there both depths are exactly 320 H and the two tie. Every answer
+ * below comes from where the surfaces lie, not from the function. */
+#define TIE_H 1024                 /* view units below the eye */
+#define TIE_Z (320 * TIE_H)        /* the wall's depth, where the floor meets the ray */
+#define TIE_N ((int32_t)1 << 29)   /* a normal's length */
+#define TIE_PX (VIEW_W / 2)
+#define TIE_PY VIEW_CY
+
+/* y = -TIE_H, seen from above (a floor, or the top of something below the eye) */
+static objd_plane tie_floor(int32_t cx, int32_t cy, int32_t cz)
+{
+    return (objd_plane){0, -TIE_N, 0, cx, cy, cz, (int64_t)TIE_N * TIE_H};
+}
+
+/* z = TIE_Z, facing the eye (a wall, or an object's face towards the eye) */
+static objd_plane tie_wall(int32_t cx, int32_t cy, int32_t cz)
+{
+    return (objd_plane){0, 0, TIE_N, cx, cy, cz, (int64_t)TIE_N * TIE_Z};
+}
+
+static int tie_front(const objd_plane *s, int s_obj, const objd_plane *p, int p_obj)
+{
+    return objd_front(s, s_obj, p, p_obj, 0, TIE_PX, TIE_PY);
+}
+
+static void test_abutting_ties(void **state)
+{
+    (void)state;
+    const objd_plane floor = tie_floor(0, 0, 0), wall = tie_wall(0, 0, 0);
+    /* the inputs really tie: one pixel nearer the screen's bottom the floor is
+     * nearer, one nearer its middle the wall is, whatever the tie rules say */
+    assert_int_equal(objd_front(&floor, 0, &wall, 0, 0, TIE_PX, TIE_PY + 1), 1);
+    assert_int_equal(objd_front(&floor, 0, &wall, 0, 0, TIE_PX, TIE_PY - 1), 0);
+
+    /* An object's face towards the eye standing on the floor (centroid 500
+     * units above it, on the eye's side of the floor's plane): at the seam the
+     * face is in front, as s and as p. */
+    objd_plane standing = tie_wall(0, -TIE_H + 500, TIE_Z);
+    assert_int_equal(tie_front(&standing, 1, &floor, 0), 1);
+    assert_int_equal(tie_front(&floor, 0, &standing, 1), 0);
+    /* an object's face hanging below the floor (centroid beyond it): behind */
+    objd_plane sunk = tie_wall(0, -TIE_H - 500, TIE_Z);
+    assert_int_equal(tie_front(&sunk, 1, &floor, 0), 0);
+    assert_int_equal(tie_front(&floor, 0, &sunk, 1), 1);
+
+    /* An object's top lying on the floor's plane but reaching through the wall
+     * (centroid 1000 beyond it): the wall is in front; one lying before the
+     * wall (centroid 1000 nearer) is in front of it. */
+    objd_plane through = tie_floor(0, -TIE_H, TIE_Z + 1000), before = tie_floor(0, -TIE_H, TIE_Z - 1000);
+    assert_int_equal(tie_front(&through, 1, &wall, 0), 0);
+    assert_int_equal(tie_front(&wall, 0, &through, 1), 1);
+    assert_int_equal(tie_front(&before, 1, &wall, 0), 1);
+    assert_int_equal(tie_front(&wall, 0, &before, 1), 0);
+
+    /* Two objects: a face standing on another's top (whose centroid lies in the
+     * standing face's plane, so only the first rule decides) is in front of it,
+     * whichever is numbered first. */
+    objd_plane top = tie_floor(0, -TIE_H, TIE_Z);
+    assert_int_equal(tie_front(&standing, 2, &top, 1), 1);
+    assert_int_equal(tie_front(&standing, 1, &top, 2), 1);
+    assert_int_equal(tie_front(&top, 1, &standing, 2), 0);
+    assert_int_equal(tie_front(&top, 2, &standing, 1), 0);
+
+    /* Two objects' tops in one plane (both centroids in it): the lower number first. */
+    objd_plane top2 = tie_floor(5000, -TIE_H, TIE_Z);
+    assert_int_equal(tie_front(&top, 1, &top2, 2), 1);
+    assert_int_equal(tie_front(&top2, 2, &top, 1), 0);
+
+    /* Two world surfaces meeting: the one whose 1/z grows faster down the
+     * screen covers the rows below the seam, so the floor wins at the seam. */
+    assert_int_equal(tie_front(&floor, 0, &wall, 0), 1);
+    assert_int_equal(tie_front(&wall, 0, &floor, 0), 0);
+    /* ... and across it: x + z = 321 TIE_H meets the wall on the seam ray
+     * (x = TIE_H there) and is nearer to the right of it */
+    objd_plane slant = {TIE_N, 0, TIE_N, 0, 0, 0, (int64_t)TIE_N * 321 * TIE_H};
+    assert_int_equal(tie_front(&slant, 0, &wall, 0), 1);
+    assert_int_equal(tie_front(&wall, 0, &slant, 0), 0);
+    assert_int_equal(objd_front(&slant, 0, &wall, 0, 0, TIE_PX + 1, TIE_PY), 1);
+    assert_int_equal(objd_front(&slant, 0, &wall, 0, 0, TIE_PX - 1, TIE_PY), 0);
+
+    /* One plane, one gradient: an object's face lying in the floor goes after the world. */
+    assert_int_equal(tie_front(&floor, 0, &top, 1), 1);
+    assert_int_equal(tie_front(&top, 1, &floor, 0), 0);
+
+    /* A plane through the eye (d = 0) is in front of everything. */
+    objd_plane edge = {0, TIE_N, 0, 0, 0, 0, 0};
+    assert_int_equal(tie_front(&floor, 0, &edge, 0), 0);
+    assert_int_equal(tie_front(&edge, 0, &floor, 0), 1);
+}
+
 /* Painter draws the objects after the world, farthest first. */
 static void test_painter(void **state)
 {
@@ -995,7 +1089,8 @@ int main(void)
         cmocka_unit_test(test_object_behind_wall), cmocka_unit_test(test_two_objects_overlap),
         cmocka_unit_test(test_straddle),          cmocka_unit_test(test_near_and_offscreen),
         cmocka_unit_test(test_interpenetrating),  cmocka_unit_test(test_wide_products),
-        cmocka_unit_test(test_inverse_depth_order), cmocka_unit_test(test_painter),
+        cmocka_unit_test(test_inverse_depth_order), cmocka_unit_test(test_abutting_ties),
+        cmocka_unit_test(test_painter),
         cmocka_unit_test(test_work_bound),        cmocka_unit_test(test_paths),
         cmocka_unit_test(test_door_motion),       cmocka_unit_test(test_door_slots),
         cmocka_unit_test(test_door_collision),    cmocka_unit_test(test_engine),
