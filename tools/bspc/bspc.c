@@ -166,8 +166,10 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
         if (kind == BSPC_SPEC_WAD || !spec[wl + 1]) {
             char maps[200];
             if (bspc_list_maps(wadname, maps, sizeof maps, err, errlen) < 0) return -1;
-            return bs_fail(err, errlen, "%s: name a map in the WAD as %.*s:MAP (its maps: %s)", spec, (int)wl, spec,
-                           *maps ? maps : "none");
+            if (kind == BSPC_SPEC_WAD)
+                return bs_fail(err, errlen, "%s: name a map in the WAD as %s:MAP (its maps: %s)", spec, spec,
+                               *maps ? maps : "none");
+            return bs_fail(err, errlen, "%s: no map named after the ':' (its maps: %s)", spec, *maps ? maps : "none");
         }
         if (bs_read_wad(path, spec + wl + 1, spec, &s, &opt, err, errlen)) goto out;
     } else {
