@@ -27,7 +27,10 @@ SDL_SRC   := hal/ram_target.c hal/sdl/hal_sdl.c
 BSPC_LIB  := $(filter-out tools/bspc/main.c,$(sort $(wildcard tools/bspc/*.c)))
 # The host programs' shared files; the frame link's sender (host/link_send.c,
 # build/render and build/emu --link) brings the link's sources along.
-HOST_LIB   = host/png.c host/scene_file.c host/port.c host/link_send.c $(sort $(LINK_SRC))
+HOST_LIB   = host/png.c host/port.c host/link_send.c $(sort $(LINK_SRC))
+# Starting a scene in the engine (host/scene_start.c) reads build_config.h, so it
+# is compiled with the firmware of each build, not shared between builds.
+HOST_ENG  := host/scene_start.c
 FLOATFREE := firmware/% hal/fb.c hal/perf.c hal/ram_target.c hal/null/% hal/serial/% hal/mps2/% hal/bare/% hal/pcvga/% $(GEN)/%
 
 # Each subsystem with rules of its own keeps them in mk/NAME.mk. They may add
@@ -52,11 +55,11 @@ $(1)/obj/$(GEN)/%.o: $(GEN)/%.c
 	@mkdir -p $$(@D)
 	$$(CC) $$(BASE) $(2) $$(FW_FLAGS) -c $$< -o $$@
 
-$(1)/bspc: $(call objs,$(1)/obj,tools/bspc/main.c $(BSPC_LIB) host/scene_file.c firmware/crc32.c firmware/scene.c)
+$(1)/bspc: $(call objs,$(1)/obj,tools/bspc/main.c $(BSPC_LIB) firmware/crc32.c firmware/scene.c)
 	$$(CC) $(2) $$^ -o $$@ -lm
-$(1)/render: $(call objs,$(1)/obj,host/render.c $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC))
+$(1)/render: $(call objs,$(1)/obj,host/render.c $(HOST_ENG) $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC))
 	$$(CC) $(2) $$^ -o $$@ -lm
-$(1)/emu: $(call objs,$(1)/obj,host/emu.c $(GEN)/default_scene.c $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(SDL_SRC))
+$(1)/emu: $(call objs,$(1)/obj,host/emu.c $(HOST_ENG) $(GEN)/default_scene.c $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(SDL_SRC))
 	$$(CC) $(2) $$^ -o $$@ $$(SDL_LIBS) -lm
 $(1)/display: $(call objs,$(1)/obj,host/display.c host/png.c host/port.c firmware/crc32.c $(HAL_SRC) $(SDL_SRC) $(sort $(LINK_SRC)))
 	$$(CC) $(2) $$^ -o $$@ $$(SDL_LIBS)

@@ -247,6 +247,8 @@ const uint8_t *hal_get_palette(void);
 #define HAL_KEY_NEXT_MODE (1u << 16)
 #define HAL_KEY_NEXT_PRESENT (1u << 17)
 #define HAL_KEY_PRINT_COUNTERS (1u << 18)
+#define HAL_KEY_PRINT_VIEW (1u << 19) /* the host's emu: print the camera as build/render options */
+#define HAL_KEY_SCREENSHOT (1u << 20) /* the host's emu: save the frame shown as a PNG */
 #define HAL_KEY_QUIT (1u << 30)
 
 uint32_t hal_input(void);     /* HAL_KEY_* bits held or pressed since the last call */

@@ -16,7 +16,7 @@
 #include "link_send.h"
 #include "png.h"
 #include "port.h"
-#include "scene_file.h"
+#include "scene_start.h"
 
 extern const uint8_t default_scene[];
 extern const uint32_t default_scene_len;
@@ -32,9 +32,11 @@ static const char usage[] =
     "Keys: Up/Down move, Left/Right turn, Alt+Left/Right or ',' '.' strafe,\n"
     "      PgUp/PgDn or A/Z fly, Home/End or Q/W look up/down, Shift run,\n"
     "      M render mode, P present mode (flip, copy8, copy16, copy32),\n"
-    "      C print counters, Esc quit.\n"
+    "      C print counters, V print the camera as build/render options\n"
+    "      (--at X,Y,Z --angle A --look L), S or F12 save a screenshot PNG\n"
+    "      (emu-shot-NNN.png in the current folder, or in --out DIR), Esc quit.\n"
     "\n"
-    "  --scale N     window size factor (default 3)\n"
+    "  --scale N     window size factor, 1..8 (default 3)\n"
     "  --flat        draw a textured scene (a WAD map) in flat colours\n"
     "  --frames N    quit after N frames (default: run until Esc; headless: 36)\n"
     "  --headless    do not open a window: render a fly-through (a turn on the spot)\n"
@@ -47,6 +49,8 @@ static const char usage[] =
     "                link's bytes, frames, keyframes, deltas and acks\n"
     "  --baud B      serial speed for a tty PORT (default 115200)\n"
     "  -h, --help    this text\n";
+
+_Static_assert(HAL_SDL_MAX_SCALE == 8, "--help names the largest --scale");
 
 #define FLY_FRAMES 36
 #define FLY_STEP_MS 83 /* a tenth of a turn per frame at the camera's turn speed */
@@ -90,19 +94,51 @@ static int finish_link(void)
     return 1;
 }
 
-/* The camera and time of the last frame, as build/render options. */
-static void print_view(const engine *e)
+/* The camera of the last frame as build/render options, into out. */
+static void view_options(const engine *e, char *out, size_t n)
 {
     char x[48], y[48], z[48], a[48];
     fxtext_format(e->cam.view.x, x, sizeof x);
     fxtext_format(e->cam.view.y, y, sizeof y);
     fxtext_format(e->cam.view.z, z, sizeof z);
     fxtext_format(e->cam.view.angle_deg, a, sizeof a);
-    printf("emu: frame %u as build/render draws it: --at %s,%s,%s --angle %s --look %d --time %u\n", e->frame - 1u,
-           x, y, z, a, (int)e->cam.view.look, (unsigned)e->t_ms);
+    snprintf(out, n, "--at %s,%s,%s --angle %s --look %d", x, y, z, a, (int)e->cam.view.look);
 }
 
-static int run_window(engine *e, long frames)
+/* The camera and time of the last frame, as build/render options. */
+static void print_view(const engine *e)
+{
+    char opts[300];
+    view_options(e, opts, sizeof opts);
+    printf("emu: frame %u as build/render draws it: %s --time %u\n", e->frame - 1u, opts, (unsigned)e->t_ms);
+    fflush(stdout);
+}
+
+/* The frame shown, as the next free emu-shot-NNN.png in dir; the camera goes
+ * with it on stdout, so build/render can draw the same view. 0, or -1 after a
+ * message. */
+static int screenshot(const engine *e, const char *dir)
+{
+    char path[4096];
+    for (int i = 0; i < 1000; i++) {
+        snprintf(path, sizeof path, "%s/emu-shot-%03d.png", dir, i);
+        struct stat st;
+        if (stat(path, &st) == 0) continue;
+        if (png_write_indexed(path, hal_shown_page(), HAL_WIDTH, HAL_HEIGHT, hal_get_palette()) != 0) {
+            fprintf(stderr, "emu: %s: cannot write: %s\n", path, strerror(errno));
+            return -1;
+        }
+        char opts[300];
+        view_options(e, opts, sizeof opts);
+        printf("emu: wrote %s: %s --time %u\n", path, opts, (unsigned)e->t_ms);
+        fflush(stdout);
+        return 0;
+    }
+    fprintf(stderr, "emu: %s: 1000 screenshots there already\n", dir);
+    return -1;
+}
+
+static int run_window(engine *e, long frames, const char *shots)
 {
     uint32_t last = hal_ticks_ms();
     for (long n = 0; frames <= 0 || n < frames; n++) {
@@ -116,6 +152,8 @@ static int run_window(engine *e, long frames)
         hal_perf_reset();
         if (step(e, input, dt) != 0) return 1;
         if (input & HAL_KEY_PRINT_COUNTERS) print_counters(e);
+        if (input & HAL_KEY_PRINT_VIEW) print_view(e);
+        if (input & HAL_KEY_SCREENSHOT) screenshot(e, shots);
     }
     return 0;
 }
@@ -147,6 +185,23 @@ static int run_headless(engine *e, const char *dir, long frames)
     return 0;
 }
 
+/* A decimal whole number, all of s: 0, or -1. */
+static int whole_number(const char *s, long *out)
+{
+    char *end;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (end == s || *end || errno) return -1;
+    *out = v;
+    return 0;
+}
+
+static int is_option_with_value(const char *a)
+{
+    return !strcmp(a, "--scale") || !strcmp(a, "--frames") || !strcmp(a, "--out") || !strcmp(a, "--link") ||
+           !strcmp(a, "--baud");
+}
+
 int main(int argc, char **argv)
 {
     const char *spec = NULL, *out = NULL, *port = NULL;
@@ -161,9 +216,17 @@ int main(int argc, char **argv)
         } else if (!strcmp(argv[i], "--headless")) {
             headless = 1;
         } else if (i + 1 < argc && !strcmp(argv[i], "--scale")) {
-            scale = atoi(argv[++i]);
+            long v;
+            if (whole_number(argv[++i], &v) != 0 || v < 1 || v > HAL_SDL_MAX_SCALE) {
+                fprintf(stderr, "emu: --scale '%s': expected a whole number 1..%d\n", argv[i], HAL_SDL_MAX_SCALE);
+                return 2;
+            }
+            scale = (int)v;
         } else if (i + 1 < argc && !strcmp(argv[i], "--frames")) {
-            frames = atol(argv[++i]);
+            if (whole_number(argv[++i], &frames) != 0 || frames < 1) {
+                fprintf(stderr, "emu: --frames '%s': expected a whole number of frames, 1 or more\n", argv[i]);
+                return 2;
+            }
         } else if (i + 1 < argc && !strcmp(argv[i], "--out")) {
             out = argv[++i];
         } else if (i + 1 < argc && !strcmp(argv[i], "--link")) {
@@ -175,6 +238,9 @@ int main(int argc, char **argv)
                 fprintf(stderr, "emu: --baud '%s': expected a speed in bits per second\n", argv[i]);
                 return 2;
             }
+        } else if (is_option_with_value(argv[i])) {
+            fprintf(stderr, "emu: option %s needs a value\n", argv[i]);
+            return 2;
         } else if (argv[i][0] == '-') {
             fprintf(stderr, "emu: unknown option '%s' (see --help)\n", argv[i]);
             return 2;
@@ -196,47 +262,25 @@ int main(int argc, char **argv)
         }
         linked = &the_link;
     }
-    uint8_t *blob = NULL;
-    size_t len = default_scene_len;
-    const void *data = default_scene;
-    if (spec) {
-        bspc_options opt = bspc_defaults();
-        if (scene_file_load(spec, &opt, &blob, &len, err, sizeof err) != 0) {
-            fprintf(stderr, "emu: %s\n", err);
-            return 1;
-        }
-        data = blob;
-    }
     static engine e;
-    scene_error se;
-    if (len > UINT32_MAX || eng_init(&e, data, (uint32_t)len, &se) != SCENE_OK) {
-        scene_file_describe_error(spec ? spec : "built-in scene", data, len, &se, err, sizeof err);
+    scene_start st;
+    bspc_options opt = bspc_defaults();
+    if (scene_start_load(&st, &e, spec, &opt, default_scene, default_scene_len, err, sizeof err) != 0) {
         fprintf(stderr, "emu: %s\n", err);
-        free(blob);
         return 1;
     }
     e.flat = (uint8_t)flat;
-    uint32_t need = eng_work_bytes(&e);
-    void *work = need ? malloc(need) : NULL;
-    if (!work || eng_set_work(&e, work, need) != 0) {
-        fprintf(stderr, "emu: %s: the scene needs %u bytes of work memory, which could not be had\n",
-                spec ? spec : "built-in scene", need);
-        free(work);
-        free(blob);
-        return 1;
-    }
 
     int rc = 0;
-    if (linked && link_hello(linked, spec ? spec : DEFAULT_SCENE_NAME, data, len) != 0) {
+    if (linked && link_hello(linked, spec ? spec : DEFAULT_SCENE_NAME, st.data, st.len) != 0) {
         fprintf(stderr, "emu: --link %s\n", link_error(linked));
         rc = 1;
     } else if (!headless && hal_sdl_init(scale, "bspvga") == 0) {
-        rc = run_window(&e, frames);
+        rc = run_window(&e, frames, out ? out : ".");
         if (rc == 0) rc = finish_link();
         hal_sdl_quit();
     } else {
-        if (!headless)
-            printf("emu: no display available (%s); rendering a fly-through headless instead\n", hal_sdl_error());
+        if (!headless) fprintf(stderr, "emu: %s; rendering a fly-through headless instead\n", hal_sdl_error());
         if (!out && !linked) out = "build/flythrough";
         rc = run_headless(&e, out, frames > 0 ? frames : FLY_FRAMES);
     }
@@ -244,7 +288,6 @@ int main(int argc, char **argv)
         link_print_summary(linked, stdout);
         link_close(linked);
     }
-    free(work);
-    free(blob);
+    scene_start_close(&st);
     return rc;
 }

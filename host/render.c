@@ -6,6 +6,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "crc32.h"
 #include "engine.h"
@@ -17,7 +19,7 @@
 #include "objects.h"
 #include "png.h"
 #include "port.h"
-#include "scene_file.h"
+#include "scene_start.h"
 
 static const char usage[] =
     "usage: render SCENE [--at X,Y[,Z]] [--angle DEG] [options]\n"
@@ -102,18 +104,53 @@ static int die(const char *fmt, const char *a, const char *b)
     return 2;
 }
 
-static int parse_at(options *o, char *arg)
+/* One coordinate of --at: a decimal number (syntax), strictly inside the
+ * world's +-32768 (range). 0, or -1 (syntax) or -2 (range). */
+static int parse_coord(const char *t, fx_t *out)
 {
-    char *parts[4];
+    int64_t v;
+    if (fxtext_parse64(t, &v)) return -1;
+    if (v <= -((int64_t)32768 << 16) || v >= (int64_t)32768 << 16) return -2;
+    *out = (fx_t)v;
+    return 0;
+}
+
+/* --at X,Y[,Z]: exactly two or three numbers, none of them empty. 0, or -1
+ * (syntax) or -2 (range). */
+static int parse_at(options *o, const char *arg)
+{
+    fx_t v[3];
     int n = 0;
-    for (char *tok = strtok(arg, ","); tok && n < 4; tok = strtok(NULL, ",")) parts[n++] = tok;
-    if (n < 2 || n > 3) return -1;
-    if (fxtext_parse(parts[0], &o->cam.x) || fxtext_parse(parts[1], &o->cam.y)) return -1;
+    for (const char *p = arg;; n++) {
+        size_t len = strcspn(p, ",");
+        char tok[64];
+        if (n == 3 || len == 0 || len >= sizeof tok) return -1;
+        memcpy(tok, p, len);
+        tok[len] = 0;
+        int rc = parse_coord(tok, &v[n]);
+        if (rc) return rc;
+        if (!p[len]) break;
+        p += len + 1;
+    }
+    if (++n < 2) return -1;
+    o->cam.x = v[0];
+    o->cam.y = v[1];
     if (n == 3) {
-        if (fxtext_parse(parts[2], &o->cam.z)) return -1;
+        o->cam.z = v[2];
         o->have_z = 1;
     }
     o->have_at = 1;
+    return 0;
+}
+
+/* Options that take a value (every other option stands alone). */
+static int takes_value(const char *a)
+{
+    static const char *const with_value[] = {"--at", "--angle", "--look", "--mode", "--present", "--split", "-o",
+                                             "--raw", "--ids", "--time", "--link", "--baud", "--objects", "--door",
+                                             "--repeat"};
+    for (size_t i = 0; i < sizeof with_value / sizeof *with_value; i++)
+        if (!strcmp(a, with_value[i])) return 1;
     return 0;
 }
 
@@ -136,19 +173,25 @@ static int parse_args(options *o, int argc, char **argv)
             if (o->scene) return die("more than one scene given: '%s'%s", a, "");
             o->scene = a;
             takes = 0;
+        } else if (!takes_value(a)) {
+            return die("unknown option '%s' (see --help)%s", a, "");
         } else if (!val) {
             return die("option %s needs a value%s", a, "");
         } else if (!strcmp(a, "--at")) {
-            char buf[256];
-            snprintf(buf, sizeof buf, "%s", val);
-            if (parse_at(o, buf)) return die("--at '%s': expected X,Y or X,Y,Z in map units (|v| < 32768)%s", val, "");
+            int at = parse_at(o, val);
+            if (at == -1)
+                return die("--at '%s': expected X,Y or X,Y,Z: two or three decimal numbers such as 128,-64.5%s", val,
+                           "");
+            if (at == -2) return die("--at '%s': outside the map: each coordinate must be above -32768 and below 32768%s", val, "");
         } else if (!strcmp(a, "--angle")) {
             if (fxtext_parse(val, &o->cam.angle_deg)) return die("--angle '%s': expected degrees%s", val, "");
             o->have_angle = 1;
         } else if (!strcmp(a, "--look")) {
             char *end;
+            errno = 0;
             long v = strtol(val, &end, 10);
-            if (*end || v < -VIEW_LOOK_MAX || v > VIEW_LOOK_MAX) return die("--look '%s': expected whole pixels -100..100%s", val, "");
+            if (*end || end == val || errno) return die("--look '%s': expected a whole number of pixels such as -20%s", val, "");
+            if (v < -VIEW_LOOK_MAX || v > VIEW_LOOK_MAX) return die("--look '%s': expected whole pixels -100..100%s", val, "");
             o->cam.look = (int32_t)v;
         } else if (!strcmp(a, "--mode")) {
             int m = render_mode_parse(val);
@@ -202,7 +245,7 @@ static int parse_args(options *o, int argc, char **argv)
             o->repeat = strtol(val, &end, 10);
             if (*end || o->repeat < 1 || o->repeat > 1000000) return die("--repeat '%s': expected 1..1000000%s", val, "");
         } else {
-            return die("unknown option '%s' (see --help)%s", a, "");
+            return die("option %s is not handled%s", a, ""); /* takes_value and this chain disagree */
         }
         i += takes;
     }
@@ -211,49 +254,7 @@ static int parse_args(options *o, int argc, char **argv)
     return 0;
 }
 
-/* Model names of a text scene, in the order bspc numbers its models (the order of its
- * 'model' lines). The compiled blob keeps no names, so --objects resolves them here;
- * a compiled scene or a WAD map gives none (0). Returns the count, or -1 out of memory. */
-static int text_model_names(const char *spec, char ***names_out)
-{
-    *names_out = NULL;
-    FILE *f = fopen(spec, "rb");
-    if (!f) return 0; /* file.wad:MAP01, not a file of that name */
-    char line[1024];
-    size_t got = fread(line, 1, 4, f);
-    if (got == 4 && !memcmp(line, "BSCN", 4)) {
-        fclose(f);
-        return 0;
-    }
-    rewind(f);
-    char **names = NULL;
-    int n = 0;
-    while (fgets(line, sizeof line, f)) {
-        char *hash = strchr(line, '#');
-        if (hash) *hash = 0;
-        char *save, *w0 = strtok_r(line, " \t\r\n", &save);
-        char *w1 = w0 ? strtok_r(NULL, " \t\r\n", &save) : NULL;
-        if (!w0 || strcmp(w0, "model") || !w1) continue;
-        char **grown = realloc(names, sizeof *names * (size_t)(n + 1));
-        char *copy = grown ? malloc(strlen(w1) + 1) : NULL;
-        if (!copy) {
-            free(grown ? grown : names);
-            fclose(f);
-            return -1;
-        }
-        names = grown;
-        names[n++] = strcpy(copy, w1);
-    }
-    fclose(f);
-    *names_out = names;
-    return n;
-}
-
-static void free_names(char **names, int n)
-{
-    for (int i = 0; i < n; i++) free(names[i]);
-    free(names);
-}
+#define OBJECTS_LINE_MAX 1022 /* characters of an --objects line, its end not counted */
 
 static void file_error(const char *path, int lineno, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 static void file_error(const char *path, int lineno, const char *fmt, ...)
@@ -277,20 +278,26 @@ static long read_objects(const char *path, const char *spec, const scene *s, obj
         fprintf(stderr, "render: %s: cannot read objects: %s\n", path, strerror(errno));
         return -1;
     }
-    char **names;
-    int nnames = text_model_names(spec, &names);
+    bspc_name *names;
+    int nnames = bspc_model_names(spec, &names);
     obj_state *objs = NULL;
     long n = 0, rc = -1;
-    char line[1024];
+    char *line = NULL;
+    size_t cap = 0;
+    ssize_t got;
     int lineno = 0;
     if (nnames < 0) {
         fprintf(stderr, "render: out of memory\n");
         goto done;
     }
-    while (fgets(line, sizeof line, f)) {
+    while ((got = getline(&line, &cap, f)) >= 0) {
         lineno++;
-        if (!strchr(line, '\n') && !feof(f)) {
-            file_error(path, lineno, "line longer than %u characters", (unsigned)sizeof line - 2);
+        if (strlen(line) != (size_t)got) {
+            file_error(path, lineno, "holds a NUL byte (not a text file?)");
+            goto done;
+        }
+        if (got > OBJECTS_LINE_MAX + (line[got - 1] == '\n')) {
+            file_error(path, lineno, "line longer than %u characters", OBJECTS_LINE_MAX);
             goto done;
         }
         char *hash = strchr(line, '#');
@@ -314,7 +321,7 @@ static long read_objects(const char *path, const char *spec, const scene *s, obj
         const char *m = tok[1];
         int named = -1;
         for (int i = 0; i < nnames; i++)
-            if (!strcmp(names[i], m)) named = i;
+            if (!strcmp(names[i].name, m)) named = i;
         if (named >= 0) {
             o.model = (uint32_t)named;
         } else {
@@ -377,7 +384,8 @@ static long read_objects(const char *path, const char *spec, const scene *s, obj
     objs = NULL;
 done:
     free(objs);
-    free_names(names, nnames);
+    free(names);
+    free(line);
     fclose(f);
     return rc;
 }
@@ -397,6 +405,35 @@ static int refuse_beyond_scene(const options *o, const scene *s)
         why = "--door: this build leaves out doors (it was built for a scene without them)";
     if (why) fprintf(stderr, "render: %s: %s\n", o->scene, why);
     return why != 0;
+}
+
+/* 1 when (x, y) lies in no sector: the first wall a ray to the east meets
+ * has no sector on the side facing the point, or the ray meets no wall at
+ * all. The same answer as the compiler's winding number for closed sectors. */
+static int in_void(const scene *s, fx_t x, fx_t y)
+{
+    int64_t best_hx = -1, best_dy = 1; /* the nearest crossing so far, hx / dy past x; none yet */
+    uint32_t sector = SCN_NONE;
+    for (uint32_t i = 0; i < s->nlines; i++) {
+        const scn_line *l = &s->lines[i];
+        const scn_vertex *a = &s->verts[l->v1], *b = &s->verts[l->v2];
+        if ((a->y > y) == (b->y > y)) continue; /* half-open: a vertex on the ray counts once */
+        /* where the wall crosses the ray's line, as hx / dy past x (dy != 0) */
+        int64_t dy = (int64_t)b->y - a->y, hx = ((int64_t)a->x - x) * dy + ((int64_t)b->x - a->x) * ((int64_t)y - a->y);
+        if (dy < 0) {
+            dy = -dy;
+            hx = -hx;
+        }
+        if (hx < 0) continue;
+        /* hx / dy against the best so far without dividing (|hx| < 2^50, dy < 2^33) */
+        if (best_hx >= 0 && (__int128)hx * best_dy >= (__int128)best_hx * dy) continue;
+        best_hx = hx;
+        best_dy = dy;
+        /* the front side is on the right going v1 -> v2: a wall going up (north)
+         * has its front to the east, away from the point */
+        sector = l->sector[b->y > a->y ? 1 : 0];
+    }
+    return sector == SCN_NONE;
 }
 
 static int apply_doors(const options *o, const scene *s, world_state *w)
@@ -419,6 +456,44 @@ static int apply_doors(const options *o, const scene *s, world_state *w)
         }
         w->ceil[d->sector] = d->h;
     }
+    return 0;
+}
+
+/* An output file can be written where it is named: an existing file (not a
+ * folder) we may write, or a new one in a folder we may write. 0, or -1 with
+ * errno set. */
+static int out_writable(const char *path)
+{
+    struct stat st;
+    if (stat(path, &st) == 0) {
+        if (S_ISDIR(st.st_mode)) {
+            errno = EISDIR;
+            return -1;
+        }
+        return access(path, W_OK);
+    }
+    if (errno != ENOENT) return -1;
+    char dir[4096];
+    const char *slash = strrchr(path, '/');
+    if (!slash) return access(".", W_OK);
+    if ((size_t)(slash - path) >= sizeof dir) {
+        errno = ENAMETOOLONG;
+        return -1;
+    }
+    snprintf(dir, sizeof dir, "%.*s", slash == path ? 1 : (int)(slash - path), path);
+    return access(dir, W_OK);
+}
+
+/* The output files before any work: a frame is not rendered for nowhere. */
+static int check_outputs(const options *o)
+{
+    const char *const paths[3] = {o->png, o->raw, o->ids};
+    static const char *const opts[3] = {"-o", "--raw", "--ids"};
+    for (int i = 0; i < 3; i++)
+        if (paths[i] && out_writable(paths[i]) != 0) {
+            fprintf(stderr, "render: %s %s: cannot write there: %s\n", opts[i], paths[i], strerror(errno));
+            return -1;
+        }
     return 0;
 }
 
@@ -527,6 +602,7 @@ int main(int argc, char **argv)
     int rc = parse_args(&o, argc, argv);
     if (rc) return rc;
 
+    if (check_outputs(&o) != 0) return 1;
     char err[512];
     /* the port first: a PORT that does not open is a bad option, found before any work */
     static link_sender sender;
@@ -534,46 +610,28 @@ int main(int argc, char **argv)
         fprintf(stderr, "render: --link %s\n", err);
         return 2;
     }
-    uint8_t *blob;
-    size_t len;
-    if (scene_file_load(o.scene, &o.bspc, &blob, &len, err, sizeof err) != 0) {
-        fprintf(stderr, "render: %s\n", err);
-        return 1;
-    }
     static engine e;
-    scene_error se;
+    scene_start st;
     hal_null_reset();
-    if (len > UINT32_MAX || eng_init(&e, blob, (uint32_t)len, &se) != SCENE_OK) {
-        scene_file_describe_error(o.scene, blob, len, &se, err, sizeof err);
+    if (scene_start_open(&st, &e, o.scene, &o.bspc, NULL, 0, err, sizeof err) != 0) {
         fprintf(stderr, "render: %s\n", err);
-        free(blob);
         return 1;
     }
     if (refuse_beyond_scene(&o, &e.sc)) {
-        free(blob);
+        scene_start_close(&st);
         return 1;
     }
     obj_state *file_objs = NULL;
     long nfile = 0;
     if (o.objects && (nfile = read_objects(o.objects, o.scene, &e.sc, &file_objs)) < 0) {
-        free(blob);
+        scene_start_close(&st);
         return 1;
     }
-    /* The renderer's work memory depends on the objects drawn: the file's may need more
-     * than the scene's own, which is what eng_work_bytes provides for. */
-    uint32_t need = eng_work_bytes(&e);
-    if (o.objects && need) {
-        world_state mine = {file_objs, (uint32_t)nfile, 0, 0};
-        uint64_t r = render_work_bytes(&e.sc, &mine), total = (uint64_t)obj_state_bytes(&e.sc) + r;
-        if (r == 0 || total > 0xFFFFFFF0u) need = 0;
-        else if (total > need) need = (uint32_t)total;
-    }
-    void *work = need ? malloc(need) : NULL;
-    if (!work || eng_set_work(&e, work, need) != 0) {
-        fprintf(stderr, "render: %s: the scene needs %u bytes of work memory, which could not be had\n", o.scene, need);
-        free(work);
+    world_state mine = {file_objs, (uint32_t)nfile, 0, 0};
+    if (scene_start_work(&st, &e, o.objects ? &mine : NULL, err, sizeof err) != 0) {
+        fprintf(stderr, "render: %s\n", err);
         free(file_objs);
-        free(blob);
+        scene_start_close(&st);
         return 1;
     }
     e.mode = o.mode;
@@ -598,11 +656,13 @@ int main(int argc, char **argv)
         obj_update(&e.world, &e.sc, o.time_ms, o.time_ms, e.cam.view.x, e.cam.view.y);
     }
     if (apply_doors(&o, &e.sc, &e.world) != 0) {
-        free(work);
         free(file_objs);
-        free(blob);
+        scene_start_close(&st);
         return 1;
     }
+    if (in_void(&e.sc, e.cam.view.x, e.cam.view.y))
+        fprintf(stderr, "render: warning: the camera is outside every sector of %s: the frame shows the void\n",
+                o.scene);
     if (o.objects) {
         e.world.objs = file_objs;
         e.world.n = (uint32_t)nfile;
@@ -631,12 +691,12 @@ int main(int argc, char **argv)
             failed = fprintf(stderr, "render: %s: cannot write id buffer: %s\n", o.ids, strerror(errno));
         free(bytes);
     }
-    if (o.link && send_link(&sender, &e, frame, o.scene, blob, len) != 0) failed = 1;
-    print_json(&o, &e, crc, o.link ? &sender : NULL);
+    if (o.link && send_link(&sender, &e, frame, o.scene, st.data, st.len) != 0) failed = 1;
+    /* the counters only of a frame that went everywhere it was asked to go */
+    if (!failed) print_json(&o, &e, crc, o.link ? &sender : NULL);
     if (o.link) link_close(&sender);
     free(ids);
     free(file_objs);
-    free(work);
-    free(blob);
+    scene_start_close(&st);
     return failed ? 1 : 0;
 }

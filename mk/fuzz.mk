@@ -25,7 +25,7 @@ FUZZ_NAMES := text wad scene render link dfu
 FUZZ_TIME  ?= 60
 FUZZ_JOBS  ?= 2
 
-FUZZ_ENGINE := $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC) host/scene_file.c tests/fuzz/fuzz_common.c
+FUZZ_ENGINE := $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC) tests/fuzz/fuzz_common.c
 FUZZ_SRC_text   := $(FUZZ_ENGINE)
 FUZZ_SRC_wad    := $(FUZZ_ENGINE)
 FUZZ_SRC_scene  := $(FUZZ_ENGINE)

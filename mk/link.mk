@@ -4,7 +4,7 @@
 #   LINK_SRC              the frame link's C sources (freestanding, no float: part of
 #                         `make nofloat`; linked into build/display and the unit tests)
 #   make build/fltool     walk a scene, encode frames into a stream, decode a stream
-#                         (tools/fltool.c; tests/test_framelink.py and tools/bench_link.py use it)
+#                         (host/fltool.c; tests/test_framelink.py and tools/bench_link.py use it)
 #   make bench-link       bytes per frame of a MAP01 fly-through (textured, and flat:
 #                         fps at 115,200 baud .. USB full speed) against raw and zlib -9,
 #                         and the encoder's instructions per frame on x86-64 (callgrind)
@@ -15,7 +15,7 @@
 
 LINK_SRC := $(sort $(wildcard hal/serial/*.c))
 
-FLTOOL_SRC := tools/fltool.c $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC) $(LINK_SRC)
+FLTOOL_SRC := host/fltool.c $(HOST_ENG) $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC) $(LINK_SRC)
 $(BUILD)/fltool: $(patsubst %.c,$(BUILD)/obj/%.o,$(FLTOOL_SRC))
 	$(CC) $(REL) $^ -o $@ -lm
 $(BUILD)/san/fltool: $(patsubst %.c,$(BUILD)/san/obj/%.o,$(FLTOOL_SRC))

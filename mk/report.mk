@@ -69,7 +69,7 @@ REPORT_CONFIGS := default subpix8 subpix4 subpix2 subpix0 step16 step12 step8 st
 
 # Only the firmware and build/render's main include the knobs' headers; the
 # scene compiler, PNG writer and HAL objects are shared with build/ (build/san/).
-KNOB_SRC    := $(FW_SRC) host/render.c
+KNOB_SRC    := $(FW_SRC) $(HOST_ENG) host/render.c
 KNOB_SHARED := $(HOST_LIB) $(BSPC_LIB) $(HAL_SRC) $(NULL_SRC)
 
 .PHONY: report report-configs REPORT_FORCE

@@ -19,7 +19,7 @@ SCENE_OUT ?= $(BUILD)/scene/$(call scene_name,$(SCENE))
 
 # Only the firmware and the programs' mains read build_config.h; the compiler,
 # PNG writer and HAL objects are shared with build/ (build/san/).
-SCENE_SRC    := $(FW_SRC) host/render.c
+SCENE_SRC    := $(FW_SRC) $(HOST_ENG) host/render.c
 SCENE_SHARED := $(HOST_LIB) $(BSPC_LIB) $(HAL_SRC) $(NULL_SRC)
 
 .PHONY: scene-host SCENE_FORCE
@@ -74,7 +74,7 @@ $(SCENE_OUT)/gen/scene_blob.c: $(SCENE_OUT)/scene.bsc $(BUILD)/bin2c
 $(SCENE_OUT)/obj/gen/scene_blob.o: $(SCENE_OUT)/gen/scene_blob.c
 	@mkdir -p $(@D)
 	$(CC) $(BASE) $(REL) $(FW_FLAGS) -c $< -o $@
-$(SCENE_OUT)/emu: $(patsubst %.c,$(SCENE_OUT)/obj/%.o,$(FW_SRC) host/emu.c) $(SCENE_OUT)/obj/gen/scene_blob.o \
+$(SCENE_OUT)/emu: $(patsubst %.c,$(SCENE_OUT)/obj/%.o,$(FW_SRC) $(HOST_ENG) host/emu.c) $(SCENE_OUT)/obj/gen/scene_blob.o \
                   $(patsubst %.c,$(BUILD)/obj/%.o,$(HOST_LIB) $(BSPC_LIB) $(HAL_SRC) $(SDL_SRC))
 	$(CC) $(REL) $^ -o $@ $(SDL_LIBS) -lm
 

@@ -123,3 +123,75 @@ def test_extremes_of_the_ranges_compile(tmp_path):
     wad = tmp_path / "edge.wad"
     wad_room(wad, -32767, -32767, 32767, 32767, -16383, 16383)
     run([program("bspc"), f"{wad}:MAP01", "-o", tmp_path / "edge2.bsc"])
+
+
+# ---- finding maps, and text files as editors write them (issue 19) -------------------------------
+
+def test_list_maps_of_a_wad(tmp_path):
+    proc = run([program("bspc"), "--list", "freedoom2.wad"])
+    assert proc.stdout.split() == [f"MAP{i:02d}" for i in range(1, 33)]
+    full = run([program("bspc"), "--list", str(freedoom("freedoom2.wad"))])
+    assert full.stdout == proc.stdout
+    bad = run([program("bspc"), "--list", str(tmp_path / "none.wad")], check=False)
+    assert bad.returncode == 1 and "cannot find" in bad.stderr
+
+
+@pytest.mark.parametrize("prog", ["bspc", "render"])
+@pytest.mark.parametrize("spec,needles", [
+    ("freedoom2.wad", ["name a map in the WAD as freedoom2.wad:MAP", "its maps: MAP01 MAP02"]),
+    ("freedoom2.wad:MAP99", ["no map MAP99", "its maps: MAP01 MAP02", "MAP32"]),
+    ("nosuch.wad", ["cannot find nosuch.wad", "$DOOMWADDIR"]),
+])
+def test_wad_named_without_a_map_or_with_a_wrong_one(prog, spec, needles):
+    proc = run([program(prog), spec], check=False)
+    assert proc.returncode == 1 and proc.stderr.count("\n") == 1, proc.stderr
+    for n in needles:
+        assert n in proc.stderr, proc.stderr
+    assert "No such file" not in proc.stderr
+
+
+def test_list_maps_of_a_pwad(tmp_path):
+    wad = tmp_path / "one.wad"
+    write_pwad_map(wad, b"", b"", b"", b"", b"")
+    assert run([program("bspc"), "--list", str(wad)]).stdout == "MAP01\n"
+
+
+@pytest.mark.parametrize("name,transform", [
+    ("bom", lambda t: b"\xef\xbb\xbf" + t),
+    ("cr", lambda t: t.replace(b"\n", b"\r")),
+    ("crlf", lambda t: t.replace(b"\n", b"\r\n")),
+    ("bom-crlf", lambda t: b"\xef\xbb\xbf" + t.replace(b"\n", b"\r\n")),
+])
+def test_text_scene_line_ends_and_byte_order_mark(tmp_path, name, transform):
+    src = ROOT / "tests/scenes/objects.scene"
+    want = run([program("bspc"), src, "-o", tmp_path / "want.bsc"])
+    assert want.returncode == 0
+    odd = tmp_path / f"{name}.scene"
+    odd.write_bytes(transform(src.read_bytes()))
+    run([program("bspc"), odd, "-o", tmp_path / "got.bsc"])
+    assert (tmp_path / "got.bsc").read_bytes() == (tmp_path / "want.bsc").read_bytes()
+
+
+def test_line_numbers_with_cr_line_ends(tmp_path):
+    odd = tmp_path / "cr.scene"
+    odd.write_bytes(b"# a comment\r\r# another\rbogus\r")
+    proc = run([program("bspc"), odd], check=False)
+    assert f"{odd}:4: unknown statement 'bogus'" in proc.stderr, proc.stderr
+
+
+def test_directory_as_input(tmp_path):
+    proc = run([program("bspc"), tmp_path], check=False)
+    assert proc.returncode == 1 and "is a directory" in proc.stderr and "read" not in proc.stderr
+
+
+def test_model_names_of_a_crlf_scene_for_render_objects(tmp_path):
+    """build/render --objects resolves names with the compiler's own parser, so a scene with
+    CRLF line ends names its models as bspc reads them."""
+    odd = tmp_path / "crlf.scene"
+    odd.write_bytes((ROOT / "tests/scenes/objects.scene").read_bytes().replace(b"\n", b"\r\n"))
+    objs = tmp_path / "objs.txt"
+    objs.write_text("object barrel 100 100 0 0\n")
+    by_name = json.loads(run([program("render"), odd, "--objects", objs]).stdout)
+    objs.write_text("object 1 100 100 0 0\n")
+    by_number = json.loads(run([program("render"), odd, "--objects", objs]).stdout)
+    assert by_name["objects"][0]["model"] == 1 and by_name["crc32"] == by_number["crc32"]

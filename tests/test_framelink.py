@@ -1,6 +1,6 @@
 """The frame link's Python twin (tools/framelink.py) against the C encoder and decoder.
 
-Streams come from build/fltool (tools/fltool.c): a fly-through of freedoom2.wad:MAP01 rendered
+Streams come from build/fltool (host/fltool.c): a fly-through of freedoom2.wad:MAP01 rendered
 by the firmware on the null target, encoded by the C encoder. The codec's tests use the walk in
 flat colours, whose frames take every path of the codec (runs, deltas, keyframes); textured frames
 are mostly raw (make bench-link), and one test sends them through too. The C decoder (build/san/fltool

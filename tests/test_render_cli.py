@@ -125,3 +125,85 @@ def test_damaged_compiled_scene_is_refused(compiled, tmp_path, damage):
     assert "bad.bsc" in proc.stderr
     if damage != "magic":  # a wrong magic is read as a text scene, which then fails to parse
         assert {"truncate": "truncated", "crc": "CRC", "version": "version"}[damage] in proc.stderr
+
+
+# ---- argument checks and messages (issue 19: a newcomer's first hour) ----------------------------
+
+def render_refused(*args, status=2):
+    proc = run([program("render"), *args], check=False)
+    assert proc.returncode == status, (args, proc.returncode, proc.stderr)
+    assert proc.stdout == "", proc.stdout  # no JSON for a refused run
+    assert proc.stderr.count("\n") == 1 and "Sanitizer" not in proc.stderr, proc.stderr
+    return proc.stderr
+
+
+def test_unknown_option_is_named_as_unknown():
+    # last on the line, where 'needs a value' was said before
+    assert "unknown option '--bogus'" in render_refused(DEFAULT, "--bogus")
+    assert "unknown option '--bogus'" in render_refused(DEFAULT, "--bogus", "1")
+    assert "needs a value" in render_refused(DEFAULT, "--at")
+
+
+@pytest.mark.parametrize("at", [",1,2", "1,2,", "1,,2", "1", "1,2,3,4", "", "1e-9,0", "0x10,0", "1,two"])
+def test_at_syntax(at):
+    err = render_refused(DEFAULT, "--at", at)
+    assert "two or three decimal numbers" in err and "outside" not in err
+
+
+@pytest.mark.parametrize("at", ["-32768,0", "0,32768", "1,2,-32768", "99999,0"])
+def test_at_range_says_what_it_checks(at):
+    assert "above -32768 and below 32768" in render_refused(DEFAULT, "--at", at)
+
+
+def test_at_range_edges_accepted():
+    j = render(DEFAULT, at="-32767.99,32767.99")
+    assert j["camera"]["x"] == round(-32767.99 * 65536) / 65536
+
+
+@pytest.mark.parametrize("look,needle", [("", "whole number"), ("x", "whole number"), ("1.5", "whole number"),
+                                         ("101", "-100..100")])
+def test_look_syntax_and_range(look, needle):
+    assert needle in render_refused(DEFAULT, "--look", look)
+
+
+@pytest.mark.parametrize("flag", ["-o", "--raw", "--ids"])
+def test_unwritable_output_fails_before_rendering(tmp_path, flag):
+    err = render_refused(DEFAULT, flag, str(tmp_path / "no" / "such" / "x.png"), status=1)
+    assert f"{flag} " in err and "cannot write there" in err
+    err = render_refused(DEFAULT, flag, str(tmp_path), status=1)  # a folder
+    assert "Is a directory" in err
+
+
+def test_output_written_and_json_printed(tmp_path):
+    out = tmp_path / "new.png"
+    j = render(DEFAULT, "-o", str(out))
+    assert out.exists() and len(j["crc32"]) == 8
+
+
+def test_camera_outside_every_sector_warns(compiled):
+    for scene in (DEFAULT, str(compiled)):
+        proc = run([program("render"), scene, "--at", "30000,30000"])
+        assert proc.returncode == 0
+        assert "warning: the camera is outside every sector" in proc.stderr
+        json.loads(proc.stdout)
+        inside = run([program("render"), scene])
+        assert inside.stderr == ""
+
+
+def test_directory_as_scene(tmp_path):
+    err = render_refused(str(tmp_path), status=1)
+    assert "is a directory" in err and "read" not in err
+
+
+def test_objects_line_with_a_nul_byte(tmp_path):
+    objs = tmp_path / "objs.txt"
+    objs.write_bytes(b"# fine\nobject 0 96 160 0 0\x00 junk\n")
+    err = render_refused(str(ROOT / "tests/scenes/objects.scene"), "--objects", str(objs), status=1)
+    assert ":2: holds a NUL byte" in err and "longer" not in err
+
+
+def test_objects_line_length_limit_kept(tmp_path):
+    objs = tmp_path / "objs.txt"
+    objs.write_text("#" + "x" * 1021 + "\n" + "#" + "x" * 1022 + "\n")
+    err = render_refused(str(ROOT / "tests/scenes/objects.scene"), "--objects", str(objs), status=1)
+    assert ":2: line longer than 1022 characters" in err

@@ -13,13 +13,13 @@
 #define SDL_MAIN_HANDLED
 #include <SDL.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "hal.h"
 #include "ram_target.h"
 #include "hal_sdl.h"
 
-#define HAL_SDL_MAX_SCALE 8
 #define HAL_SDL_ASPECT_H 240 /* 320x200 shown as 320x240 */
 
 
@@ -33,12 +33,12 @@ static struct {
     uint32_t t0;
     uint32_t last_shown; /* SDL ticks when the last frame was shown */
     uint32_t edges; /* edge-triggered bits (and quit) pressed since the last hal_input */
-    SDL_Scancode sc_a, sc_z, sc_q, sc_w, sc_comma, sc_period, sc_m, sc_p, sc_c;
+    SDL_Scancode sc_a, sc_z, sc_q, sc_w, sc_comma, sc_period, sc_m, sc_p, sc_c, sc_v, sc_s;
     char err[256];
 } sdl;
 
 #define HAL_KEY_EDGES ((uint32_t)HAL_KEY_NEXT_MODE | (uint32_t)HAL_KEY_NEXT_PRESENT | \
-                       (uint32_t)HAL_KEY_PRINT_COUNTERS)
+                       (uint32_t)HAL_KEY_PRINT_COUNTERS | (uint32_t)HAL_KEY_PRINT_VIEW | (uint32_t)HAL_KEY_SCREENSHOT)
 
 /* ---- window -------------------------------------------------------------- */
 const char *hal_sdl_error(void)
@@ -76,10 +76,9 @@ static SDL_Scancode key_sc(SDL_Keycode k, SDL_Scancode fallback)
 
 /* SDL 2.26 picks its windowless "offscreen" (or "dummy") driver by itself
  * when no display works; that is a failure unless the user asked for it. */
-static int headless_fallback(void)
+static int headless_fallback(const char *asked)
 {
     const char *drv = SDL_GetCurrentVideoDriver();
-    const char *asked = SDL_GetHint(SDL_HINT_VIDEODRIVER); /* also reads the environment */
     if (drv == NULL)
         return 1;
     if (strcmp(drv, "offscreen") != 0 && strcmp(drv, "dummy") != 0)
@@ -99,11 +98,18 @@ int hal_sdl_init(int scale, const char *title)
     if (title == NULL)
         title = "hal";
 
+    const char *asked = SDL_GetHint(SDL_HINT_VIDEODRIVER); /* also reads the environment */
+    const char *xdg = getenv("XDG_RUNTIME_DIR"), *wl = getenv("WAYLAND_DISPLAY");
+    if (!asked && (!xdg || !*xdg) && (!wl || wl[0] != '/')) {
+        /* No Wayland socket can be found, and libwayland would say so on
+         * stderr when SDL tries it: leave Wayland out of SDL's own list. */
+        SDL_SetHint(SDL_HINT_VIDEODRIVER, "x11,KMSDRM,offscreen,dummy");
+    }
     if (SDL_Init(SDL_INIT_VIDEO) != 0) {
         fail("SDL_Init(video) failed (no display?)");
         return -1;
     }
-    if (headless_fallback()) {
+    if (headless_fallback(asked)) {
         snprintf(sdl.err, sizeof sdl.err,
                  "no display available: SDL fell back to its '%s' video driver "
                  "(set DISPLAY, or SDL_VIDEODRIVER=%s to run without a window)",
@@ -153,6 +159,8 @@ int hal_sdl_init(int scale, const char *title)
     sdl.sc_m = key_sc(SDLK_m, SDL_SCANCODE_M);
     sdl.sc_p = key_sc(SDLK_p, SDL_SCANCODE_P);
     sdl.sc_c = key_sc(SDLK_c, SDL_SCANCODE_C);
+    sdl.sc_v = key_sc(SDLK_v, SDL_SCANCODE_V);
+    sdl.sc_s = key_sc(SDLK_s, SDL_SCANCODE_S);
     sdl.edges = 0;
     sdl.t0 = SDL_GetTicks();
     return 0;
@@ -189,6 +197,10 @@ static void pump(void)
                 sdl.edges |= HAL_KEY_NEXT_PRESENT;
             else if (sc == sdl.sc_c)
                 sdl.edges |= HAL_KEY_PRINT_COUNTERS;
+            else if (sc == sdl.sc_v)
+                sdl.edges |= HAL_KEY_PRINT_VIEW;
+            else if (sc == sdl.sc_s || sc == SDL_SCANCODE_F12)
+                sdl.edges |= HAL_KEY_SCREENSHOT;
         }
     }
 }

@@ -9,12 +9,14 @@
  *   Alt+Left/Right, ',' '.'  strafe         PgUp/PgDn, A/Z  fly up/down
  *   Home/End, Q/W      look up/down        Shift           run
  *   M next render mode (edge)   P next present mode (edge)
- *   C print counters (edge)     Esc or closing the window: quit (stays set)
+ *   C print counters (edge)     V print the camera (edge)
+ *   S or F12 screenshot (edge)  Esc or closing the window: quit (stays set)
  */
 #ifndef HAL_SDL_H
 #define HAL_SDL_H
 
 #define HAL_SDL_DEFAULT_SCALE 3
+#define HAL_SDL_MAX_SCALE 8
 
 /* Open the window: scale is the integer size factor (<= 0: default 3; larger
  * than 8 is clamped), title may be NULL. Returns 0, or -1 with the reason in

@@ -9,6 +9,7 @@
 #include "crc32.h"
 #include "geom.h"
 #include "scene.h"
+#include "scene_file.h"
 
 bspc_options bspc_defaults(void)
 {
@@ -48,6 +49,39 @@ static int ends_with_wad(const char *s, size_t n)
 {
     return n >= 4 && s[n - 4] == '.' && tolower((unsigned char)s[n - 3]) == 'w' &&
            tolower((unsigned char)s[n - 2]) == 'a' && tolower((unsigned char)s[n - 1]) == 'd';
+}
+
+bspc_spec_kind bspc_spec(const char *spec, size_t *wadlen)
+{
+    size_t sl = strlen(spec);
+    const char *colon = strrchr(spec, ':');
+    bspc_spec_kind k = BSPC_SPEC_FILE;
+    if (colon && ends_with_wad(spec, (size_t)(colon - spec))) {
+        k = BSPC_SPEC_WAD_MAP;
+        sl = (size_t)(colon - spec);
+    } else if (ends_with_wad(spec, sl)) {
+        k = BSPC_SPEC_WAD;
+    }
+    if (wadlen) *wadlen = sl;
+    return k;
+}
+
+int bspc_model_names(const char *spec, bspc_name **names)
+{
+    *names = NULL;
+    if (bspc_spec(spec, NULL) != BSPC_SPEC_FILE || scene_file_probe(spec)) return 0;
+    bs_scene s;
+    memset(&s, 0, sizeof s);
+    bspc_options opt = bspc_defaults();
+    char err[8];
+    int n = 0;
+    if (bs_read_text(spec, &s, &opt, err, sizeof err) == 0 && s.nmodels > 0) {
+        *names = malloc(sizeof **names * s.nmodels);
+        n = *names ? (int)s.nmodels : -1;
+        for (int i = 0; i < n; i++) snprintf((*names)[i].name, sizeof (*names)[i].name, "%s", s.models[i].name);
+    }
+    bs_scene_free(&s);
+    return n;
 }
 
 static uint32_t walk_sector(const bs_tree *t, int32_t x, int32_t y)
@@ -119,23 +153,25 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
     int rc = -1;
 
     /* "file.wad:MAP01" or a text scene */
-    size_t sl = strlen(spec);
-    const char *colon = strrchr(spec, ':');
-    if (colon && ends_with_wad(spec, (size_t)(colon - spec))) {
+    size_t wl;
+    bspc_spec_kind kind = bspc_spec(spec, &wl);
+    if (kind != BSPC_SPEC_FILE) {
         char wadname[1024], path[1100];
-        size_t wl = (size_t)(colon - spec);
         if (wl >= sizeof wadname) return bs_fail(err, errlen, "%s: file name too long", spec);
         memcpy(wadname, spec, wl);
         wadname[wl] = 0;
-        if (!colon[1])
-            return bs_fail(err, errlen, "%s: no map named after the ':' (e.g. %sMAP01)", spec, spec);
         if (bspc_find_wad(wadname, path, sizeof path))
             return bs_fail(err, errlen, "%s: cannot find %s (looked in the current folder, "
                            "$DOOMWADDIR and /usr/share/games/doom)", spec, wadname);
-        if (bs_read_wad(path, colon + 1, spec, &s, &opt, err, errlen)) goto out;
-    } else if (ends_with_wad(spec, sl)) {
-        return bs_fail(err, errlen, "%s: name a map in the WAD, e.g. %s:MAP01 or %s:E1M1", spec, spec,
-                       spec);
+        if (kind == BSPC_SPEC_WAD || !spec[wl + 1]) {
+            char maps[200];
+            if (bspc_list_maps(wadname, maps, sizeof maps, err, errlen) < 0) return -1;
+            if (kind == BSPC_SPEC_WAD)
+                return bs_fail(err, errlen, "%s: name a map in the WAD as %s:MAP (its maps: %s)", spec, spec,
+                               *maps ? maps : "none");
+            return bs_fail(err, errlen, "%s: no map named after the ':' (its maps: %s)", spec, *maps ? maps : "none");
+        }
+        if (bs_read_wad(path, spec + wl + 1, spec, &s, &opt, err, errlen)) goto out;
     } else {
         if (bs_read_text(spec, &s, &opt, err, errlen)) goto out;
     }

@@ -43,4 +43,30 @@ int bspc_compile(const char *spec, const bspc_options *opt, uint8_t **blob, size
 /* Resolve a WAD file name as bspc_compile does; returns 0 and the path in out, or -1. */
 int bspc_find_wad(const char *name, char *out, size_t outlen);
 
+/* What a scene spec names: the one reading of its form. */
+typedef enum {
+    BSPC_SPEC_FILE,    /* a file: a text scene, or a compiled scene */
+    BSPC_SPEC_WAD,     /* "x.wad": a WAD without a map */
+    BSPC_SPEC_WAD_MAP  /* "x.wad:MAP01": a map in a WAD */
+} bspc_spec_kind;
+
+/* The kind of spec; *wadlen (may be NULL) gets the length of the WAD's name. */
+bspc_spec_kind bspc_spec(const char *spec, size_t *wadlen);
+
+/* The maps of the WAD named by wad (found as bspc_compile finds it), in the
+ * order of its directory, separated by spaces ("MAP01 MAP02"; "" when it has
+ * none). Returns the number of maps, or -1 with a message in err. When out is
+ * too small the list ends in "...". */
+int bspc_list_maps(const char *wad, char *out, size_t outlen, char *err, size_t errlen);
+
+/* A text scene's model names, in the order the compiler numbers the models
+ * (that of its 'model' lines), read by the compiler's own parser. Returns the
+ * count and a malloc'd *names (caller frees); 0 for a scene that is not a
+ * text scene (a compiled scene, a WAD map: they keep no names) or does not
+ * parse; -1 out of memory. */
+typedef struct {
+    char name[32];
+} bspc_name;
+int bspc_model_names(const char *spec, bspc_name **names);
+
 #endif

@@ -1,5 +1,6 @@
 /* main.c - build/bspc, the BSP compiler's command line:
  *   bspc INPUT [-o OUT] [--split fewest|balanced|mixed] [--flat] [--stats] [--needs] [--config FILE.h] [-v]
+ *   bspc --list WAD
  * INPUT is a text scene (docs/scene-format.md) or file.wad:MAP01 / file.wad:E1M1. */
 #include <errno.h>
 #include <stdio.h>
@@ -14,6 +15,7 @@ static void usage(FILE *f)
 {
     fputs("usage: bspc INPUT [-o OUT] [--split fewest|balanced|mixed] [--flat] [--stats]\n"
           "            [--needs] [--config FILE.h] [-v]\n"
+          "       bspc --list WAD\n"
           "\n"
           "Compiles a scene into a BSP blob (firmware/scene_format.h).\n"
           "  INPUT            a text scene (docs/scene-format.md), or a Doom-format map as\n"
@@ -32,6 +34,7 @@ static void usage(FILE *f)
           "                   (firmware/build_config.h); INPUT may then also be a compiled\n"
           "                   scene (.bsc), whose needs record is used as it is\n"
           "  -v               progress and warnings on stderr\n"
+          "  --list WAD       print the names of the maps in WAD on one line\n"
           "  --help           this text\n",
           f);
 }
@@ -72,14 +75,17 @@ static int write_config(const char *path, const char *name, const scene *sc)
     return 0;
 }
 
-static int is_compiled(const char *path)
+/* --list WAD: its maps, one line. */
+static int list_maps(const char *wad)
 {
-    FILE *f = fopen(path, "rb");
-    uint8_t m[4] = {0};
-    if (!f) return 0;
-    size_t n = fread(m, 1, 4, f);
-    fclose(f);
-    return n == 4 && ((uint32_t)m[0] | (uint32_t)m[1] << 8 | (uint32_t)m[2] << 16 | (uint32_t)m[3] << 24) == SCN_MAGIC;
+    char maps[16384], err[512];
+    int n = bspc_list_maps(wad, maps, sizeof maps, err, sizeof err);
+    if (n < 0) {
+        fprintf(stderr, "bspc: %s\n", err);
+        return 1;
+    }
+    printf("%s\n", maps);
+    return 0;
 }
 
 /* --config for a scene compiled before: its own needs record, once it loads. It is
@@ -132,6 +138,12 @@ int main(int argc, char **argv)
                 return 2;
             }
             config = argv[i];
+        } else if (strcmp(a, "--list") == 0) {
+            if (++i >= argc) {
+                fprintf(stderr, "bspc: --list needs a WAD file name\n");
+                return 2;
+            }
+            return list_maps(argv[i]);
         } else if (strcmp(a, "-o") == 0) {
             if (++i >= argc) {
                 fprintf(stderr, "bspc: -o needs a file name\n");
@@ -168,7 +180,7 @@ int main(int argc, char **argv)
         usage(stderr);
         return 2;
     }
-    if (config && is_compiled(in)) return config_from_compiled(in, config);
+    if (config && scene_file_probe(in)) return config_from_compiled(in, config);
     char outbuf[1100];
     if (!outp) {
         default_out(in, outbuf, sizeof outbuf);

@@ -18,9 +18,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "bspc_int.h"
 #include "fxtext.h"
+#include "scene_file.h"
 
 #define MAX_TOK 32
 
@@ -617,6 +619,11 @@ int bs_read_text(const char *path, bs_scene *s, const bspc_options *opt, char *e
     (void)opt;
     FILE *f = fopen(path, "rb");
     if (!f) return bs_fail(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+    struct stat st;
+    if (fstat(fileno(f), &st) == 0 && S_ISDIR(st.st_mode)) { /* a folder opens; only its read fails */
+        fclose(f);
+        return bs_fail(err, errlen, "%s: is a directory, not a scene file", path);
+    }
     char *buf = NULL;
     size_t len = 0, cap = 0;
     for (;;) {
@@ -634,16 +641,16 @@ int bs_read_text(const char *path, bs_scene *s, const bspc_options *opt, char *e
         len += got;
         if (got < 4096) break;
     }
-    int ioerr = ferror(f);
+    int ioerr = ferror(f) ? errno : 0;
     fclose(f);
     if (ioerr) {
         free(buf);
-        return bs_fail(err, errlen, "%s: read error", path);
+        return bs_fail(err, errlen, "%s: read error: %s", path, strerror(ioerr));
     }
     buf[len] = 0;
     if (strlen(buf) != len) {
         /* binary: say what it is not, and what it is when it is a compiled scene */
-        int compiled = len >= 4 && memcmp(buf, "BSCN", 4) == 0;
+        int compiled = scene_file_is_compiled((const uint8_t *)buf, len);
         free(buf);
         if (compiled)
             return bs_fail(err, errlen, "%s: a compiled scene, not a source to compile (bspc --config reads "
@@ -658,9 +665,17 @@ int bs_read_text(const char *path, bs_scene *s, const bspc_options *opt, char *e
     parser p = {path, 0, err, errlen, s, NULL, 0, 0, ""};
     int rc = 0;
     char *line = buf;
+    if (!strncmp(line, "\xef\xbb\xbf", 3)) line += 3; /* a UTF-8 byte-order mark, as some editors write */
     while (line && rc == 0) {
-        char *next = strchr(line, '\n');
-        if (next) *next++ = 0;
+        /* a line ends in LF, CRLF or a lone CR (old Mac editors) */
+        char *next = line + strcspn(line, "\r\n");
+        if (!*next)
+            next = NULL;
+        else {
+            int crlf = next[0] == '\r' && next[1] == '\n';
+            *next = 0;
+            next += 1 + crlf;
+        }
         p.line++;
         char *hash = strchr(line, '#');
         if (hash) *hash = 0;

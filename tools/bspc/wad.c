@@ -342,7 +342,9 @@ int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_sc
             break;
         }
     if (marker == nlumps) {
-        bs_fail(err, errlen, "%s: no map %s in %s", display, want, wadpath);
+        char maps[200];
+        if (bspc_list_maps(wadpath, maps, sizeof maps, err, errlen) >= 0)
+            bs_fail(err, errlen, "%s: no map %s in %s (its maps: %s)", display, want, wadpath, *maps ? maps : "none");
         goto out;
     }
     static const char *need[L_N] = {"THINGS", "LINEDEFS", "SIDEDEFS", "VERTEXES", "SECTORS"};

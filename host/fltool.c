@@ -36,18 +36,24 @@
 #include "fxtext.h"
 #include "hal.h"
 #include "hal_null.h"
-#include "scene_file.h"
+#include "scene_start.h"
 
-static int usage(void)
+static int usage_to(FILE *f, int rc)
 {
     fputs("usage: fltool walk SCENE [--frames N] [--dt MS] [--out DIR] [--flat]\n"
           "       fltool encode FRAMES.raw --out STREAM [--info FRAMES.jsonl] [--palette P.bin]\n"
           "                     [--key-interval N] [--scratch BYTES] [--sizes]\n"
           "       fltool decode STREAM [--chunk N] [--frames-out FILE]\n"
           "       fltool bench FRAMES.raw [--key-interval N] [--repeat R] [--crc]\n"
-          "       fltool digest FRAMES.raw\n",
-          stderr);
-    return 2;
+          "       fltool digest FRAMES.raw\n"
+          "       fltool --help\n",
+          f);
+    return rc;
+}
+
+static int usage(void)
+{
+    return usage_to(stderr, 2);
 }
 
 static uint8_t *read_file(const char *path, size_t *len)
@@ -131,26 +137,15 @@ static int cmd_walk(int argc, char **argv)
     }
     if (!spec || frames < 1 || dt < 1) return usage();
     char err[512];
-    uint8_t *blob;
-    size_t len;
     bspc_options opt = bspc_defaults();
-    if (scene_file_load(spec, &opt, &blob, &len, err, sizeof err) != 0) {
-        fprintf(stderr, "fltool: %s\n", err);
-        return 1;
-    }
     static engine e;
-    scene_error se;
+    scene_start st;
     hal_null_reset();
-    if (eng_init(&e, blob, (uint32_t)len, &se) != SCENE_OK) {
-        scene_file_describe_error(spec, blob, len, &se, err, sizeof err);
+    if (scene_start_load(&st, &e, spec, &opt, NULL, 0, err, sizeof err) != 0) {
         fprintf(stderr, "fltool: %s\n", err);
-        free(blob);
         return 1;
     }
     e.flat = (uint8_t)flat;
-    uint32_t need = eng_work_bytes(&e);
-    void *work = malloc(need);
-    if (!work || eng_set_work(&e, work, need)) return 1;
 
     char path[4096];
     snprintf(path, sizeof path, "%s/frames.raw", out);
@@ -216,8 +211,7 @@ static int cmd_walk(int argc, char **argv)
     }
     fclose(fr);
     fclose(fj);
-    free(work);
-    free(blob);
+    scene_start_close(&st);
     return 0;
 }
 
@@ -490,6 +484,7 @@ static int cmd_digest(int argc, char **argv)
 int main(int argc, char **argv)
 {
     if (argc < 2) return usage();
+    if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) return usage_to(stdout, 0);
     if (!strcmp(argv[1], "walk")) return cmd_walk(argc - 2, argv + 2);
     if (!strcmp(argv[1], "encode")) return cmd_encode(argc - 2, argv + 2, 0);
     if (!strcmp(argv[1], "bench")) return cmd_encode(argc - 2, argv + 2, 1);

@@ -2,13 +2,12 @@
 #include "scene_file.h"
 
 #include <errno.h>
+#include <sys/stat.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 
 #include "crc32.h"
-#include "scene.h"
 
 #define SCENE_FILE_MAX (256u << 20) /* larger than any scene the format can index sensibly */
 
@@ -17,6 +16,13 @@ static int read_whole(const char *path, uint8_t **data, size_t *len, char *err, 
     FILE *f = fopen(path, "rb");
     if (!f) {
         snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+        return -1;
+    }
+    /* a folder opens for reading, and only the first read fails */
+    struct stat st;
+    if (fstat(fileno(f), &st) == 0 && S_ISDIR(st.st_mode)) {
+        snprintf(err, errlen, "%s: is a directory, not a scene file", path);
+        fclose(f);
         return -1;
     }
     size_t cap = 1 << 16, n = 0;
@@ -37,11 +43,11 @@ static int read_whole(const char *path, uint8_t **data, size_t *len, char *err, 
         buf = nb;
         cap *= 2;
     }
-    int bad = ferror(f);
+    int bad = ferror(f) ? errno : 0;
     fclose(f);
     if (!buf || bad) {
+        snprintf(err, errlen, "%s: %s", path, bad ? strerror(bad) : "out of memory");
         free(buf);
-        snprintf(err, errlen, "%s: read failed", path);
         return -1;
     }
     *data = buf;
@@ -49,17 +55,31 @@ static int read_whole(const char *path, uint8_t **data, size_t *len, char *err, 
     return 0;
 }
 
+int scene_file_is_compiled(const uint8_t *data, size_t n)
+{
+    return n >= 4 && ((uint32_t)data[0] | (uint32_t)data[1] << 8 | (uint32_t)data[2] << 16 |
+                      (uint32_t)data[3] << 24) == SCN_MAGIC;
+}
+
+int scene_file_probe(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    uint8_t m[4];
+    if (!f) return 0;
+    size_t n = fread(m, 1, sizeof m, f);
+    fclose(f);
+    return scene_file_is_compiled(m, n);
+}
+
 int scene_file_load(const char *spec, const bspc_options *opt, uint8_t **blob, size_t *len, char *err, size_t errlen)
 {
-    /* "file.wad:MAP01" names a map inside a WAD: always a source. */
-    const char *colon = strrchr(spec, ':');
-    int is_wad_map = colon && colon > spec && colon - spec >= 4 && strncasecmp(colon - 4, ".wad", 4) == 0;
-    if (!is_wad_map) {
+    /* A WAD, with a map named or not, is a source: the compiler finds it on its
+     * search path and explains what is missing. */
+    if (bspc_spec(spec, NULL) == BSPC_SPEC_FILE) {
         uint8_t *data;
         size_t n;
         if (read_whole(spec, &data, &n, err, errlen) != 0) return -1;
-        uint32_t magic = n >= 4 ? (uint32_t)data[0] | (uint32_t)data[1] << 8 | (uint32_t)data[2] << 16 | (uint32_t)data[3] << 24 : 0;
-        if (magic == SCN_MAGIC) {
+        if (scene_file_is_compiled(data, n)) {
             /* The loader takes a blob in a larger buffer (a flash sector); a file is
              * exactly what bspc wrote, so bytes past total_bytes mean it is damaged.
              * A short file and a version this build does not read are the loader's
