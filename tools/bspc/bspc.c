@@ -166,6 +166,8 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
     if (bs_tjunc_segs(&t, s.name, err, errlen) || bs_tjunc_polys(&t, err, errlen)) goto out;
     double t_tj = bs_now_ms();
 
+    if (bs_split_big_leaves(&t, s.name, err, errlen)) goto out;
+
     uint64_t dsum = 0;
     t.max_depth = 0;
     for (uint32_t i = 0; i < t.nleaves; i++) {
@@ -173,12 +175,6 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
         if (t.leaves[i].depth > t.max_depth) t.max_depth = t.leaves[i].depth;
     }
     t.mean_depth = t.nleaves ? (double)dsum / t.nleaves : 0.0;
-    for (uint32_t i = 0; i < t.nleaves; i++)
-        if (t.leaves[i].poly.n > SCN_MAX_LEAF_VERTS) {
-            bs_fail(err, errlen, "%s: leaf %u: floor polygon has %u vertices, more than the renderer's %d",
-                    s.name, i, t.leaves[i].poly.n, SCN_MAX_LEAF_VERTS);
-            goto out;
-        }
     if (t.max_depth > SCN_MAX_DEPTH) {
         bs_fail(err, errlen, "%s: BSP tree %u nodes deep, deeper than %d (try --split balanced)",
                 s.name, t.max_depth, SCN_MAX_DEPTH);

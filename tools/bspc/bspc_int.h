@@ -5,7 +5,7 @@
  * scene_check.c validates it and finds the player's sector; bsp_build.c builds
  * the tree (split choice, exact seg splitting, leaf regions); leaf_poly.c owns
  * the convex-polygon clipping; tjunc.c removes T-junctions from segs and leaf
- * polygons; blob_write.c writes firmware/scene_format.h.
+ * polygons; leaf_split.c cuts floor polygons too big for the renderer; blob_write.c writes firmware/scene_format.h.
  *
  * Numbers: every coordinate is 16.16 (one raw unit = 1/65536 map unit) held in
  * an int32_t. Side tests and intersections use exact integer arithmetic
@@ -350,6 +350,10 @@ void bs_poly_tidy(bs_poly *p);
 /* tjunc.c */
 int bs_tjunc_segs(bs_tree *t, const char *name, char *err, size_t errlen);
 int bs_tjunc_polys(bs_tree *t, char *err, size_t errlen);
+
+/* leaf_split.c: cut every leaf whose floor polygon has more than
+ * SCN_MAX_LEAF_VERTS corners into convex pieces (new nodes on chords). */
+int bs_split_big_leaves(bs_tree *t, const char *name, char *err, size_t errlen);
 
 /* blob_write.c */
 int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *len, char *err,
