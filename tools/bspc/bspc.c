@@ -142,6 +142,7 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
 
     if (bs_check_ranges(&s, err, errlen)) goto out;
     if (s.is_text && bs_check_closed(&s, err, errlen)) goto out;
+    if (bs_check_crossings(&s, err, errlen)) goto out;
     s.player_sector = bs_player_sector(&s);
     if (s.player_sector == SCN_NONE && s.is_text) {
         char b1[32], b2[32];
