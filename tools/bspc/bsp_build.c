@@ -432,12 +432,20 @@ out:
     return rc;
 }
 
+uint64_t bs_seg_budget(const bs_tree *t)
+{
+    uint64_t log2 = 0;
+    while (log2 < 32 && ((uint64_t)1 << log2) < t->nsides) log2++;
+    return (uint64_t)t->nsides * (log2 + 2) + 4096u;
+}
+
 int bs_seg_budget_check(const bs_tree *t, const char *name, uint32_t more, uint32_t line, char *err, size_t errlen)
 {
-    uint64_t budget = BS_SEG_BUDGET(t);
+    uint64_t budget = bs_seg_budget(t);
     if ((uint64_t)t->nsegs + more <= budget) return 0;
     return bs_fail(err, errlen,
-                   "%s: linedef %u: the walls are cut into more than %llu pieces (2 per wall side + 4,096): "
-                   "walls that cross each other?",
-                   name, line, (unsigned long long)budget);
+                   "%s: linedef %u: the tree cuts the %u wall sides into more than %llu pieces, the "
+                   "compiler's budget (sides x (log2 sides + 2) + 4,096, above what maps whose walls "
+                   "do not cross need)",
+                   name, line, t->nsides, (unsigned long long)budget);
 }

@@ -178,6 +178,7 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
 
     if (bs_check_ranges(&s, err, errlen)) goto out;
     if (s.is_text && bs_check_closed(&s, err, errlen)) goto out;
+    if (bs_check_crossings(&s, err, errlen)) goto out;
     s.player_sector = bs_player_sector(&s);
     if (s.player_sector == SCN_NONE && s.is_text) {
         char b1[32], b2[32];
@@ -202,6 +203,8 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
     if (bs_tjunc_segs(&t, s.name, err, errlen) || bs_tjunc_polys(&t, err, errlen)) goto out;
     double t_tj = bs_now_ms();
 
+    if (bs_split_big_leaves(&t, s.name, err, errlen)) goto out;
+
     uint64_t dsum = 0;
     t.max_depth = 0;
     for (uint32_t i = 0; i < t.nleaves; i++) {
@@ -209,12 +212,6 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
         if (t.leaves[i].depth > t.max_depth) t.max_depth = t.leaves[i].depth;
     }
     t.mean_depth = t.nleaves ? (double)dsum / t.nleaves : 0.0;
-    for (uint32_t i = 0; i < t.nleaves; i++)
-        if (t.leaves[i].poly.n > SCN_MAX_LEAF_VERTS) {
-            bs_fail(err, errlen, "%s: leaf %u: floor polygon has %u vertices, more than the renderer's %d",
-                    s.name, i, t.leaves[i].poly.n, SCN_MAX_LEAF_VERTS);
-            goto out;
-        }
     if (t.max_depth > SCN_MAX_DEPTH) {
         bs_fail(err, errlen, "%s: BSP tree %u nodes deep, deeper than %d (try --split balanced)",
                 s.name, t.max_depth, SCN_MAX_DEPTH);

@@ -5,7 +5,7 @@
  * scene_check.c validates it and finds the player's sector; bsp_build.c builds
  * the tree (split choice, exact seg splitting, leaf regions); leaf_poly.c owns
  * the convex-polygon clipping; tjunc.c removes T-junctions from segs and leaf
- * polygons; blob_write.c writes firmware/scene_format.h.
+ * polygons; leaf_split.c cuts floor polygons too big for the renderer; blob_write.c writes firmware/scene_format.h.
  *
  * Numbers: every coordinate is 16.16 (one raw unit = 1/65536 map unit) held in
  * an int32_t. Side tests and intersections use exact integer arithmetic
@@ -199,6 +199,8 @@ uint8_t bs_scene_shade(const bs_scene *s, uint8_t c, int delta);
 int bs_check_ranges(const bs_scene *s, char *err, size_t errlen);
 int bs_check_closed(const bs_scene *s, char *err, size_t errlen);
 uint32_t bs_player_sector(const bs_scene *s);
+/* crossings.c: refuse two walls whose insides cross, naming both and the point. */
+int bs_check_crossings(const bs_scene *s, char *err, size_t errlen);
 /* The sector containing (x, y) by the same winding-number rule, or SCN_NONE. */
 uint32_t bs_point_sector(const bs_scene *s, int32_t x, int32_t y);
 
@@ -305,12 +307,16 @@ typedef struct {
     int32_t world[4];     /* xmin, ymin, xmax, ymax of the world box (16.16) */
 } bs_tree;
 
-/* Wall pieces a compile may make. Real maps split about a tenth of their wall
- * sides (of the 68 Freedoom maps, at most 12% more pieces than sides); walls that
- * cross each other everywhere, as in a damaged map, split quadratically, and the
- * T-junction passes then cost pieces x points: such a compile is refused here
- * instead of running for minutes toward a polygon the renderer could not take. */
-#define BS_SEG_BUDGET(t) (2u * (uint64_t)(t)->nsides + 4096u)
+/* Wall pieces a compile may make. Walls that do not cross (crossings.c refuses
+ * the others) need O(n log n) pieces for n wall sides (Paterson and Yao's bound
+ * for autopartitions): nested rooms, where every partition cuts the rooms
+ * around it, need the log factor (150 concentric squares, 1,196 sides: 7,104
+ * pieces); the 68 Freedoom maps make at most 12% more pieces than sides. The
+ * budget is sides x (log2 sides + 2) + 4,096. A damaged WAD whose walls cross
+ * everywhere splits quadratically, and the T-junction passes then cost pieces x
+ * points: such a compile is refused at the budget instead of running for
+ * minutes toward a polygon the renderer could not take. */
+uint64_t bs_seg_budget(const bs_tree *t);
 int bs_seg_budget_check(const bs_tree *t, const char *name, uint32_t more, uint32_t line, char *err, size_t errlen);
 
 /* Vertex table: index of (x, y), adding it if new; SCN_NONE on allocation failure. */
@@ -350,6 +356,10 @@ void bs_poly_tidy(bs_poly *p);
 /* tjunc.c */
 int bs_tjunc_segs(bs_tree *t, const char *name, char *err, size_t errlen);
 int bs_tjunc_polys(bs_tree *t, char *err, size_t errlen);
+
+/* leaf_split.c: cut every leaf whose floor polygon has more than
+ * SCN_MAX_LEAF_VERTS corners into convex pieces (new nodes on chords). */
+int bs_split_big_leaves(bs_tree *t, const char *name, char *err, size_t errlen);
 
 /* blob_write.c */
 int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *len, char *err,
