@@ -88,6 +88,7 @@ static uint32_t wall_parts(const scene *s, const scn_seg *g)
 /* A seg's line in map units: from (ax, ay) along (dx, dy) of length len. */
 typedef struct {
     double ax, ay, dx, dy, len;
+    double nx, ny, c; /* in front by about nx * x + ny * y + c (unit normal): for decide */
 } seg_line;
 
 static seg_line line_of(const scene *s, const scn_seg *g)
@@ -96,6 +97,9 @@ static seg_line line_of(const scene *s, const scn_seg *g)
     seg_line l;
     l.ax = unit(a->x), l.ay = unit(a->y), l.dx = unit(b->x) - l.ax, l.dy = unit(b->y) - l.ay;
     l.len = sqrt(l.dx * l.dx + l.dy * l.dy);
+    l.nx = l.len > 0 ? l.dy / l.len : 0;
+    l.ny = l.len > 0 ? -l.dx / l.len : 0;
+    l.c = -(l.nx * l.ax + l.ny * l.ay);
     return l;
 }
 
@@ -120,15 +124,14 @@ enum { SEG_BEHIND, SEG_UNDECIDED, SEG_FACING };
 
 static int decide(const seg_line *l, const region *r)
 {
-    double lo = INFINITY, hi = -INFINITY;
+    int behind = 0, front = 0;
     for (int i = 0; i < r->n; i++) {
-        double f = in_front(l, r, i);
-        if (f < lo) lo = f;
-        if (f > hi) hi = f;
+        double f = l->nx * r->x[i] + l->ny * r->y[i] + l->c;
+        if (f >= -SLACK - DECIDE_EPS) front = 1; /* not wholly behind */
+        if (f <= -SLACK + DECIDE_EPS) behind = 1; /* not wholly in front */
+        if (front && behind) return SEG_UNDECIDED;
     }
-    if (hi < -SLACK - DECIDE_EPS) return SEG_BEHIND;
-    if (lo > -SLACK + DECIDE_EPS) return SEG_FACING;
-    return SEG_UNDECIDED;
+    return front ? SEG_FACING : SEG_BEHIND;
 }
 
 typedef struct {
@@ -143,15 +146,24 @@ typedef struct {
  * parent (list[from .. from+count)) and the parts of those already facing. */
 typedef struct {
     uint32_t node, from, count;
-    uint32_t edges, surfs;
+    uint32_t edges, surfs;   /* of the segs facing the whole region */
+    uint64_t more_e, more_s; /* of the undecided ones: what a leaf below can add at most */
 } walk_item;
+
+/* Can a leaf below beat the most found so far? (If not, the subtree is skipped:
+ * the leaves are met in the same order, so the result and worst_leaf stay.) */
+static int may_beat(const walls_ctx *c, const walk_item *it)
+{
+    return it->edges + it->more_e > c->rep->wall_edges || it->surfs + it->more_s > c->rep->wall_surfaces;
+}
 
 static void leaf_walls(walls_ctx *c, uint32_t leaf, const region *r, const walk_item *it)
 {
     uint32_t edges = it->edges, surfs = it->surfs;
     for (uint32_t k = 0; k < it->count; k++) {
         uint32_t g = c->list[it->from + k];
-        if (!may_face(&c->lines[g], r)) continue;
+        int d = decide(&c->lines[g], r);
+        if (d == SEG_BEHIND || (d == SEG_UNDECIDED && !may_face(&c->lines[g], r))) continue;
         edges += c->parts[g] * WALL_EDGES;
         surfs += c->parts[g];
     }
@@ -167,7 +179,7 @@ static void leaf_walls(walls_ctx *c, uint32_t leaf, const region *r, const walk_
  * list[*top ..] for its children. */
 static walk_item narrow(walls_ctx *c, const walk_item *it, const region *r, uint32_t *top)
 {
-    walk_item out = {it->node, *top, 0, it->edges, it->surfs};
+    walk_item out = {it->node, *top, 0, it->edges, it->surfs, 0, 0};
     for (uint32_t k = 0; k < it->count; k++) {
         uint32_t g = c->list[it->from + k];
         int d = decide(&c->lines[g], r);
@@ -176,6 +188,8 @@ static walk_item narrow(walls_ctx *c, const walk_item *it, const region *r, uint
             out.surfs += c->parts[g];
         } else if (d == SEG_UNDECIDED) {
             c->list[*top + out.count++] = g;
+            out.more_e += c->parts[g] * WALL_EDGES;
+            out.more_s += c->parts[g];
         }
     }
     *top += out.count;
@@ -201,7 +215,7 @@ static int walk_regions(walls_ctx *c)
         return -1;
     }
     /* the root's list: every seg with parts (a zero-length seg always counts) */
-    walk_item root = {s->root, 0, 0, 0, 0};
+    walk_item root = {s->root, 0, 0, 0, 0, 0, 0};
     for (uint32_t g = 0; g < s->nsegs; g++) {
         if (!c->parts[g]) continue;
         if (c->lines[g].len == 0) {
@@ -209,6 +223,8 @@ static int walk_regions(walls_ctx *c)
             root.surfs += c->parts[g];
         } else {
             c->list[root.count++] = g;
+            root.more_e += c->parts[g] * WALL_EDGES;
+            root.more_s += c->parts[g];
         }
     }
     int sp = 0;
@@ -223,12 +239,14 @@ static int walk_regions(walls_ctx *c)
         sp--;
         walk_item it = stack[sp];
         uint32_t n = it.node, top = it.from + it.count; /* blocks above belong to finished subtrees */
+        if (!may_beat(c, &it)) continue;
         copy_region(here, &regions[sp]);
         if (n & SCN_LEAF_BIT) {
             if (here->n >= 3) leaf_walls(c, n & ~SCN_LEAF_BIT, here, &it);
             continue;
         }
         walk_item mine = narrow(c, &it, here, &top);
+        if (!may_beat(c, &mine)) continue;
         const scn_node *nd = &s->nodes[n];
         double px = unit(nd->x), py = unit(nd->y), dx = unit(nd->dx), dy = unit(nd->dy);
         for (int side = 0; side < 2; side++) {
