@@ -43,6 +43,8 @@ struct bs_wadlook {
     uint32_t nlines_cap; /* sides has room for 2 * nlines_cap */
     const char *sky_name;
     uint8_t neutral; /* palette index of a mid grey, for parts without a texture */
+    uint32_t *flats; /* the lumps between flat markers, in directory order (found once) */
+    uint32_t nflats; /* valid once flats is set */
 };
 
 static uint16_t rd16(const uint8_t *p) { return (uint16_t)(p[0] | (p[1] << 8)); }
@@ -135,14 +137,14 @@ static int store(bs_wadlook *L, const char *name, const uint8_t *pic, uint32_t w
         bs_grow(&L->mean, &L->mcap, lk->ntex + 1, sizeof *L->mean))
         return bs_fail(err, errlen, "%s: out of memory", L->wad);
     uint8_t *t = lk->texels + lk->ntexels;
-    double sum[3] = {0, 0, 0};
-    for (uint32_t u = 0; u < cols; u++)
-        for (uint32_t v = 0; v < rows; v++) {
-            uint8_t c = pic[u * h + v % h];
-            t[(u << hb) + v] = c;
-            if (v < h)
-                for (int k = 0; k < 3; k++) sum[k] += lk->palette[3 * c + k];
-        }
+    uint64_t sum[3] = {0, 0, 0}; /* exact, as the double sums they replace were */
+    for (uint32_t u = 0; u < cols; u++) {
+        const uint8_t *col = pic + u * h;
+        uint8_t *dst = t + (u << hb);
+        for (uint32_t v = 0; v < h; v++)
+            for (int k = 0; k < 3; k++) sum[k] += lk->palette[3 * col[v] + k];
+        for (uint32_t v = 0; v < rows; v += h) memcpy(dst + v, col, rows - v < h ? rows - v : h);
+    }
     scn_texture *x = &lk->tex[lk->ntex];
     x->first = lk->ntexels;
     x->wbits = (uint8_t)wb;
@@ -150,7 +152,7 @@ static int store(bs_wadlook *L, const char *name, const uint8_t *pic, uint32_t w
     x->reserved = 0;
     x->height = (uint16_t)h;
     x->reserved2 = 0;
-    for (int k = 0; k < 3; k++) L->mean[lk->ntex][k] = sum[k] / ((double)cols * h);
+    for (int k = 0; k < 3; k++) L->mean[lk->ntex][k] = (double)sum[k] / ((double)cols * h);
     x->colour = nearest(lk->palette, L->mean[lk->ntex][0], L->mean[lk->ntex][1], L->mean[lk->ntex][2]);
     lk->ntexels += n;
     *out = (uint16_t)lk->ntex++;
@@ -284,22 +286,33 @@ static int compose_wall(bs_wadlook *L, const char *name, uint16_t *out, char *er
 static int is_flat_start(const char *n) { return strcmp(n, "F_START") == 0 || strcmp(n, "FF_START") == 0; }
 static int is_flat_end(const char *n) { return strcmp(n, "F_END") == 0 || strcmp(n, "FF_END") == 0; }
 
-/* the last flat of that name between F_START/F_END or FF_START/FF_END, or ndir */
-static uint32_t find_flat(const bs_wadlook *L, const char *name)
+/* the lumps between F_START/F_END or FF_START/FF_END, listed on the first call */
+static int list_flats(bs_wadlook *L)
 {
-    uint32_t found = L->ndir;
+    if (L->flats) return 0;
+    L->flats = malloc(sizeof *L->flats * (L->ndir + 1));
+    if (!L->flats) return -1;
     int in = 0;
     for (uint32_t i = 0; i < L->ndir; i++) {
         const char *n = L->dir[i].name;
         if (is_flat_start(n)) in = 1;
         else if (is_flat_end(n)) in = 0;
-        else if (in && strcmp(n, name) == 0) found = i;
+        else if (in) L->flats[L->nflats++] = i;
     }
-    return found;
+    return 0;
+}
+
+/* the last flat of that name between the markers, or ndir */
+static uint32_t find_flat(const bs_wadlook *L, const char *name)
+{
+    for (uint32_t k = L->nflats; k-- > 0;)
+        if (strcmp(L->dir[L->flats[k]].name, name) == 0) return L->flats[k];
+    return L->ndir;
 }
 
 static int compose_flat(bs_wadlook *L, const char *name, uint16_t *out, char *err, size_t errlen)
 {
+    if (list_flats(L)) return bs_fail(err, errlen, "%s: out of memory", L->wad);
     uint32_t li = find_flat(L, name);
     if (li == L->ndir) {
         *out = SCN_TEX_NONE;
@@ -549,5 +562,6 @@ void bs_look_close(bs_wadlook *L)
     free(L->tdef[1]);
     free(L->used);
     free(L->mean);
+    free(L->flats);
     free(L);
 }
