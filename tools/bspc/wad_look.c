@@ -137,14 +137,16 @@ static int store(bs_wadlook *L, const char *name, const uint8_t *pic, uint32_t w
         bs_grow(&L->mean, &L->mcap, lk->ntex + 1, sizeof *L->mean))
         return bs_fail(err, errlen, "%s: out of memory", L->wad);
     uint8_t *t = lk->texels + lk->ntexels;
-    uint64_t sum[3] = {0, 0, 0}; /* exact, as the double sums they replace were */
+    uint32_t hist[256] = {0};
     for (uint32_t u = 0; u < cols; u++) {
         const uint8_t *col = pic + u * h;
         uint8_t *dst = t + (u << hb);
-        for (uint32_t v = 0; v < h; v++)
-            for (int k = 0; k < 3; k++) sum[k] += lk->palette[3 * col[v] + k];
+        for (uint32_t v = 0; v < h; v++) hist[col[v]]++;
         for (uint32_t v = 0; v < rows; v += h) memcpy(dst + v, col, rows - v < h ? rows - v : h);
     }
+    uint64_t sum[3] = {0, 0, 0}; /* exact, as the double sums they replace were */
+    for (int c = 0; c < 256; c++)
+        for (int k = 0; k < 3; k++) sum[k] += (uint64_t)hist[c] * lk->palette[3 * c + k];
     scn_texture *x = &lk->tex[lk->ntex];
     x->first = lk->ntexels;
     x->wbits = (uint8_t)wb;
@@ -188,6 +190,13 @@ static int draw_patch(const bs_wadlook *L, const uint8_t *p, uint32_t size, cons
                 return bs_fail(err, errlen, "%s: patch %s: column %d: post of %u bytes at %u runs past the end "
                                "(%u bytes)", L->wad, what, c, len, at, size);
             const uint8_t *src = p + at + 3;
+            if (pic && !opaque && !sum) { /* a texture's patch: the rows of the post inside the picture */
+                int32_t y0 = oy + (int32_t)top, k0 = y0 < 0 ? -y0 : 0, k1 = (int32_t)len;
+                if (y0 + k1 > h) k1 = h - y0;
+                if (k0 < k1) memcpy(pic + x * h + y0 + k0, src + k0, (size_t)(k1 - k0));
+                at += len + 4;
+                continue;
+            }
             for (uint32_t k = 0; k < len; k++) {
                 int32_t y = oy + (int32_t)(top + k);
                 if (opaque) (*opaque)++;
