@@ -45,6 +45,8 @@ struct bs_wadlook {
     uint8_t neutral; /* palette index of a mid grey, for parts without a texture */
     uint32_t *flats; /* the lumps between flat markers, in directory order (found once) */
     uint32_t nflats; /* valid once flats is set */
+    uint32_t *sprites; /* the same for the sprite markers */
+    uint32_t nsprites;
 };
 
 static uint16_t rd16(const uint8_t *p) { return (uint16_t)(p[0] | (p[1] << 8)); }
@@ -526,17 +528,32 @@ int bs_look_side(bs_wadlook *L, uint32_t li, int k, const uint8_t rec[30], unsig
 static int is_sprite_start(const char *n) { return strcmp(n, "S_START") == 0 || strcmp(n, "SS_START") == 0; }
 static int is_sprite_end(const char *n) { return strcmp(n, "S_END") == 0 || strcmp(n, "SS_END") == 0; }
 
-uint8_t bs_look_thing_colour(bs_wadlook *L, const char prefix[4], uint8_t fallback)
+/* the lumps between S_START/S_END or SS_START/SS_END, listed on the first call */
+static int list_sprites(bs_wadlook *L)
 {
-    uint8_t def[768];
-    bs_palette(def);
-    uint8_t colour = nearest(L->lk->palette, def[3 * fallback], def[3 * fallback + 1], def[3 * fallback + 2]);
+    if (L->sprites) return 0;
+    L->sprites = malloc(sizeof *L->sprites * (L->ndir + 1));
+    if (!L->sprites) return -1;
     int in = 0;
     for (uint32_t i = 0; i < L->ndir; i++) {
         const char *n = L->dir[i].name;
         if (is_sprite_start(n)) in = 1;
         else if (is_sprite_end(n)) in = 0;
-        else if (in && strncmp(n, prefix, 4) == 0 && n[4] == 'A' && (n[5] == '0' || n[5] == '1')) {
+        else if (in) L->sprites[L->nsprites++] = i;
+    }
+    return 0;
+}
+
+uint8_t bs_look_thing_colour(bs_wadlook *L, const char prefix[4], uint8_t fallback)
+{
+    uint8_t def[768];
+    bs_palette(def);
+    uint8_t colour = nearest(L->lk->palette, def[3 * fallback], def[3 * fallback + 1], def[3 * fallback + 2]);
+    if (list_sprites(L)) return colour; /* out of memory: things.txt's colour */
+    for (uint32_t k = 0; k < L->nsprites; k++) {
+        uint32_t i = L->sprites[k];
+        const char *n = L->dir[i].name;
+        if (strncmp(n, prefix, 4) == 0 && n[4] == 'A' && (n[5] == '0' || n[5] == '1')) {
             uint8_t *p;
             char msg[300];
             uint64_t count = 0;
@@ -572,5 +589,6 @@ void bs_look_close(bs_wadlook *L)
     free(L->used);
     free(L->mean);
     free(L->flats);
+    free(L->sprites);
     free(L);
 }
