@@ -21,7 +21,15 @@ typedef struct {
     char name[9];
     int kind;
     uint16_t tex; /* SCN_TEX_NONE: unknown (warned once) */
+    uint32_t hash; /* of name: most entries are told apart by it alone */
 } used_name;
+
+static uint32_t name_hash(const char *t)
+{
+    uint32_t h = 2166136261u; /* FNV-1a */
+    while (*t) h = (h ^ (uint8_t)*t++) * 16777619u;
+    return h;
+}
 
 struct bs_wadlook {
     FILE *f;
@@ -344,8 +352,9 @@ static int texture(bs_wadlook *L, const char *name, int kind, uint16_t *out, cha
 {
     *out = SCN_TEX_NONE;
     if (!name[0] || strcmp(name, "-") == 0) return 0;
+    uint32_t h = name_hash(name);
     for (uint32_t i = 0; i < L->nused; i++)
-        if (L->used[i].kind == kind && strcmp(L->used[i].name, name) == 0) {
+        if (L->used[i].hash == h && L->used[i].kind == kind && strcmp(L->used[i].name, name) == 0) {
             *out = L->used[i].tex;
             return 0;
         }
@@ -355,6 +364,7 @@ static int texture(bs_wadlook *L, const char *name, int kind, uint16_t *out, cha
     if (bs_grow(&L->used, &L->ucap, L->nused + 1, sizeof *L->used)) return bs_fail(err, errlen, "%s: out of memory", L->wad);
     used_name *u = &L->used[L->nused++];
     snprintf(u->name, sizeof u->name, "%s", name);
+    u->hash = name_hash(u->name);
     u->kind = kind;
     u->tex = *out;
     return 0;
