@@ -24,7 +24,7 @@ FW_SRC    := $(sort $(wildcard firmware/*.c)) $(GEN)/fx_tables.c
 HAL_SRC   := hal/fb.c hal/perf.c
 NULL_SRC  := hal/ram_target.c hal/null/hal_null.c
 SDL_SRC   := hal/ram_target.c hal/sdl/hal_sdl.c
-BSPC_LIB  := $(filter-out tools/bspc/main.c,$(sort $(wildcard tools/bspc/*.c)))
+BSPC_LIB  := $(filter-out tools/bspc/main.c tools/bspc/crc_fast.c,$(sort $(wildcard tools/bspc/*.c)))
 # The host programs' shared files; the frame link's sender (host/link_send.c,
 # build/render and build/emu --link) brings the link's sources along.
 HOST_LIB   = host/png.c host/port.c host/link_send.c $(sort $(LINK_SRC))
@@ -55,7 +55,7 @@ $(1)/obj/$(GEN)/%.o: $(GEN)/%.c
 	@mkdir -p $$(@D)
 	$$(CC) $$(BASE) $(2) $$(FW_FLAGS) -c $$< -o $$@
 
-$(1)/bspc: $(call objs,$(1)/obj,tools/bspc/main.c $(BSPC_LIB) firmware/crc32.c firmware/scene.c)
+$(1)/bspc: $(call objs,$(1)/obj,tools/bspc/main.c $(BSPC_LIB) tools/bspc/crc_fast.c firmware/scene.c)
 	$$(CC) $(2) $$^ -o $$@ -lm
 $(1)/render: $(call objs,$(1)/obj,host/render.c $(HOST_ENG) $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC))
 	$$(CC) $(2) $$^ -o $$@ -lm

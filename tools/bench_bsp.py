@@ -5,7 +5,10 @@ Runs build/bspc --stats on every map of freedoom1.wad (E1M1..E4M9) and
 freedoom2.wad (MAP01..MAP32) with each split strategy, runs zdbsp and glbsp on
 the same WADs when they are installed, reads the nodes shipped inside the
 Freedoom WADs, and prints one table of totals: splits, leaves (subsectors),
-max depth and build time. The table goes to stdout and to build/bench-bsp.md.
+max depth and build time. A second table times bspc on three generated scenes
+that once took seconds (a grid of 3,600 sectors, a room with a 10,000-wall
+zigzag side, a convex 10,000-gon room). The tables go to stdout and to
+build/bench-bsp.md.
 
 For the other builders the figures come from the lumps they write:
 splits = SEGS - linedef sides, leaves = SSECTORS, depth from NODES.
@@ -13,7 +16,9 @@ Python 3 standard library only.
 """
 import argparse
 import json
+import math
 import os
+import resource
 import shutil
 import struct
 import subprocess
@@ -164,6 +169,102 @@ def run_external(cmd_for, wads, tmp, label):
     return built, wall
 
 
+# ---- generated scenes (text format, docs/scene-format.md) --------------------
+
+def grid_scene(n=60, cell=64):
+    """n x n square sectors of differing floors and ceilings, each wall between
+    two of them two-sided."""
+    out = [f"sector c{i}_{j} floor={((i * 7 + j * 3) % 5) * 8} ceil={128 + ((i + j) % 3) * 16}"
+           for j in range(n) for i in range(n)]
+    o = -n * cell // 2
+
+    def at(k):
+        return o + k * cell
+    for j in range(n):  # walls along x = at(i); the front (right) side is east going north
+        for i in range(n + 1):
+            x, y0, y1 = at(i), at(j), at(j + 1)
+            if i == 0:
+                out.append(f"wall {x} {y0} {x} {y1} c0_{j}")
+            elif i == n:
+                out.append(f"wall {x} {y1} {x} {y0} c{n - 1}_{j}")
+            else:
+                out.append(f"wall {x} {y0} {x} {y1} c{i}_{j} c{i - 1}_{j}")
+    for i in range(n):  # walls along y = at(j); the front side is north going west
+        for j in range(n + 1):
+            y, x0, x1 = at(j), at(i), at(i + 1)
+            if j == 0:
+                out.append(f"wall {x1} {y} {x0} {y} c{i}_0")
+            elif j == n:
+                out.append(f"wall {x0} {y} {x1} {y} c{i}_{n - 1}")
+            else:
+                out.append(f"wall {x1} {y} {x0} {y} c{i}_{j} c{i}_{j - 1}")
+    out.append(f"player {o + cell // 2} {o + cell // 2} 0")
+    return "\n".join(out) + "\n"
+
+
+def zigzag_scene(walls=10000, step=6, amp=16):
+    """One room whose south side is a zigzag of walls - 3 walls (teeth step
+    units wide, amp deep), closed by three straight walls."""
+    k = walls - 3
+    x0 = -k * step // 2
+    pts = [(x0 + i * step, 0 if i % 2 == 0 else amp) for i in range(k + 1)][::-1]
+    out = ["sector room floor=0 ceil=128"]
+    out += [f"wall {a[0]} {a[1]} {b[0]} {b[1]} room" for a, b in zip(pts, pts[1:])]
+    w, e, top = pts[-1][0], pts[0][0], 512
+    out += [f"wall {w} {pts[-1][1]} {w} {top} room", f"wall {w} {top} {e} {top} room",
+            f"wall {e} {top} {e} {pts[0][1]} room", "player 0 256 90"]
+    return "\n".join(out) + "\n"
+
+
+def ngon_scene(n=10000, r=30000):
+    """A convex room of n walls (a regular n-gon, vertices on 1/10000 units)."""
+    p = [(r * math.cos(-2 * math.pi * i / n), r * math.sin(-2 * math.pi * i / n)) for i in range(n)]
+    out = ["sector room floor=0 ceil=128"]
+    out += [f"wall {p[i][0]:.4f} {p[i][1]:.4f} {p[(i + 1) % n][0]:.4f} {p[(i + 1) % n][1]:.4f} room"
+            for i in range(n)]
+    out.append("player 0 0 0")
+    return "\n".join(out) + "\n"
+
+
+GENERATED = (("grid of 3,600 sectors", "grid.scene", grid_scene),
+             ("zigzag of 10,000 walls", "zigzag.scene", zigzag_scene),
+             ("convex 10,000-gon", "ngon.scene", ngon_scene))
+
+
+def children_cpu():
+    """user + system seconds of the finished child processes"""
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def run_generated(bspc, tmp):
+    """One row per generated scene: walls, outcome, figures, wall time."""
+    rows = []
+    for label, fname, make in GENERATED:
+        path = os.path.join(tmp, fname)
+        with open(path, "w") as f:
+            f.write(make())
+        c0, t0 = children_cpu(), time.perf_counter()
+        r = subprocess.run([bspc, path, "--stats", "-o", os.path.join(tmp, "gen.bsc")],
+                           capture_output=True, text=True)
+        times = (f"{time.perf_counter() - t0:.2f}", f"{children_cpu() - c0:.2f}")
+        if r.returncode == 0:
+            st = json.loads(r.stdout)
+            rows.append((label, st["input_walls"], "compiled", st["splits"], st["leaves"],
+                         st["max_depth"], *times))
+        else:
+            msg = r.stderr.strip().splitlines()[-1] if r.stderr.strip() else "failed"
+            rows.append((label, "-", "refused: " + msg.replace(path, fname), "-", "-", "-", *times))
+    return rows
+
+
+def table(head, rows):
+    lines = ["| " + " | ".join(head) + " |", "|" + "|".join("---" for _ in head) + "|"]
+    for r in rows:
+        lines.append("| " + " | ".join(f"{v:,}" if isinstance(v, int) else str(v) for v in r) + " |")
+    return lines
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--bspc", default="build/bspc")
@@ -208,6 +309,7 @@ def main():
         t = wad_totals(maps_by_wad, None)
         rows.append(("nodes shipped in Freedoom", t["maps"], t["splits"], "-", t["segs"],
                      t["leaves"], t["max_depth"], "-", "read from the WADs"))
+        gen_rows = run_generated(args.bspc, tmp)
 
     head = ("builder", "maps", "splits", "T-junction splits", "segs", "leaves", "max depth",
             "time (s)", "notes")
@@ -217,9 +319,12 @@ def main():
              "points made on one side of a two-sided line), counted apart; the others do not. "
              "time: wall clock, process start and WAD reading included (bspc: one process per "
              "map; zdbsp, glbsp: one per WAD).", "",
-             "| " + " | ".join(head) + " |", "|" + "|".join("---" for _ in head) + "|"]
-    for r in rows:
-        lines.append("| " + " | ".join(f"{v:,}" if isinstance(v, int) else str(v) for v in r) + " |")
+             *table(head, rows), "", "## Generated scenes", "",
+             "bspc (default strategy, one process each) on scenes made by tools/bench_bsp.py. "
+             "time: wall clock; cpu: user + system time of the bspc process.", "",
+             *table(("scene", "walls", "outcome", "splits", "leaves", "max depth", "time (s)",
+                     "cpu (s)"),
+                    gen_rows)]
     text = "\n".join(lines) + "\n"
     sys.stdout.write(text)
     os.makedirs(os.path.dirname(args.out) or ".", exist_ok=True)

@@ -79,7 +79,16 @@ typedef struct {
     const bspc_options *opt;
     bs_chooser *chooser;
     uint32_t warned;
+    uint32_t *count; /* per sector, and one for SCN_NONE: make_leaf's tally */
 } builder;
+
+/* the sector a seg faces, as an index into count[] (the last entry: none) */
+static uint32_t seg_sector(const builder *B, uint32_t seg)
+{
+    const bs_seg *g = &B->t->segs[seg];
+    uint32_t sec = B->s->lines[g->line].sector[g->side];
+    return sec < B->s->nsectors ? sec : B->s->nsectors;
+}
 
 static int push_seg(work *w, uint32_t seg)
 {
@@ -167,25 +176,19 @@ static int make_leaf(builder *B, work *w, char *err, size_t errlen)
     else
         t->nodes[w->parent].child[w->which] = SCN_LEAF_BIT | li;
 
-    /* sector: the most common one among the segs' facing sides */
+    /* sector: the most common one among the segs' facing sides (the first seg's
+     * on a tie), counted per sector in B->count, which is all zero between leaves */
     uint32_t best = SCN_NONE, bestn = 0, distinct = 0;
+    for (uint32_t i = 0; i < L->nsegs; i++) distinct += B->count[seg_sector(B, L->segs[i])]++ == 0;
     for (uint32_t i = 0; i < L->nsegs; i++) {
         const bs_seg *g = &t->segs[L->segs[i]];
-        uint32_t sec = B->s->lines[g->line].sector[g->side];
-        uint32_t cnt = 0, seen_before = 0;
-        for (uint32_t j = 0; j < L->nsegs; j++) {
-            const bs_seg *h = &t->segs[L->segs[j]];
-            if (B->s->lines[h->line].sector[h->side] == sec) {
-                cnt++;
-                if (j < i) seen_before = 1;
-            }
-        }
-        if (!seen_before) distinct++;
-        if (cnt > bestn) {
-            bestn = cnt;
-            best = sec;
+        uint32_t c = B->count[seg_sector(B, L->segs[i])];
+        if (c > bestn) {
+            bestn = c;
+            best = B->s->lines[g->line].sector[g->side];
         }
     }
+    for (uint32_t i = 0; i < L->nsegs; i++) B->count[seg_sector(B, L->segs[i])] = 0;
     L->sector = best;
     if (distinct > 1) {
         if (B->warned < 10)
@@ -310,11 +313,12 @@ int bs_build(const bs_scene *s, const bspc_options *opt, bs_tree *t, char *err, 
     B.s = s;
     B.opt = opt;
     B.chooser = bs_chooser_new(t, opt ? opt->split : BSPC_SPLIT_MIXED);
+    B.count = calloc((size_t)s->nsectors + 1, sizeof *B.count);
 
     uint32_t scap = 0, sn = 0;
     work *stack = NULL;
     int rc = -1;
-    if (!B.chooser || bs_grow(&stack, &scap, 64, sizeof(work))) {
+    if (!B.chooser || !B.count || bs_grow(&stack, &scap, 64, sizeof(work))) {
         bs_fail(err, errlen, "%s: out of memory", s->name);
         goto out;
     }
@@ -429,6 +433,7 @@ out:
     }
     free(stack);
     bs_chooser_free(B.chooser);
+    free(B.count);
     return rc;
 }
 

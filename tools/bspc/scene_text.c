@@ -34,6 +34,8 @@ typedef struct {
     bs_scene *s;
     uint32_t *vhash; /* vertex index + 1 */
     uint32_t hcap;
+    uint32_t *shash; /* sector index + 1 by name: the first sector of each name */
+    uint32_t scap, shashed; /* its size (a power of two); sectors entered so far */
     int in_model;    /* between 'model' and 'end' */
     const char *stmt; /* the statement being read, for messages of helpers shared by several */
 } parser;
@@ -89,6 +91,48 @@ static int valid_name(const char *t)
     return strlen(t) < 32;
 }
 
+static uint32_t hash_name(const char *t)
+{
+    uint32_t h = 2166136261u; /* FNV-1a */
+    while (*t) h = (h ^ (uint8_t)*t++) * 16777619u;
+    return h;
+}
+
+/* Enter the sectors declared since the last call into p->shash (a name already
+ * there keeps its first sector), growing it to at least twice their number. */
+static int sector_index(parser *p)
+{
+    const bs_scene *s = p->s;
+    if ((uint64_t)s->nsectors * 2 + 2 > p->scap) {
+        uint32_t cap = p->scap ? p->scap : 64;
+        while ((uint64_t)s->nsectors * 2 + 2 > cap) cap *= 2;
+        uint32_t *h = calloc(cap, sizeof *h);
+        if (!h) return -1;
+        free(p->shash);
+        p->shash = h;
+        p->scap = cap;
+        p->shashed = 0;
+    }
+    for (; p->shashed < s->nsectors; p->shashed++) {
+        const char *name = s->sectors[p->shashed].name;
+        uint32_t h = hash_name(name) & (p->scap - 1);
+        while (p->shash[h] && strcmp(s->sectors[p->shash[h] - 1].name, name) != 0) h = (h + 1) & (p->scap - 1);
+        if (!p->shash[h]) p->shash[h] = p->shashed + 1;
+    }
+    return 0;
+}
+
+/* The first sector named t among those entered (1), or 0. */
+static int named_sector(const parser *p, const char *t, uint32_t *out)
+{
+    for (uint32_t h = hash_name(t) & (p->scap - 1); p->shash[h]; h = (h + 1) & (p->scap - 1))
+        if (strcmp(p->s->sectors[p->shash[h] - 1].name, t) == 0) {
+            *out = p->shash[h] - 1;
+            return 1;
+        }
+    return 0;
+}
+
 static int find_sector(parser *p, const char *t, uint32_t *out)
 {
     bs_scene *s = p->s;
@@ -101,11 +145,8 @@ static int find_sector(parser *p, const char *t, uint32_t *out)
         return perr(p, "wall: unknown sector %s (%u sector(s) declared above this line)", t,
                     s->nsectors);
     }
-    for (uint32_t i = 0; i < s->nsectors; i++)
-        if (strcmp(s->sectors[i].name, t) == 0) {
-            *out = i;
-            return 0;
-        }
+    if (sector_index(p)) return perr(p, "out of memory");
+    if (named_sector(p, t, out)) return 0;
     return perr(p, "wall: unknown sector '%s' (sectors must be declared before the walls that use them)",
                 t);
 }
@@ -184,10 +225,11 @@ static int do_sector(parser *p, char **tok, int n)
         if (!valid_name(tok[i]))
             return perr(p, "sector: bad name '%s' (a letter or '_' first, then letters, digits, "
                            "'_', '-', '.'; up to 31 characters)", tok[i]);
-        for (uint32_t k = 0; k < s->nsectors; k++)
-            if (strcmp(s->sectors[k].name, tok[i]) == 0)
-                return perr(p, "sector: name '%s' already used by sector %u (line %d)", tok[i], k,
-                            s->sectors[k].src_line);
+        uint32_t k;
+        if (sector_index(p)) return perr(p, "out of memory");
+        if (named_sector(p, tok[i], &k))
+            return perr(p, "sector: name '%s' already used by sector %u (line %d)", tok[i], k,
+                        s->sectors[k].src_line);
         strcpy(sec.name, tok[i]);
         i++;
     }
@@ -662,7 +704,7 @@ int bs_read_text(const char *path, bs_scene *s, const bspc_options *opt, char *e
     snprintf(s->name, sizeof s->name, "%s", path);
     s->is_text = 1;
     s->player_sector = SCN_NONE;
-    parser p = {path, 0, err, errlen, s, NULL, 0, 0, ""};
+    parser p = {path, 0, err, errlen, s, NULL, 0, NULL, 0, 0, 0, ""};
     int rc = 0;
     char *line = buf;
     if (!strncmp(line, "\xef\xbb\xbf", 3)) line += 3; /* a UTF-8 byte-order mark, as some editors write */
@@ -730,6 +772,7 @@ int bs_read_text(const char *path, bs_scene *s, const bspc_options *opt, char *e
     }
     free(buf);
     free(p.vhash);
+    free(p.shash);
     if (rc) return rc;
     if (p.in_model)
         return bs_fail(err, errlen, "%s:%d: model '%s': 'end' missing", path, cur_model(&p)->src_line,

@@ -21,7 +21,15 @@ typedef struct {
     char name[9];
     int kind;
     uint16_t tex; /* SCN_TEX_NONE: unknown (warned once) */
+    uint32_t hash; /* of name: most entries are told apart by it alone */
 } used_name;
+
+static uint32_t name_hash(const char *t)
+{
+    uint32_t h = 2166136261u; /* FNV-1a */
+    while (*t) h = (h ^ (uint8_t)*t++) * 16777619u;
+    return h;
+}
 
 struct bs_wadlook {
     FILE *f;
@@ -43,6 +51,10 @@ struct bs_wadlook {
     uint32_t nlines_cap; /* sides has room for 2 * nlines_cap */
     const char *sky_name;
     uint8_t neutral; /* palette index of a mid grey, for parts without a texture */
+    uint32_t *flats; /* the lumps between flat markers, in directory order (found once) */
+    uint32_t nflats; /* valid once flats is set */
+    uint32_t *sprites; /* the same for the sprite markers */
+    uint32_t nsprites;
 };
 
 static uint16_t rd16(const uint8_t *p) { return (uint16_t)(p[0] | (p[1] << 8)); }
@@ -135,14 +147,16 @@ static int store(bs_wadlook *L, const char *name, const uint8_t *pic, uint32_t w
         bs_grow(&L->mean, &L->mcap, lk->ntex + 1, sizeof *L->mean))
         return bs_fail(err, errlen, "%s: out of memory", L->wad);
     uint8_t *t = lk->texels + lk->ntexels;
-    double sum[3] = {0, 0, 0};
-    for (uint32_t u = 0; u < cols; u++)
-        for (uint32_t v = 0; v < rows; v++) {
-            uint8_t c = pic[u * h + v % h];
-            t[(u << hb) + v] = c;
-            if (v < h)
-                for (int k = 0; k < 3; k++) sum[k] += lk->palette[3 * c + k];
-        }
+    uint32_t hist[256] = {0};
+    for (uint32_t u = 0; u < cols; u++) {
+        const uint8_t *col = pic + u * h;
+        uint8_t *dst = t + (u << hb);
+        for (uint32_t v = 0; v < h; v++) hist[col[v]]++;
+        for (uint32_t v = 0; v < rows; v += h) memcpy(dst + v, col, rows - v < h ? rows - v : h);
+    }
+    uint64_t sum[3] = {0, 0, 0}; /* exact, as the double sums they replace were */
+    for (int c = 0; c < 256; c++)
+        for (int k = 0; k < 3; k++) sum[k] += (uint64_t)hist[c] * lk->palette[3 * c + k];
     scn_texture *x = &lk->tex[lk->ntex];
     x->first = lk->ntexels;
     x->wbits = (uint8_t)wb;
@@ -150,7 +164,7 @@ static int store(bs_wadlook *L, const char *name, const uint8_t *pic, uint32_t w
     x->reserved = 0;
     x->height = (uint16_t)h;
     x->reserved2 = 0;
-    for (int k = 0; k < 3; k++) L->mean[lk->ntex][k] = sum[k] / ((double)cols * h);
+    for (int k = 0; k < 3; k++) L->mean[lk->ntex][k] = (double)sum[k] / ((double)cols * h);
     x->colour = nearest(lk->palette, L->mean[lk->ntex][0], L->mean[lk->ntex][1], L->mean[lk->ntex][2]);
     lk->ntexels += n;
     *out = (uint16_t)lk->ntex++;
@@ -186,6 +200,13 @@ static int draw_patch(const bs_wadlook *L, const uint8_t *p, uint32_t size, cons
                 return bs_fail(err, errlen, "%s: patch %s: column %d: post of %u bytes at %u runs past the end "
                                "(%u bytes)", L->wad, what, c, len, at, size);
             const uint8_t *src = p + at + 3;
+            if (pic && !opaque && !sum) { /* a texture's patch: the rows of the post inside the picture */
+                int32_t y0 = oy + (int32_t)top, k0 = y0 < 0 ? -y0 : 0, k1 = (int32_t)len;
+                if (y0 + k1 > h) k1 = h - y0;
+                if (k0 < k1) memcpy(pic + x * h + y0 + k0, src + k0, (size_t)(k1 - k0));
+                at += len + 4;
+                continue;
+            }
             for (uint32_t k = 0; k < len; k++) {
                 int32_t y = oy + (int32_t)(top + k);
                 if (opaque) (*opaque)++;
@@ -284,22 +305,33 @@ static int compose_wall(bs_wadlook *L, const char *name, uint16_t *out, char *er
 static int is_flat_start(const char *n) { return strcmp(n, "F_START") == 0 || strcmp(n, "FF_START") == 0; }
 static int is_flat_end(const char *n) { return strcmp(n, "F_END") == 0 || strcmp(n, "FF_END") == 0; }
 
-/* the last flat of that name between F_START/F_END or FF_START/FF_END, or ndir */
-static uint32_t find_flat(const bs_wadlook *L, const char *name)
+/* the lumps between F_START/F_END or FF_START/FF_END, listed on the first call */
+static int list_flats(bs_wadlook *L)
 {
-    uint32_t found = L->ndir;
+    if (L->flats) return 0;
+    L->flats = malloc(sizeof *L->flats * (L->ndir + 1));
+    if (!L->flats) return -1;
     int in = 0;
     for (uint32_t i = 0; i < L->ndir; i++) {
         const char *n = L->dir[i].name;
         if (is_flat_start(n)) in = 1;
         else if (is_flat_end(n)) in = 0;
-        else if (in && strcmp(n, name) == 0) found = i;
+        else if (in) L->flats[L->nflats++] = i;
     }
-    return found;
+    return 0;
+}
+
+/* the last flat of that name between the markers, or ndir */
+static uint32_t find_flat(const bs_wadlook *L, const char *name)
+{
+    for (uint32_t k = L->nflats; k-- > 0;)
+        if (strcmp(L->dir[L->flats[k]].name, name) == 0) return L->flats[k];
+    return L->ndir;
 }
 
 static int compose_flat(bs_wadlook *L, const char *name, uint16_t *out, char *err, size_t errlen)
 {
+    if (list_flats(L)) return bs_fail(err, errlen, "%s: out of memory", L->wad);
     uint32_t li = find_flat(L, name);
     if (li == L->ndir) {
         *out = SCN_TEX_NONE;
@@ -320,8 +352,9 @@ static int texture(bs_wadlook *L, const char *name, int kind, uint16_t *out, cha
 {
     *out = SCN_TEX_NONE;
     if (!name[0] || strcmp(name, "-") == 0) return 0;
+    uint32_t h = name_hash(name);
     for (uint32_t i = 0; i < L->nused; i++)
-        if (L->used[i].kind == kind && strcmp(L->used[i].name, name) == 0) {
+        if (L->used[i].hash == h && L->used[i].kind == kind && strcmp(L->used[i].name, name) == 0) {
             *out = L->used[i].tex;
             return 0;
         }
@@ -331,6 +364,7 @@ static int texture(bs_wadlook *L, const char *name, int kind, uint16_t *out, cha
     if (bs_grow(&L->used, &L->ucap, L->nused + 1, sizeof *L->used)) return bs_fail(err, errlen, "%s: out of memory", L->wad);
     used_name *u = &L->used[L->nused++];
     snprintf(u->name, sizeof u->name, "%s", name);
+    u->hash = name_hash(u->name);
     u->kind = kind;
     u->tex = *out;
     return 0;
@@ -504,17 +538,32 @@ int bs_look_side(bs_wadlook *L, uint32_t li, int k, const uint8_t rec[30], unsig
 static int is_sprite_start(const char *n) { return strcmp(n, "S_START") == 0 || strcmp(n, "SS_START") == 0; }
 static int is_sprite_end(const char *n) { return strcmp(n, "S_END") == 0 || strcmp(n, "SS_END") == 0; }
 
-uint8_t bs_look_thing_colour(bs_wadlook *L, const char prefix[4], uint8_t fallback)
+/* the lumps between S_START/S_END or SS_START/SS_END, listed on the first call */
+static int list_sprites(bs_wadlook *L)
 {
-    uint8_t def[768];
-    bs_palette(def);
-    uint8_t colour = nearest(L->lk->palette, def[3 * fallback], def[3 * fallback + 1], def[3 * fallback + 2]);
+    if (L->sprites) return 0;
+    L->sprites = malloc(sizeof *L->sprites * (L->ndir + 1));
+    if (!L->sprites) return -1;
     int in = 0;
     for (uint32_t i = 0; i < L->ndir; i++) {
         const char *n = L->dir[i].name;
         if (is_sprite_start(n)) in = 1;
         else if (is_sprite_end(n)) in = 0;
-        else if (in && strncmp(n, prefix, 4) == 0 && n[4] == 'A' && (n[5] == '0' || n[5] == '1')) {
+        else if (in) L->sprites[L->nsprites++] = i;
+    }
+    return 0;
+}
+
+uint8_t bs_look_thing_colour(bs_wadlook *L, const char prefix[4], uint8_t fallback)
+{
+    uint8_t def[768];
+    bs_palette(def);
+    uint8_t colour = nearest(L->lk->palette, def[3 * fallback], def[3 * fallback + 1], def[3 * fallback + 2]);
+    if (list_sprites(L)) return colour; /* out of memory: things.txt's colour */
+    for (uint32_t k = 0; k < L->nsprites; k++) {
+        uint32_t i = L->sprites[k];
+        const char *n = L->dir[i].name;
+        if (strncmp(n, prefix, 4) == 0 && n[4] == 'A' && (n[5] == '0' || n[5] == '1')) {
             uint8_t *p;
             char msg[300];
             uint64_t count = 0;
@@ -549,5 +598,7 @@ void bs_look_close(bs_wadlook *L)
     free(L->tdef[1]);
     free(L->used);
     free(L->mean);
+    free(L->flats);
+    free(L->sprites);
     free(L);
 }
