@@ -218,12 +218,21 @@ def run(args):
     originals = {rel: (ROOT / rel).read_text().splitlines(keepends=True) for rel in files}
     results = []
     start = time.monotonic()
-    tried = 0
+    try:
+        try_mutants(args, every, tree, originals, base, log, results, start)
+    except KeyboardInterrupt:
+        # Ctrl-C: the report of the mutants run so far (the scratch file was restored)
+        print("mutate: interrupted; reporting the mutants run so far")
+    log.close()
+    elapsed = time.monotonic() - t0
+    report(args, out, files, len(every), results, elapsed)
+
+
+def try_mutants(args, every, tree, originals, base, log, results, start):
     for m in every:
         if sum(r["status"] != "no-build" for r in results) >= args.sample:
             break
         rel, n, text, rule = m
-        tried += 1
         lines = list(originals[rel])
         lines[n - 1] = text
         path = tree / rel
@@ -253,9 +262,6 @@ def run(args):
         left = rate * (args.sample - done)
         print(f"[{done}/{args.sample}] {rel}:{n} {status}{' by ' + by if by else ''} ({took:.1f}s, "
               f"~{fmt_time(left)} left)", flush=True)
-    log.close()
-    elapsed = time.monotonic() - t0
-    report(args, out, files, len(every), results, elapsed)
 
 
 def counts(rows):
@@ -319,15 +325,15 @@ def report(args, out, files, total, results, elapsed):
         print(f"mutate: docs/benchmarks.md updated")
 
 
-DEFAULT_SAMPLE = 100
+DEFAULT_SAMPLE = 40
 DEFAULT_SEED = 19
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--sample", type=int, default=int(os.environ.get("MUTATE_SAMPLE") or DEFAULT_SAMPLE),
-                    help=f"mutants to run that build (env MUTATE_SAMPLE; default {DEFAULT_SAMPLE}: about "
-                         f"half an hour on 2 cores)")
+                    help=f"mutants to run that build (env MUTATE_SAMPLE; default {DEFAULT_SAMPLE}: about"
+                         f" ten minutes on 2 idle cores)")
     ap.add_argument("--seed", type=int, default=int(os.environ.get("MUTATE_SEED") or DEFAULT_SEED),
                     help=f"seed of the shuffle that picks the mutants (env MUTATE_SEED; default {DEFAULT_SEED})")
     ap.add_argument("--files", nargs="+", metavar="FILE",
