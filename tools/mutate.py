@@ -107,7 +107,8 @@ def sync_tree(dst):
         src, out = ROOT / rel, dst / rel
         if src.is_file() and (not out.exists() or out.read_bytes() != src.read_bytes()):
             out.parent.mkdir(parents=True, exist_ok=True)
-            shutil.copy2(src, out)
+            # a fresh time, so make rebuilds objects left from an interrupted mutant
+            shutil.copyfile(src, out)
 
 
 def programs(tests):
