@@ -141,6 +141,8 @@ help:
 	@echo "                make bench-pcvga (write counters per present mode)"
 	@echo "make flash      IMAGE=x.dfu DEVICE=VID:PID (or LOOPBACK=1): USB DFU download"
 	@echo "make bench-textures  bytes of each Freedoom map's textures, flats and light tables (docs/textures-bytes.md)"
+	@echo "make mutate     mutation testing of firmware/, firmware/dfu/, hal/serial/ (MUTATE_SAMPLE=N mutants)"
+	@echo "                -> build/mutate/report.md and docs/benchmarks.md; not part of make test"
 	@echo "make bench-bsp  bspc over all 68 Freedoom maps per strategy, beside zdbsp and glbsp"
 	@echo "make report     error against the reference vs instructions per frame, per render mode and"
 	@echo "                precision-knob configuration (mk/report.mk) -> build/report/report.md and plots"
@@ -203,6 +205,16 @@ bench-textures: deps $(BUILD)/bspc
 	$(PY) tools/texture_bytes.py --bspc $(BUILD)/bspc
 
 .PHONY: bench-textures
+
+# Mutation testing of firmware/, firmware/dfu/ and hal/serial/ against the fast tests of each file
+# (tools/mutate.py --help): build/mutate/report.md and docs/benchmarks.md. MUTATE_SAMPLE=N mutants,
+# MUTATE_SEED=S picks them.
+MUTATE_SAMPLE ?=
+MUTATE_SEED ?=
+mutate: deps $(GEN)/fx_tables.c
+	MUTATE_SAMPLE=$(MUTATE_SAMPLE) MUTATE_SEED=$(MUTATE_SEED) $(PY) tools/mutate.py
+
+.PHONY: mutate
 
 clean:
 	rm -rf $(BUILD)/obj $(BUILD)/san $(BUILD)/gen $(BUILD)/scene $(BUILD)/size $(PROGRAMS) $(BUILD)/*.bsc $(BUILD)/gen_tables $(BUILD)/bin2c $(BUILD)/fuzz/obj $(BUILD)/fuzz/fuzz_*
