@@ -12,9 +12,10 @@
  * second, back to front, draws. Not exact, by
  * design: an object still overdraws the surfaces of its own leaf that are in
  * front of it, and two objects are ordered by their origins only. */
+#include "painter.h"
+
 #include "bsp_walk.h"
 #include "obj_draw.h"
-#include "render.h"
 #include "surfaces.h"
 
 #define PAINTER_BACKGROUND 0
@@ -165,21 +166,21 @@ static void draw_object(const scene *sc, uint32_t i, const obj_state *o, const v
 }
 
 void painter_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t,
-                    const render_work *work, render_stats *st)
+                    render_stats *st, void *work, uint32_t work_bytes)
 {
     painter p = {sc, w, v, t, st, {fill_polygon, 0}, 0, 0, 0, 0, 0};
     walk_stats ws;
     uint32_t nobj = (CFG_OBJECTS && w && w->objs) ? w->n : 0;
-    if (nobj && (!work || !work->mem || work->bytes < painter_work_bytes(sc, w))) {
+    if (nobj && (!work || work_bytes < painter_work_bytes(sc, w))) {
         st->refused = 1; /* no room to order the objects */
-        render_clear(t, PAINTER_BACKGROUND);
+        rast_clear(t, PAINTER_BACKGROUND);
         return;
     }
     p.sink.ctx = &p;
     p.sink.flat = t->flat;
-    render_clear(t, PAINTER_BACKGROUND);
+    rast_clear(t, PAINTER_BACKGROUND);
     if (nobj) {
-        pt_order *order = work->mem, *tmp = order + nobj;
+        pt_order *order = work, *tmp = order + nobj;
         uint32_t n = 0;
         for (uint32_t i = 0; i < nobj; i++) {
             const obj_state *o = &w->objs[i];

@@ -121,8 +121,8 @@ static void layout(const scene *s, const world_state *w, span_layout *L)
     object_bound(s, w, &faces, &oedges, &objs);
     /* the world's part: what the build allows, or less when the compiler proved
      * that no frame of this scene needs more (docs/needs.md); at least one polygon */
-    L->world_edges = min_u64(s->needs->edges, SPAN_POOL_EDGES);
-    L->world_surfs = min_u64(s->needs->surfaces, SPAN_POOL_SURFACES);
+    L->world_edges = min_u64(s->needs->edges, SPANS_POOL_EDGES);
+    L->world_surfs = min_u64(s->needs->surfaces, SPANS_POOL_SURFACES);
     if (L->world_edges < POLY_EDGES) L->world_edges = POLY_EDGES;
     if (L->world_surfs < 1) L->world_surfs = 1;
     L->edges = L->world_edges + oedges;
@@ -134,7 +134,7 @@ static void layout(const scene *s, const world_state *w, span_layout *L)
                align8(L->objs * sizeof(sp_obj));
 }
 
-uint32_t span_work_bytes(const scene *s, const world_state *w)
+uint32_t spans_work_bytes(const scene *s, const world_state *w)
 {
     span_layout L;
     layout(s, w, &L);
@@ -691,7 +691,7 @@ void spans_render(const scene *sc, const world_state *w, const view_xform *v, co
     layout(sc, w, &L);
     if (!work || L.total > 0xFFFFFFF0u || work_bytes < L.total) {
         st->refused = 1; /* the caller did not provide the memory this frame needs */
-        render_clear(t, BACKGROUND_COLOUR);
+        rast_clear(t, BACKGROUND_COLOUR);
         return;
     }
     uint8_t *mem = work;
