@@ -71,11 +71,11 @@ static int place_objects(void *ctx, uint32_t leaf, unsigned clip_mask)
     painter *p = ctx;
     (void)clip_mask;
     const scn_leaf *f = &p->sc->leaves[leaf];
-    int32_t box[4];
+    int32_t box[BOX_SIDES];
     objd_leaf_box(p->sc, f, box);
     p->visits++;
-    if (box[0] > box[2]) return 0;
-    int32_t west = (box[0] >> 16) - 2 * p->reach - 1, east = box[2] >> 16;
+    if (box[BOX_LEFT] > box[BOX_RIGHT]) return 0;
+    int32_t west = (box[BOX_LEFT] >> 16) - 2 * p->reach - 1, east = box[BOX_RIGHT] >> 16;
     uint32_t lo = 0, hi = p->nobjs;
     while (lo < hi) { /* the first object whose west edge is at or east of west */
         uint32_t mid = lo + (hi - lo) / 2;

@@ -270,40 +270,40 @@ static uint32_t collect_objects(span_state *S)
     return n;
 }
 
-static void box_add(int32_t box[4], const scn_vertex *p)
+static void box_add(int32_t box[BOX_SIDES], const scn_vertex *p)
 {
-    if (p->y > box[0]) box[0] = p->y;
-    if (p->y < box[1]) box[1] = p->y;
-    if (p->x < box[2]) box[2] = p->x;
-    if (p->x > box[3]) box[3] = p->x;
+    if (p->y > box[BOX_TOP]) box[BOX_TOP] = p->y;
+    if (p->y < box[BOX_BOTTOM]) box[BOX_BOTTOM] = p->y;
+    if (p->x < box[BOX_LEFT]) box[BOX_LEFT] = p->x;
+    if (p->x > box[BOX_RIGHT]) box[BOX_RIGHT] = p->x;
 }
 
 /* The objects whose box touches the leaf's bounding box (the compiler's: its
- * floor polygon and its segs; top, bottom, left, right) and that no earlier
+ * floor polygon and its segs) and that no earlier
  * leaf touched: this leaf's key is their kmin. */
 static void find_objects(span_state *S, uint32_t leaf)
 {
     const scene *sc = S->sc;
     const scn_leaf *f = &sc->leaves[leaf];
-    int32_t box[4] = {INT32_MIN, INT32_MAX, INT32_MAX, INT32_MIN};
+    int32_t box[BOX_SIDES] = {INT32_MIN, INT32_MAX, INT32_MAX, INT32_MIN}; /* empty */
     for (uint32_t i = 0; i < f->num_pverts; i++) box_add(box, &sc->pverts[f->first_pvert + i]);
     for (uint32_t i = 0; i < f->num_segs; i++) {
         const scn_seg *g = &sc->segs[f->first_seg + i];
         box_add(box, &sc->verts[g->v1]);
         box_add(box, &sc->verts[g->v2]);
     }
-    if (box[2] > box[3]) return; /* no geometry */
+    if (box[BOX_LEFT] > box[BOX_RIGHT]) return; /* no geometry */
     /* the first object that can reach the leaf from the left, by bisection */
-    int64_t from = (int64_t)box[2] - S->obj_span;
+    int64_t from = (int64_t)box[BOX_LEFT] - S->obj_span;
     uint32_t lo = 0, hi = S->nobjs;
     while (lo < hi) {
         uint32_t mid = lo + (hi - lo) / 2;
         if (S->objs[mid].x0 < from) lo = mid + 1;
         else hi = mid;
     }
-    for (uint32_t i = lo; i < S->nobjs && S->objs[i].x0 <= box[3]; i++) {
+    for (uint32_t i = lo; i < S->nobjs && S->objs[i].x0 <= box[BOX_RIGHT]; i++) {
         sp_obj *o = &S->objs[i];
-        if (o->kmin || o->x1 < box[2] || o->y0 > box[0] || o->y1 < box[1]) continue;
+        if (o->kmin || o->x1 < box[BOX_LEFT] || o->y0 > box[BOX_TOP] || o->y1 < box[BOX_BOTTOM]) continue;
         o->kmin = S->key;
         S->pending--;
     }
