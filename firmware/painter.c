@@ -105,9 +105,10 @@ static int draw_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
     return 0;
 }
 
-/* Drawing order: the leaf drawn first (larger key) first, then farthest first
- * (larger depth), then by index: a stable, total order. */
-static int before(const pt_order *a, const pt_order *b)
+/* Drawing order, 1 if a is drawn before b: the leaf drawn first (larger key)
+ * first, then farthest first (larger depth), then by index: a stable, total
+ * order. */
+static int draws_before(const pt_order *a, const pt_order *b)
 {
     if (a->key != b->key) return a->key > b->key;
     return a->depth != b->depth ? a->depth > b->depth : a->index < b->index;
@@ -148,7 +149,7 @@ static void draw_object(const scene *sc, uint32_t i, const obj_state *o, const v
         faces[nf].key = 0;
         faces[nf].depth = pl.cz;
         faces[nf].index = f;
-        for (uint32_t k = nf++; k > 0 && before(&faces[k], &faces[k - 1]); k--) {
+        for (uint32_t k = nf++; k > 0 && draws_before(&faces[k], &faces[k - 1]); k--) {
             pt_order x = faces[k];
             faces[k] = faces[k - 1];
             faces[k - 1] = x;
@@ -196,7 +197,7 @@ void painter_render(const scene *sc, const world_state *w, const view_xform *v, 
         uint32_t placed = 0; /* objects in no visited leaf are not drawn */
         for (uint32_t k = 0; k < n; k++)
             if (order[k].key) order[placed++] = order[k];
-        sort_by(order, tmp, placed, before);
+        sort_by(order, tmp, placed, draws_before);
         st->objects_visible = placed;
         p.nobjs = placed;
     }

@@ -511,7 +511,9 @@ static int overtakes_at(span_state *S, sp_surf *top, sp_surf *p, int x, int y)
     return hi;
 }
 
-static void note(span_state *S, sp_next *n, sp_surf *top, sp_surf *p, int x, int y)
+/* Keep p's overtaking of top in *n if it comes before the one *n holds (at the
+ * same pixel: if p is nearer there than n's surface). */
+static void keep_sooner_overtake(span_state *S, sp_next *n, sp_surf *top, sp_surf *p, int x, int y)
 {
     int at = overtakes_at(S, top, p, x, y);
     if (at < n->x || (at == n->x && at < VIEW_W && in_front(S, p, n->s, at, y, 1))) {
@@ -521,10 +523,10 @@ static void note(span_state *S, sp_next *n, sp_surf *top, sp_surf *p, int x, int
 }
 
 /* The next overtaking of top from pixel x on. */
-static sp_next plan(span_state *S, sp_surf *top, int x, int y)
+static sp_next next_overtake(span_state *S, sp_surf *top, int x, int y)
 {
     sp_next n = {VIEW_W, 0};
-    for (sp_surf *p = top->below; p; p = p->below) note(S, &n, top, p, x, y);
+    for (sp_surf *p = top->below; p; p = p->below) keep_sooner_overtake(S, &n, top, p, x, y);
     return n;
 }
 
@@ -545,7 +547,7 @@ static sp_surf *overtake(span_state *S, sp_surf *top, sp_next *n, int *cur, int 
         emit_span(S, top, y, *cur, at);
         *cur = at;
         top = raise_surf(top, n->s);
-        *n = plan(S, top, at, y);
+        *n = next_overtake(S, top, at, y);
     }
     return top;
 }
@@ -575,7 +577,7 @@ static inline __attribute__((always_inline)) void scan_line(span_state *S, sp_ed
                 s->above = 0;
                 top->above = s;
                 top = s;
-                if (objects && nobj) next = plan(S, top, col, y);
+                if (objects && nobj) next = next_overtake(S, top, col, y);
             } else {                            /* slot it in below */
                 sp_surf *p = top;
                 while (!in_front(S, s, p->below, col, y, objects)) p = p->below;
@@ -583,7 +585,7 @@ static inline __attribute__((always_inline)) void scan_line(span_state *S, sp_ed
                 s->above = p;
                 p->below->above = s;
                 p->below = s;
-                if (objects && nobj) note(S, &next, top, s, col, y);
+                if (objects && nobj) keep_sooner_overtake(S, &next, top, s, col, y);
             }
         } else {
             if (--s->state != 0) continue;
@@ -594,11 +596,11 @@ static inline __attribute__((always_inline)) void scan_line(span_state *S, sp_ed
                 top = s->below;
                 top->above = 0;
                 if (objects && mixed) top = nearest(S, top, col, y);
-                if (objects) next = nobj ? plan(S, top, col, y) : (sp_next){VIEW_W, 0};
+                if (objects) next = nobj ? next_overtake(S, top, col, y) : (sp_next){VIEW_W, 0};
             } else if (s->below || s->above) {  /* leaves from inside the stack */
                 s->above->below = s->below;
                 s->below->above = s->above;
-                if (objects && s == next.s) next = nobj ? plan(S, top, col, y) : (sp_next){VIEW_W, 0};
+                if (objects && s == next.s) next = nobj ? next_overtake(S, top, col, y) : (sp_next){VIEW_W, 0};
             }
             s->below = s->above = 0;
         }
