@@ -1,4 +1,5 @@
-/* bsp_walk.c - data-recursive BSP traversal with frustum culling of node boxes.
+/* bsp_walk.c - data-recursive BSP traversal over the boxes a caller's test
+ * passes, and on it the walk with frustum culling of node boxes.
  *
  * The horizontal frustum planes (left, right, near) are tested against each
  * child's box in map space: for each plane, the box corner farthest along the
@@ -24,11 +25,10 @@ static void frustum_planes(const view_xform *v, walk_plane p[3])
 
 /* Returns -1 if the box is outside some plane, else the mask with the planes
  * the box is wholly inside of removed. */
-static int cull_box(const int32_t box[4], const view_xform *v, const walk_plane p[3], unsigned mask)
+static int cull_box(const int32_t box[BOX_SIDES], const view_xform *v, const walk_plane p[3], unsigned mask)
 {
-    /* box: top (ymax), bottom (ymin), left (xmin), right (xmax) */
-    int64_t x0 = fx_asr64((int64_t)box[2] - v->cx, 3), x1 = fx_asr64((int64_t)box[3] - v->cx, 3);
-    int64_t y0 = fx_asr64((int64_t)box[1] - v->cy, 3), y1 = fx_asr64((int64_t)box[0] - v->cy, 3);
+    int64_t x0 = fx_asr64((int64_t)box[BOX_LEFT] - v->cx, 3), x1 = fx_asr64((int64_t)box[BOX_RIGHT] - v->cx, 3);
+    int64_t y0 = fx_asr64((int64_t)box[BOX_BOTTOM] - v->cy, 3), y1 = fx_asr64((int64_t)box[BOX_TOP] - v->cy, 3);
     for (int i = 0; i < 3; i++) {
         if (!(mask & p[i].bit)) continue;
         int64_t far = (p[i].nx >= 0 ? x1 : x0) * p[i].nx + (p[i].ny >= 0 ? y1 : y0) * p[i].ny;
@@ -43,60 +43,103 @@ static int cull_box(const int32_t box[4], const view_xform *v, const walk_plane 
     return (int)mask;
 }
 
-void walk_tree(const scene *s, const view_xform *v, walk_order order, walk_visit visit, void *ctx,
-               const occ_columns *occ, walk_stats *st)
+/* The walk itself. Inlined whole into walk_boxes and walk_tree: with the
+ * frustum's rules constant there, the compiler calls its tests directly (the
+ * frame's walk pays no call through a pointer per box). */
+static inline __attribute__((always_inline)) int walk(const scene *s, const walk_rules *rules, void *ctx,
+                                                      unsigned state, walk_stats *st)
 {
-    uint32_t stack[CFG_MAX_DEPTH + 2];
-    uint8_t masks[CFG_MAX_DEPTH + 2];
-    walk_plane planes[3];
+    uint32_t stack[WALK_STACK_MAX];
+    uint8_t states[WALK_STACK_MAX];
     int sp = 0;
-    walk_stats local = {0, 0};
+    walk_stats local;
     if (!st) st = &local;
     st->nodes = st->boxes_culled = st->boxes_hidden = 0;
-    if (s->nleaves == 0) return;
-    frustum_planes(v, planes);
+    if (s->nleaves == 0) return 0;
     stack[sp] = s->root;
-    masks[sp++] = CLIP_ALL;
+    states[sp++] = (uint8_t)state;
     while (sp > 0) {
         sp--;
         uint32_t n = stack[sp];
-        unsigned mask = masks[sp];
-        if (occ && sp > 0 && occ_full(occ)) return; /* nothing more can show */
+        unsigned in = states[sp];
+        if (rules->stop && sp > 0 && rules->stop(ctx)) return 1;
         if (n & SCN_LEAF_BIT) {
-            if (visit(ctx, n & ~SCN_LEAF_BIT, mask)) return;
+            if (rules->leaf(rules->leaf_ctx, n & ~SCN_LEAF_BIT, in)) return 1;
             continue;
         }
         const scn_node *node = &s->nodes[n];
-        int near = scene_node_side(node, (int32_t)v->cx, (int32_t)v->cy);
-        st->nodes++;
-        /* push the child to visit second first */
-        int first = (order == WALK_FRONT_TO_BACK) ? near : near ^ 1;
+        /* push the child to walk second first */
+        int first = rules->first ? rules->first(ctx, node) : 0;
         int second = first ^ 1;
-        int m2 = cull_box(node->bbox[second], v, planes, mask);
-        int m1 = cull_box(node->bbox[first], v, planes, mask);
-        if (occ) {
-            int x0, x1;
-            if (m2 >= 0 && (occ_box_columns(v, node->bbox[second], &x0, &x1), occ_hidden(occ, x0, x1))) {
-                m2 = -1;
-                st->boxes_hidden++;
-            }
-            if (m1 >= 0 && (occ_box_columns(v, node->bbox[first], &x0, &x1), occ_hidden(occ, x0, x1))) {
-                m1 = -1;
-                st->boxes_hidden++;
-            }
-        }
-        if (sp + 2 > CFG_MAX_DEPTH + 2) return; /* unreachable for a validated scene */
+        st->nodes++;
+        int m2 = rules->box(ctx, node->bbox[second], in);
+        int m1 = rules->box(ctx, node->bbox[first], in);
+        if (sp + 2 > WALK_STACK_MAX) return 0; /* unreachable for a validated scene */
         if (m2 >= 0) {
             stack[sp] = node->child[second];
-            masks[sp++] = (uint8_t)m2;
+            states[sp++] = (uint8_t)m2;
         } else {
             st->boxes_culled++;
         }
         if (m1 >= 0) {
             stack[sp] = node->child[first];
-            masks[sp++] = (uint8_t)m1;
+            states[sp++] = (uint8_t)m1;
         } else {
             st->boxes_culled++;
         }
     }
+    return 0;
+}
+
+int walk_boxes(const scene *s, const walk_rules *rules, void *ctx, unsigned state, walk_stats *st)
+{
+    return walk(s, rules, ctx, state, st);
+}
+
+/* ---- the frustum walk ---- */
+
+typedef struct {
+    const view_xform *v;
+    walk_plane planes[3];
+    walk_order order;
+    const occ_columns *occ; /* may be NULL */
+    walk_stats *st;
+} frustum_walk;
+
+static int frustum_first(void *ctx, const scn_node *node)
+{
+    const frustum_walk *f = ctx;
+    int near = scene_node_side(node, (int32_t)f->v->cx, (int32_t)f->v->cy);
+    return (f->order == WALK_FRONT_TO_BACK) ? near : near ^ 1;
+}
+
+static int frustum_box(void *ctx, const int32_t box[BOX_SIDES], unsigned mask)
+{
+    frustum_walk *f = ctx;
+    int m = cull_box(box, f->v, f->planes, mask);
+    if (m >= 0 && f->occ) {
+        int x0, x1;
+        occ_box_columns(f->v, box, &x0, &x1);
+        if (occ_hidden(f->occ, x0, x1)) {
+            f->st->boxes_hidden++;
+            return -1;
+        }
+    }
+    return m;
+}
+
+static int frustum_full(void *ctx)
+{
+    const frustum_walk *f = ctx;
+    return occ_full(f->occ);
+}
+
+void walk_tree(const scene *s, const view_xform *v, walk_order order, walk_visit visit, void *ctx,
+               const occ_columns *occ, walk_stats *st)
+{
+    walk_stats local;
+    frustum_walk f = {v, {{0}}, order, occ, st ? st : &local};
+    const walk_rules rules = {frustum_first, frustum_box, visit, ctx, occ ? frustum_full : 0};
+    frustum_planes(v, f.planes);
+    walk(s, &rules, &f, CLIP_ALL, f.st);
 }

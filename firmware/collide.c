@@ -2,8 +2,8 @@
  * with sliding, the floor under a point, and line of sight.
  *
  * Owns: exact integer geometry on the 1/4096-unit grid (orientation, point to
- * segment distance, segment crossing), the BSP box walk that finds candidate
- * segs, and the move and sight rules.
+ * segment distance, segment crossing), the box tests by which bsp_walk.c's
+ * walk finds candidate segs, and the move and sight rules.
  *
  * Ranges. Map coordinates are inside +-SCN_COORD_MAX units (vertices by the
  * loader, positions clamped here), so a grid coordinate (16.16 >> 4) is below
@@ -13,6 +13,8 @@
  * exact 128-bit w128_sign_diff(). Nothing here divides by a value that can be 0.
  */
 #include "collide.h"
+
+#include "bsp_walk.h"
 #include "wide128.h"
 
 #define G_SHIFT 4                                        /* grid = 16.16 >> 4: 1/4096 unit */
@@ -24,17 +26,18 @@
 #define SKIN (FX_ONE / 64)                               /* a slide leaves the wall by this */
 #define MIN_SLIDE (FX_ONE / 256)                         /* shorter slides are dropped */
 #define UNIT_SHIFT 30                                    /* unit normals are 2.30 */
-#define STACK_MAX (CFG_MAX_DEPTH + 2)                    /* box walk: one sibling per level + 1 */
 #define CAND_MAX 128                                     /* candidate segs kept per move piece */
 #define HUGE_H ((int64_t)1 << 40)                        /* "no ceiling" (heights are < 2^31) */
 
+/* A point on the 1/4096-unit grid. */
 typedef struct {
     int64_t x, y; /* grid units, |x|, |y| < 2^27 */
-} gpt;
+} grid_pt;
 
+/* The map box a tree query covers: leaves under node boxes that overlap it. */
 typedef struct {
     int64_t x0, y0, x1, y1; /* 16.16, inclusive */
-} rbox;
+} query_box;
 
 static int64_t min64(int64_t a, int64_t b) { return a < b ? a : b; }
 static int64_t max64(int64_t a, int64_t b) { return a > b ? a : b; }
@@ -44,25 +47,25 @@ static int sgn64(int64_t v) { return (v > 0) - (v < 0); }
 
 /* ------------------------------------------------------------ grid geometry */
 
-static gpt to_grid(int64_t x, int64_t y)
+static grid_pt to_grid(int64_t x, int64_t y)
 {
-    gpt p = {fx_asr64(x, G_SHIFT), fx_asr64(y, G_SHIFT)};
+    grid_pt p = {fx_asr64(x, G_SHIFT), fx_asr64(y, G_SHIFT)};
     return p;
 }
 
-static gpt vert(const scene *s, uint32_t v)
+static grid_pt vert(const scene *s, uint32_t v)
 {
     return to_grid(s->verts[v].x, s->verts[v].y);
 }
 
 /* (b - a) x (p - a): > 0 when p is left of a->b (behind a seg), < 0 right (in front). */
-static int64_t orient(gpt a, gpt b, gpt p)
+static int64_t orient(grid_pt a, grid_pt b, grid_pt p)
 {
     return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x);
 }
 
 /* 1 if the distance from p to the closed segment ab is below r (r2 = r*r, r < 2^23). */
-static int near_seg(gpt p, gpt a, gpt b, int64_t r, int64_t r2)
+static int near_seg(grid_pt p, grid_pt a, grid_pt b, int64_t r, int64_t r2)
 {
     if (p.x + r <= min64(a.x, b.x) || p.x - r >= max64(a.x, b.x) || p.y + r <= min64(a.y, b.y) ||
         p.y - r >= max64(a.y, b.y))
@@ -81,7 +84,7 @@ static int near_seg(gpt p, gpt a, gpt b, int64_t r, int64_t r2)
 
 /* Distance from p to the closed segment ab in grid units, rounded down (for
  * comparisons that need no exactness). */
-static int64_t dist_seg(gpt p, gpt a, gpt b)
+static int64_t dist_seg(grid_pt p, grid_pt a, grid_pt b)
 {
     int64_t abx = b.x - a.x, aby = b.y - a.y, apx = p.x - a.x, apy = p.y - a.y;
     int64_t t = abx * apx + aby * apy;
@@ -96,7 +99,7 @@ static int64_t dist_seg(gpt p, gpt a, gpt b)
 }
 
 /* 1 if the closed segments pq and ab share a point. */
-static int seg_cross(gpt p, gpt q, gpt a, gpt b)
+static int seg_cross(grid_pt p, grid_pt q, grid_pt a, grid_pt b)
 {
     int d1 = sgn64(orient(a, b, p)), d2 = sgn64(orient(a, b, q));
     int d3 = sgn64(orient(p, q, a)), d4 = sgn64(orient(p, q, b));
@@ -110,7 +113,7 @@ static int seg_cross(gpt p, gpt q, gpt a, gpt b)
 /* 1 if a circle of radius r moving along pq comes nearer than r to segment ab:
  * the distance between two segments is 0 if they cross, else the least of the
  * four end-point-to-segment distances. */
-static int sweep_near(gpt p, gpt q, gpt a, gpt b, int64_t r, int64_t r2)
+static int sweep_near(grid_pt p, grid_pt q, grid_pt a, grid_pt b, int64_t r, int64_t r2)
 {
     return seg_cross(p, q, a, b) || near_seg(p, a, b, r, r2) || near_seg(q, a, b, r, r2) ||
            near_seg(a, p, q, r, r2) || near_seg(b, p, q, r, r2);
@@ -140,7 +143,7 @@ static int unit_vec(int64_t vx, int64_t vy, int32_t *nx, int32_t *ny)
 
 /* The unit normal of segment ab at its point nearest p, pointing at p (the seg's
  * front normal if p is on it). */
-static int seg_normal(gpt p, gpt a, gpt b, int32_t *nx, int32_t *ny)
+static int seg_normal(grid_pt p, grid_pt a, grid_pt b, int32_t *nx, int32_t *ny)
 {
     int64_t abx = b.x - a.x, aby = b.y - a.y, apx = p.x - a.x, apy = p.y - a.y;
     int64_t t = abx * apx + aby * apy, l2 = abx * abx + aby * aby;
@@ -167,19 +170,16 @@ static int seg_normal(gpt p, gpt a, gpt b, int32_t *nx, int32_t *ny)
 
 /* ------------------------------------------------------------ tree walk */
 
-typedef int (*leaf_fn)(void *ctx, uint32_t leaf); /* nonzero stops the walk */
-
-static int box_meets(const int32_t bb[4], const rbox *b)
+static int box_meets(const int32_t bb[BOX_SIDES], const query_box *b)
 {
-    /* bb: top, bottom, left, right = ymax, ymin, xmin, xmax */
-    return bb[2] <= b->x1 && bb[3] >= b->x0 && bb[1] <= b->y1 && bb[0] >= b->y0;
+    return bb[BOX_LEFT] <= b->x1 && bb[BOX_RIGHT] >= b->x0 && bb[BOX_BOTTOM] <= b->y1 && bb[BOX_TOP] >= b->y0;
 }
 
 /* 1 unless the line through p, q leaves every corner of bb strictly on one side. */
-static int line_meets(const int32_t bb[4], gpt p, gpt q)
+static int line_meets(const int32_t bb[BOX_SIDES], grid_pt p, grid_pt q)
 {
-    gpt lo = to_grid(bb[2], bb[1]), hi = to_grid(bb[3], bb[0]);
-    gpt c[4] = {{lo.x, lo.y}, {hi.x, lo.y}, {hi.x, hi.y}, {lo.x, hi.y}};
+    grid_pt lo = to_grid(bb[BOX_LEFT], bb[BOX_BOTTOM]), hi = to_grid(bb[BOX_RIGHT], bb[BOX_TOP]);
+    grid_pt c[4] = {{lo.x, lo.y}, {hi.x, lo.y}, {hi.x, hi.y}, {lo.x, hi.y}};
     int pos = 0, neg = 0;
     for (int k = 0; k < 4; k++) {
         int64_t o = orient(p, q, c[k]);
@@ -189,28 +189,26 @@ static int line_meets(const int32_t bb[4], gpt p, gpt q)
     return pos && neg;
 }
 
-/* Visit every leaf under a node box that overlaps b (and, with line, that the
- * line through line[0], line[1] meets). The explicit stack holds at most one
- * pending sibling per level of the validated tree (depth <= CFG_MAX_DEPTH) plus
- * the node in hand. Returns 1 if fn stopped the walk. */
-static int walk_leaves(const scene *s, const rbox *b, const gpt *line, leaf_fn fn, void *ctx)
+typedef struct {
+    const query_box *box;
+    const grid_pt *line; /* NULL: any box that overlaps box */
+} tree_query;
+
+static int query_meets(void *ctx, const int32_t bb[BOX_SIDES], unsigned state)
 {
-    uint32_t stack[STACK_MAX];
-    uint32_t sp = 0;
-    if (s->nleaves == 0) return 0;
-    stack[sp++] = s->root;
-    while (sp) {
-        uint32_t n = stack[--sp];
-        if (n & SCN_LEAF_BIT) {
-            if (fn(ctx, n & ~SCN_LEAF_BIT)) return 1;
-            continue;
-        }
-        const scn_node *nd = &s->nodes[n];
-        for (int c = 1; c >= 0; c--)
-            if (sp < STACK_MAX && box_meets(nd->bbox[c], b) && (!line || line_meets(nd->bbox[c], line[0], line[1])))
-                stack[sp++] = nd->child[c];
-    }
-    return 0;
+    const tree_query *q = ctx;
+    if (!box_meets(bb, q->box) || (q->line && !line_meets(bb, q->line[0], q->line[1]))) return -1;
+    return (int)state;
+}
+
+/* Visit every leaf under a node box that overlaps b (and, with line, that the
+ * line through line[0], line[1] meets), child 0 first. Returns 1 if fn stopped
+ * the walk. */
+static int walk_leaves(const scene *s, const query_box *b, const grid_pt *line, walk_visit fn, void *ctx)
+{
+    tree_query q = {b, line};
+    const walk_rules rules = {0, query_meets, fn, ctx, 0};
+    return walk_boxes(s, &rules, &q, 0, 0);
 }
 
 /* ------------------------------------------------------------ moving */
@@ -221,7 +219,7 @@ typedef struct {
     int64_t r, r2;       /* radius on the grid (2^12 .. 2^22) and its square */
     int64_t rraw;        /* radius, 16.16 */
     int64_t height, step;
-    rbox box;            /* the candidates cover this box */
+    query_box box;            /* the candidates cover this box */
     int64_t gx0, gy0, gx1, gy1; /* the same on the grid */
     int overflow;        /* more segs than CAND_MAX: checks walk the tree themselves */
     uint32_t n;
@@ -239,13 +237,14 @@ typedef struct {
 static int seg_in_box(const mover *m, uint32_t si)
 {
     const scn_seg *g = &m->s->segs[si];
-    gpt a = vert(m->s, g->v1), b = vert(m->s, g->v2);
+    grid_pt a = vert(m->s, g->v1), b = vert(m->s, g->v2);
     return max64(a.x, b.x) >= m->gx0 && min64(a.x, b.x) <= m->gx1 && max64(a.y, b.y) >= m->gy0 &&
            min64(a.y, b.y) <= m->gy1;
 }
 
-static int walk_leaf_segs(void *vctx, uint32_t leaf)
+static int walk_leaf_segs(void *vctx, uint32_t leaf, unsigned state)
 {
+    (void)state;
     seg_walk *w = (seg_walk *)vctx;
     const scn_leaf *l = &w->m->s->leaves[leaf];
     for (uint32_t i = 0; i < l->num_segs; i++)
@@ -253,8 +252,9 @@ static int walk_leaf_segs(void *vctx, uint32_t leaf)
     return 0;
 }
 
-static int gather_leaf(void *vctx, uint32_t leaf)
+static int gather_leaf(void *vctx, uint32_t leaf, unsigned state)
 {
+    (void)state;
     mover *m = (mover *)vctx;
     const scn_leaf *l = &m->s->leaves[leaf];
     for (uint32_t i = 0; i < l->num_segs; i++) {
@@ -296,12 +296,13 @@ static void for_candidates(const mover *m, seg_fn fn, void *ctx)
     walk_leaves(m->s, &m->box, 0, walk_leaf_segs, &w);
 }
 
-/* Where the body stands: highest floor and lowest ceiling over the sectors its
- * circle overlaps (the centre's included), and the centre's sector. */
+/* Where the body stands (its footing): highest floor and lowest ceiling over
+ * the sectors its circle overlaps (the centre's included), and the centre's
+ * sector. */
 typedef struct {
     int64_t floor, ceil;
     uint32_t sector;
-} stand;
+} footing;
 
 /* Does a wall block a body standing on floor z? */
 static int wall_blocks(const mover *m, const scn_line *ln, int64_t z)
@@ -315,15 +316,15 @@ static int wall_blocks(const mover *m, const scn_line *ln, int64_t z)
 
 typedef struct {
     const mover *m;
-    gpt p, q;        /* the path */
+    grid_pt p, q;        /* the path */
     int64_t z;       /* floor stood on at the start of the sub-step */
     int blocked;     /* some wall blocks the path */
     int stuck;       /* a blocking wall that p already overlaps holds the move */
     int touched;     /* fmax, cmin hold something */
     int64_t fmax, cmin; /* over the sectors touched at q */
-} path_ck;
+} path_check;
 
-static void touch_sector(path_ck *c, uint32_t sec)
+static void touch_sector(path_check *c, uint32_t sec)
 {
     if (sec == SCN_NONE) return;
     const scn_sector *t = &c->m->s->sectors[sec];
@@ -335,7 +336,7 @@ static void touch_sector(path_ck *c, uint32_t sec)
 
 /* A wall the start already overlaps: it blocks a move that brings the centre
  * nearer or takes it across (or, for a one-sided wall, from on it to behind it). */
-static int escape_blocked(gpt p, gpt q, gpt a, gpt b, int one_sided)
+static int escape_blocked(grid_pt p, grid_pt q, grid_pt a, grid_pt b, int one_sided)
 {
     if (dist_seg(q, a, b) < dist_seg(p, a, b)) return 1;
     if (!seg_cross(p, q, a, b)) return 0;
@@ -346,12 +347,12 @@ static int escape_blocked(gpt p, gpt q, gpt a, gpt b, int one_sided)
 
 static void check_seg(void *ctx, uint32_t si)
 {
-    path_ck *c = (path_ck *)ctx;
+    path_check *c = (path_check *)ctx;
     if (c->blocked) return;
     const mover *m = c->m;
     const scn_seg *g = &m->s->segs[si];
     const scn_line *ln = &m->s->lines[g->line];
-    gpt a = vert(m->s, g->v1), b = vert(m->s, g->v2);
+    grid_pt a = vert(m->s, g->v1), b = vert(m->s, g->v2);
     if (near_seg(c->q, a, b, m->r, m->r2)) {
         touch_sector(c, ln->sector[0]);
         touch_sector(c, ln->sector[1]);
@@ -368,9 +369,9 @@ static void check_seg(void *ctx, uint32_t si)
  * of the sub-step and stands as *at at p? Fills *out with where it would stand at
  * q. at == NULL: only compute *out (no end rules). */
 static int try_path(const mover *m, int64_t px, int64_t py, int64_t qx, int64_t qy, int64_t z,
-                    const stand *at, stand *out, int *stuck)
+                    const footing *at, footing *out, int *stuck)
 {
-    path_ck c;
+    path_check c;
     c.m = m;
     c.p = to_grid(px, py);
     c.q = to_grid(qx, qy);
@@ -400,21 +401,21 @@ static int try_path(const mover *m, int64_t px, int64_t py, int64_t qx, int64_t 
 
 typedef struct {
     const mover *m;
-    gpt l, h;        /* last clear point, first blocked point */
+    grid_pt l, h;        /* last clear point, first blocked point */
     int64_t z;
     int found;
     int64_t best;    /* distance from l to the nearest blocking seg */
-    gpt a, b;        /* that seg */
-} contact_ck;
+    grid_pt a, b;        /* that seg */
+} contact_check;
 
 static void contact_seg(void *ctx, uint32_t si)
 {
-    contact_ck *c = (contact_ck *)ctx;
+    contact_check *c = (contact_check *)ctx;
     const mover *m = c->m;
     const scn_seg *g = &m->s->segs[si];
     const scn_line *ln = &m->s->lines[g->line];
     if (!wall_blocks(m, ln, c->z)) return;
-    gpt a = vert(m->s, g->v1), b = vert(m->s, g->v2);
+    grid_pt a = vert(m->s, g->v1), b = vert(m->s, g->v2);
     if (near_seg(c->l, a, b, m->r, m->r2)) { /* already overlapped: only if it holds the move */
         if (!escape_blocked(c->l, c->h, a, b, ln->sector[1] == SCN_NONE)) return;
     } else if (!sweep_near(c->l, c->h, a, b, m->r, m->r2)) {
@@ -433,7 +434,7 @@ static void contact_seg(void *ctx, uint32_t si)
 static int contact_normal(const mover *m, int64_t z, int64_t lx, int64_t ly, int64_t hx, int64_t hy,
                           int32_t *nx, int32_t *ny)
 {
-    contact_ck c;
+    contact_check c;
     c.m = m;
     c.l = to_grid(lx, ly);
     c.h = to_grid(hx, hy);
@@ -475,7 +476,7 @@ uint32_t col_move(const scene *s, const world_state *w, const col_body *body, fx
     dx = clamp64(dx, -MOVE_MAX, MOVE_MAX);
     dy = clamp64(dy, -MOVE_MAX, MOVE_MAX);
 
-    stand st;
+    footing st;
     gather(&m, px, py, px, py);
     try_path(&m, px, py, px, py, floor_z ? *floor_z : 0, 0, &st, 0);
 
@@ -495,7 +496,7 @@ uint32_t col_move(const scene *s, const world_state *w, const col_body *body, fx
             rx = qx - px;
             ry = qy - py;
             gather(&m, px, py, qx, qy);
-            stand sq;
+            footing sq;
             int stuck = 0;
             if (try_path(&m, px, py, qx, qy, z, &st, &sq, &stuck)) {
                 px = qx;
@@ -506,7 +507,7 @@ uint32_t col_move(const scene *s, const world_state *w, const col_body *body, fx
             flags |= COL_BLOCKED | (stuck ? COL_STUCK : 0);
             /* the furthest clear fraction lo / 2^12 of the piece (|r| < 2^21, so r * 2^12 < 2^33) */
             int32_t lo = 0, hi = 1 << BISECT_BITS;
-            stand slo = st;
+            footing slo = st;
             while (hi - lo > 1) {
                 int32_t mid = (lo + hi) / 2;
                 int64_t mx = px + fx_asr64(rx * mid, BISECT_BITS), my = py + fx_asr64(ry * mid, BISECT_BITS);
@@ -563,28 +564,29 @@ int col_floor_at(const scene *s, fx_t x, fx_t y, fx_t *floor)
 typedef struct {
     const scene *s;
     const world_state *w;
-    gpt p, q;
+    grid_pt p, q;
     int64_t gx0, gy0, gx1, gy1; /* box of pq on the grid */
     int64_t z1, z2;
-} sight_ck;
+} sight_check;
 
 /* Is the height z1 + (z2 - z1) * num / den (0 <= num <= den, den > 0) above hi
  * or below lo? |z1 - hi|, |z2 - z1| < 2^33 and den < 2^59: exact via w128_sign_diff. */
-static int z_outside(const sight_ck *c, int64_t num, int64_t den, int64_t lo, int64_t hi)
+static int z_outside(const sight_check *c, int64_t num, int64_t den, int64_t lo, int64_t hi)
 {
     int64_t dz = c->z2 - c->z1;
     if (w128_sign_diff(c->z1 - hi, den, -dz, num) > 0) return 1; /* (z1-hi)*den + dz*num > 0 */
     return w128_sign_diff(c->z1 - lo, den, -dz, num) < 0;        /* (z1-lo)*den + dz*num < 0 */
 }
 
-static int sight_leaf(void *vctx, uint32_t leaf)
+static int sight_leaf(void *vctx, uint32_t leaf, unsigned state)
 {
-    sight_ck *c = (sight_ck *)vctx;
+    (void)state;
+    sight_check *c = (sight_check *)vctx;
     const scene *s = c->s;
     const scn_leaf *l = &s->leaves[leaf];
     for (uint32_t i = 0; i < l->num_segs; i++) {
         const scn_seg *g = &s->segs[l->first_seg + i];
-        gpt a = vert(s, g->v1), b = vert(s, g->v2);
+        grid_pt a = vert(s, g->v1), b = vert(s, g->v2);
         if (max64(a.x, b.x) < c->gx0 || min64(a.x, b.x) > c->gx1 || max64(a.y, b.y) < c->gy0 ||
             min64(a.y, b.y) > c->gy1)
             continue;
@@ -622,7 +624,7 @@ static int sight_leaf(void *vctx, uint32_t leaf)
 int col_line_of_sight(const scene *s, const world_state *w, fx_t x1, fx_t y1, fx_t z1, fx_t x2, fx_t y2, fx_t z2)
 {
     int64_t ax = clampw(x1), ay = clampw(y1), bx = clampw(x2), by = clampw(y2);
-    sight_ck c;
+    sight_check c;
     c.s = s;
     c.w = w;
     c.p = to_grid(ax, ay);
@@ -635,7 +637,7 @@ int col_line_of_sight(const scene *s, const world_state *w, fx_t x1, fx_t y1, fx
     c.z2 = z2;
     /* one grid step wider than the segment, so no seg the grid test can see is culled */
     int64_t e = (int64_t)1 << G_SHIFT;
-    rbox b = {min64(ax, bx) - e, min64(ay, by) - e, max64(ax, bx) + e, max64(ay, by) + e};
-    gpt line[2] = {c.p, c.q};
+    query_box b = {min64(ax, bx) - e, min64(ay, by) - e, max64(ax, bx) + e, max64(ay, by) + e};
+    grid_pt line[2] = {c.p, c.q};
     return !walk_leaves(s, &b, line, sight_leaf, &c);
 }

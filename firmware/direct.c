@@ -316,10 +316,10 @@ static uint32_t first_at_or_east(const dr_state *S, int32_t x)
 static void activate_objects_in(dr_state *S, uint32_t leaf)
 {
     const scn_leaf *f = &S->sc->leaves[leaf];
-    int32_t box[4];
+    int32_t box[BOX_SIDES];
     objd_leaf_box(S->sc, f, box);
-    if (box[0] > box[2]) return;
-    int32_t west = (box[0] >> 16) - 2 * S->reach - 1, east = box[2] >> 16;
+    if (box[BOX_LEFT] > box[BOX_RIGHT]) return;
+    int32_t west = (box[BOX_LEFT] >> 16) - 2 * S->reach - 1, east = box[BOX_RIGHT] >> 16;
     for (uint32_t i = first_at_or_east(S, west); i < S->nobjs && S->objs[i].left <= east; i++) {
         dr_obj *o = &S->objs[i];
         const obj_state *os = &S->w->objs[o->index];

@@ -7,8 +7,8 @@ scene_status eng_init(engine *e, const void *blob, uint32_t len, scene_error *er
     scene_status st = scene_load(&e->sc, blob, len, err);
     if (st != SCENE_OK) return st;
     e->mode = render_mode_default();
-    e->work.mem = e->rwork.mem = 0;
-    e->work.bytes = e->rwork.bytes = 0;
+    e->work.mem = e->renderer_work.mem = 0;
+    e->work.bytes = e->renderer_work.bytes = 0;
     e->world = (world_state){0, 0, 0, 0};
     e->t_ms = 0;
     e->present = HAL_PRESENT_FLIP;
@@ -42,8 +42,8 @@ int eng_set_work(engine *e, void *mem, uint32_t bytes)
     if (obj_init(&e->world, &e->sc, mem, world) != 0) return -1;
     e->work.mem = mem;
     e->work.bytes = bytes;
-    e->rwork.mem = (uint8_t *)mem + world; /* world is a multiple of 8: the rest stays aligned */
-    e->rwork.bytes = bytes - world;
+    e->renderer_work.mem = (uint8_t *)mem + world; /* world is a multiple of 8: the rest stays aligned */
+    e->renderer_work.bytes = bytes - world;
     e->t_ms = 0;
     return 0;
 }
@@ -58,7 +58,7 @@ void eng_render(engine *e, uint32_t *ids)
     hal_surface surf = hal_begin_frame(e->present);
     hal_tally tally = {{0, 0, 0}, 0};
     rast_target t = {&surf, ids, hal_surface_linear(&surf) ? &tally : 0, e->flat};
-    render_frame(&e->sc, world_of(e), &e->cam.view, e->mode, &t, &e->rwork, &e->stats);
+    render_frame(&e->sc, world_of(e), &e->cam.view, e->mode, &t, &e->renderer_work, &e->stats);
     if (t.tally) hal_add_tally(&surf, &tally);
     hal_present(e->present);
     e->frame++;

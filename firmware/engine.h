@@ -19,8 +19,8 @@ typedef struct {
     uint8_t flat;           /* 1: a textured scene is drawn in its flat colours */
     uint32_t frame;         /* frames rendered since eng_init */
     render_stats stats;     /* of the last frame */
-    render_work work;       /* given by the target: eng_set_work */
-    render_work rwork;      /* the renderer's part of it (after the world state) */
+    render_work work;          /* given by the target: eng_set_work */
+    render_work renderer_work; /* the renderer's part of it (after the world state) */
     world_state world;      /* objects and doors now, in the work area; unset (NULL arrays) before eng_set_work */
     uint32_t t_ms;          /* time since eng_init: the sum of eng_step's dt */
 } engine;

@@ -18,7 +18,7 @@
  * takes in one leaf more. */
 #include "eye.h"
 
-#define EYE_STACK (CFG_MAX_DEPTH + 2)
+#include "bsp_walk.h" /* WALK_STACK_MAX */
 
 /* Room the eye needs from the boundary, in 16.16 map units: twice the near
  * plane's distance plus one view-space step. Within the 90-degree field of
@@ -109,7 +109,7 @@ static int clear_of_walls(const scene *sc, const world_state *w, const scn_leaf 
 
 int eye_in_world(const scene *sc, const world_state *w, const view_xform *v)
 {
-    uint32_t stack[EYE_STACK];
+    uint32_t stack[WALK_STACK_MAX];
     int top = 0, found = 0;
     stack[top++] = sc->root;
     while (top > 0) {
@@ -129,7 +129,7 @@ int eye_in_world(const scene *sc, const world_state *w, const view_xform *v)
         int side = side_of(node->x, node->y, node->dx, node->dy, v->cx, v->cy, EYE_MARGIN_X);
         if (side <= 0) stack[top++] = node->child[0];
         if (side >= 0) {
-            if (top == EYE_STACK) return 0; /* cannot happen for a loaded scene: depth is checked */
+            if (top == WALK_STACK_MAX) return 0; /* cannot happen for a loaded scene: depth is checked */
             stack[top++] = node->child[1];
         }
     }

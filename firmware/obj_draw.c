@@ -139,16 +139,16 @@ int objd_front(const objd_plane *s, int s_obj, const objd_plane *p, int p_obj, i
 
 /* ---- the object in the tree ------------------------------------------------------ */
 
-void objd_leaf_box(const scene *sc, const scn_leaf *f, int32_t box[4])
+void objd_leaf_box(const scene *sc, const scn_leaf *f, int32_t box[BOX_SIDES])
 {
     const scn_vertex *p = &sc->pverts[f->first_pvert];
-    box[0] = box[1] = INT32_MAX;
-    box[2] = box[3] = INT32_MIN;
+    box[BOX_LEFT] = box[BOX_BOTTOM] = INT32_MAX;
+    box[BOX_RIGHT] = box[BOX_TOP] = INT32_MIN;
     for (uint32_t i = 0; i < f->num_pverts; i++) {
-        if (p[i].x < box[0]) box[0] = p[i].x;
-        if (p[i].y < box[1]) box[1] = p[i].y;
-        if (p[i].x > box[2]) box[2] = p[i].x;
-        if (p[i].y > box[3]) box[3] = p[i].y;
+        if (p[i].x < box[BOX_LEFT]) box[BOX_LEFT] = p[i].x;
+        if (p[i].y < box[BOX_BOTTOM]) box[BOX_BOTTOM] = p[i].y;
+        if (p[i].x > box[BOX_RIGHT]) box[BOX_RIGHT] = p[i].x;
+        if (p[i].y > box[BOX_TOP]) box[BOX_TOP] = p[i].y;
     }
 }
 
@@ -156,13 +156,13 @@ void objd_leaf_box(const scene *sc, const scn_leaf *f, int32_t box[4])
  * Offsets are shifted (edges by 1, corners by 3) so the cross products stay
  * below 2^60.03 (box offsets below 2^32.03 raw, shifted by 3; edge directions
  * below 2^32 raw, shifted by 1). */
-int objd_touches_leaf(const scene *sc, const obj_state *o, const scn_leaf *f, const int32_t box[4])
+int objd_touches_leaf(const scene *sc, const obj_state *o, const scn_leaf *f, const int32_t box[BOX_SIDES])
 {
     int64_t r = sc->models[o->model].radius;
     int64_t bx0 = (int64_t)o->x - r, by0 = (int64_t)o->y - r, bx1 = (int64_t)o->x + r, by1 = (int64_t)o->y + r;
     const scn_vertex *p = &sc->pverts[f->first_pvert];
     uint32_t n = f->num_pverts;
-    if (n < 3 || box[0] > bx1 || box[2] < bx0 || box[1] > by1 || box[3] < by0) return 0;
+    if (n < 3 || box[BOX_LEFT] > bx1 || box[BOX_RIGHT] < bx0 || box[BOX_BOTTOM] > by1 || box[BOX_TOP] < by0) return 0;
     for (uint32_t i = 0; i < n; i++) {
         const scn_vertex *a = &p[i], *b = &p[i + 1 == n ? 0 : i + 1];
         int64_t dx = fx_asr64((int64_t)b->x - a->x, 1), dy = fx_asr64((int64_t)b->y - a->y, 1);

@@ -74,14 +74,15 @@ void objd_plane_wall(const view_xform *v, const scn_vertex *a, const scn_vertex 
 int objd_front(const objd_plane *s, int s_obj, const objd_plane *p, int p_obj, int look, int px, int py);
 
 
-/* The bounding box of the leaf's floor polygon: xmin, ymin, xmax, ymax. */
-void objd_leaf_box(const scene *s, const scn_leaf *f, int32_t box[4]);
+/* The bounding box of the leaf's floor polygon (BOX_* sides; left > right:
+ * no polygon). */
+void objd_leaf_box(const scene *s, const scn_leaf *f, int32_t box[BOX_SIDES]);
 
 /* Does the object's box (origin +- its model's radius) reach into the leaf's
  * convex floor polygon (box: objd_leaf_box's)? A box within the rounding of an
  * edge counts as touching: the renderers that ask (direct, painter) only take
  * an object in a leaf early by it. */
-int objd_touches_leaf(const scene *s, const obj_state *o, const scn_leaf *f, const int32_t box[4]);
+int objd_touches_leaf(const scene *s, const obj_state *o, const scn_leaf *f, const int32_t box[BOX_SIDES]);
 
 /* 0 if the object's bounding cylinder is wholly outside the near, left or right plane. */
 int objd_in_view(const scene *s, const obj_state *o, const view_xform *v);

@@ -98,9 +98,9 @@ int occ_seg_columns(view_pt p, view_pt q, int *x0, int *x1)
     return 1;
 }
 
-void occ_box_columns(const view_xform *v, const int32_t box[4], int *x0, int *x1)
+void occ_box_columns(const view_xform *v, const int32_t box[BOX_SIDES], int *x0, int *x1)
 {
-    const int32_t xs[2] = {box[2], box[3]}, ys[2] = {box[1], box[0]};
+    const int32_t xs[2] = {box[BOX_LEFT], box[BOX_RIGHT]}, ys[2] = {box[BOX_BOTTOM], box[BOX_TOP]};
     int lo = VIEW_W, hi = 0;
     for (int i = 0; i < 4; i++) {
         view_pt p = view_point(v, xs[i & 1], ys[i >> 1], 0);

@@ -29,7 +29,7 @@ void occ_close(occ_columns *o, int x0, int x1);
  * is wholly outside the view. */
 int occ_seg_columns(view_pt p, view_pt q, int *x0, int *x1);
 
-/* Columns a bounding box (top, bottom, left, right) can cover, conservatively. */
-void occ_box_columns(const view_xform *v, const int32_t box[4], int *x0, int *x1);
+/* Columns a map box (BOX_* sides) can cover, conservatively. */
+void occ_box_columns(const view_xform *v, const int32_t box[BOX_SIDES], int *x0, int *x1);
 
 #endif

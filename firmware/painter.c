@@ -12,9 +12,10 @@
  * second, back to front, draws. Not exact, by
  * design: an object still overdraws the surfaces of its own leaf that are in
  * front of it, and two objects are ordered by their origins only. */
+#include "painter.h"
+
 #include "bsp_walk.h"
 #include "obj_draw.h"
-#include "render.h"
 #include "surfaces.h"
 
 #define PAINTER_BACKGROUND 0
@@ -70,11 +71,11 @@ static int place_objects(void *ctx, uint32_t leaf, unsigned clip_mask)
     painter *p = ctx;
     (void)clip_mask;
     const scn_leaf *f = &p->sc->leaves[leaf];
-    int32_t box[4];
+    int32_t box[BOX_SIDES];
     objd_leaf_box(p->sc, f, box);
     p->visits++;
-    if (box[0] > box[2]) return 0;
-    int32_t west = (box[0] >> 16) - 2 * p->reach - 1, east = box[2] >> 16;
+    if (box[BOX_LEFT] > box[BOX_RIGHT]) return 0;
+    int32_t west = (box[BOX_LEFT] >> 16) - 2 * p->reach - 1, east = box[BOX_RIGHT] >> 16;
     uint32_t lo = 0, hi = p->nobjs;
     while (lo < hi) { /* the first object whose west edge is at or east of west */
         uint32_t mid = lo + (hi - lo) / 2;
@@ -104,9 +105,10 @@ static int draw_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
     return 0;
 }
 
-/* Drawing order: the leaf drawn first (larger key) first, then farthest first
- * (larger depth), then by index: a stable, total order. */
-static int before(const pt_order *a, const pt_order *b)
+/* Drawing order, 1 if a is drawn before b: the leaf drawn first (larger key)
+ * first, then farthest first (larger depth), then by index: a stable, total
+ * order. */
+static int draws_before(const pt_order *a, const pt_order *b)
 {
     if (a->key != b->key) return a->key > b->key;
     return a->depth != b->depth ? a->depth > b->depth : a->index < b->index;
@@ -147,7 +149,7 @@ static void draw_object(const scene *sc, uint32_t i, const obj_state *o, const v
         faces[nf].key = 0;
         faces[nf].depth = pl.cz;
         faces[nf].index = f;
-        for (uint32_t k = nf++; k > 0 && before(&faces[k], &faces[k - 1]); k--) {
+        for (uint32_t k = nf++; k > 0 && draws_before(&faces[k], &faces[k - 1]); k--) {
             pt_order x = faces[k];
             faces[k] = faces[k - 1];
             faces[k - 1] = x;
@@ -165,21 +167,21 @@ static void draw_object(const scene *sc, uint32_t i, const obj_state *o, const v
 }
 
 void painter_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t,
-                    const render_work *work, render_stats *st)
+                    render_stats *st, void *work, uint32_t work_bytes)
 {
     painter p = {sc, w, v, t, st, {fill_polygon, 0}, 0, 0, 0, 0, 0};
     walk_stats ws;
     uint32_t nobj = (CFG_OBJECTS && w && w->objs) ? w->n : 0;
-    if (nobj && (!work || !work->mem || work->bytes < painter_work_bytes(sc, w))) {
+    if (nobj && (!work || work_bytes < painter_work_bytes(sc, w))) {
         st->refused = 1; /* no room to order the objects */
-        render_clear(t, PAINTER_BACKGROUND);
+        rast_clear(t, PAINTER_BACKGROUND);
         return;
     }
     p.sink.ctx = &p;
     p.sink.flat = t->flat;
-    render_clear(t, PAINTER_BACKGROUND);
+    rast_clear(t, PAINTER_BACKGROUND);
     if (nobj) {
-        pt_order *order = work->mem, *tmp = order + nobj;
+        pt_order *order = work, *tmp = order + nobj;
         uint32_t n = 0;
         for (uint32_t i = 0; i < nobj; i++) {
             const obj_state *o = &w->objs[i];
@@ -195,7 +197,7 @@ void painter_render(const scene *sc, const world_state *w, const view_xform *v, 
         uint32_t placed = 0; /* objects in no visited leaf are not drawn */
         for (uint32_t k = 0; k < n; k++)
             if (order[k].key) order[placed++] = order[k];
-        sort_by(order, tmp, placed, before);
+        sort_by(order, tmp, placed, draws_before);
         st->objects_visible = placed;
         p.nobjs = placed;
     }

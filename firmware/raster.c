@@ -136,3 +136,9 @@ uint32_t rast_convex(const rast_target *t, const screen_pt *pts, int n, const te
     }
     return drawn;
 }
+
+void rast_clear(const rast_target *t, uint8_t colour)
+{
+    tex_paint paint = tex_flat(colour);
+    for (int y = 0; y < VIEW_H; y++) rast_span(t, y, 0, VIEW_W, &paint, RAST_ID(RAST_KIND_NONE, 0));
+}

@@ -153,4 +153,7 @@ void rast_rows(const screen_pt *pts, int n, int top, int bottom, int16_t lo[VIEW
  * collapsed by rounding) covers nothing. Returns the pixels drawn. */
 uint32_t rast_convex(const rast_target *t, const screen_pt *pts, int n, const tex_paint *paint, uint32_t id);
 
+/* Fill the whole frame in one flat colour, with the id of no surface. */
+void rast_clear(const rast_target *t, uint8_t colour);
+
 #endif

@@ -2,6 +2,7 @@
 #include "render.h"
 
 #include "direct.h"
+#include "painter.h"
 #include "spans.h"
 
 static const char *const mode_names[RENDER_MODE_COUNT] = {"spans", "painter", "direct"};
@@ -44,12 +45,6 @@ render_mode render_mode_next(render_mode m)
     return m;
 }
 
-void render_clear(const rast_target *t, uint8_t colour)
-{
-    tex_paint paint = tex_flat(colour);
-    for (int y = 0; y < VIEW_H; y++) rast_span(t, y, 0, VIEW_W, &paint, RAST_ID(RAST_KIND_NONE, 0));
-}
-
 static uint32_t max_u32(uint32_t a, uint32_t b)
 {
     return a > b ? a : b;
@@ -59,7 +54,7 @@ uint32_t render_work_bytes(const scene *s, const world_state *w)
 {
     uint32_t need = 0, b;
     if (CFG_MODE(CFG_MODE_SPANS)) {
-        if ((b = span_work_bytes(s, w)) == 0) return 0; /* beyond 32 bits: refuse the scene */
+        if ((b = spans_work_bytes(s, w)) == 0) return 0; /* beyond 32 bits: refuse the scene */
         need = max_u32(need, b);
     }
     if (CFG_MODE(CFG_MODE_DIRECT)) {
@@ -83,7 +78,7 @@ void render_frame(const scene *s, const world_state *w, const camera *cam, rende
     if (!built(mode)) mode = render_mode_default();
     switch (mode) {
     case RENDER_PAINTER:
-        if (CFG_MODE(CFG_MODE_PAINTER)) painter_render(s, w, &v, t, work, st);
+        if (CFG_MODE(CFG_MODE_PAINTER)) painter_render(s, w, &v, t, st, work ? work->mem : 0, work ? work->bytes : 0);
         break;
     case RENDER_SPANS:
         if (CFG_MODE(CFG_MODE_SPANS)) spans_render(s, w, &v, t, st, work ? work->mem : 0, work ? work->bytes : 0);

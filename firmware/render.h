@@ -1,4 +1,7 @@
-/* render.h - one frame of the world, in a selectable mode (prefix render_). */
+/* render.h - one frame of the world, in a selectable mode (prefix render_): the
+ * dispatcher over the modes (direct.h, spans.h, painter.h). Nothing below it
+ * includes it: the modes share the lower layers (surfaces.h, raster.h,
+ * render_stats.h), never this file. */
 #ifndef RENDER_H
 #define RENDER_H
 
@@ -25,7 +28,7 @@ int render_mode_parse(const char *name);
 render_mode render_mode_default(void);
 render_mode render_mode_next(render_mode m);
 
-/* Work memory for the modes (spans.h, direct.h, painter_work_bytes). */
+/* Work memory for the modes (direct.h, spans.h, painter.h). */
 typedef struct {
     void *mem;
     uint32_t bytes;
@@ -42,15 +45,5 @@ uint32_t render_work_bytes(const scene *s, const world_state *w);
  * drawn: the background only, and stats->refused. stats may be NULL. */
 void render_frame(const scene *s, const world_state *w, const camera *cam, render_mode mode, const rast_target *t,
                   const render_work *work, render_stats *stats);
-
-/* Shared by the modes. */
-void render_clear(const rast_target *t, uint8_t colour);
-
-/* Draw the back-to-front (painter) frame; each object right after the nearest
- * visited leaf its box touches (the leaves' numbers and the objects' order need
- * painter_work_bytes of the work memory). */
-void painter_render(const scene *s, const world_state *w, const view_xform *v, const rast_target *t,
-                    const render_work *work, render_stats *st);
-uint32_t painter_work_bytes(const scene *s, const world_state *w);
 
 #endif

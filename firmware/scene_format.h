@@ -115,9 +115,13 @@ typedef struct {
     uint32_t side;   /* 0 front, 1 back of the linedef [index: 2] */
 } scn_seg;
 
+/* The sides of a map box, in the order a node's child boxes keep them (and
+ * every other box of map coordinates in the core): box[BOX_TOP] is ymax. */
+enum { BOX_TOP, BOX_BOTTOM, BOX_LEFT, BOX_RIGHT, BOX_SIDES };
+
 typedef struct {
     int32_t x, y, dx, dy;  /* partition line through (x,y) along (dx,dy), 16.16; front = right side */
-    int32_t bbox[2][4];    /* [child][top, bottom, left, right]: ymax, ymin, xmin, xmax, 16.16 */
+    int32_t bbox[2][BOX_SIDES]; /* [child][BOX_*]: ymax, ymin, xmin, xmax, 16.16 */
     uint32_t child[2];     /* 0 front (right), 1 back; SCN_LEAF_BIT marks a leaf [child] */
 } scn_node;
 

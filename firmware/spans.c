@@ -121,8 +121,8 @@ static void layout(const scene *s, const world_state *w, span_layout *L)
     object_bound(s, w, &faces, &oedges, &objs);
     /* the world's part: what the build allows, or less when the compiler proved
      * that no frame of this scene needs more (docs/needs.md); at least one polygon */
-    L->world_edges = min_u64(s->needs->edges, SPAN_POOL_EDGES);
-    L->world_surfs = min_u64(s->needs->surfaces, SPAN_POOL_SURFACES);
+    L->world_edges = min_u64(s->needs->edges, SPANS_POOL_EDGES);
+    L->world_surfs = min_u64(s->needs->surfaces, SPANS_POOL_SURFACES);
     if (L->world_edges < POLY_EDGES) L->world_edges = POLY_EDGES;
     if (L->world_surfs < 1) L->world_surfs = 1;
     L->edges = L->world_edges + oedges;
@@ -134,7 +134,7 @@ static void layout(const scene *s, const world_state *w, span_layout *L)
                align8(L->objs * sizeof(sp_obj));
 }
 
-uint32_t span_work_bytes(const scene *s, const world_state *w)
+uint32_t spans_work_bytes(const scene *s, const world_state *w)
 {
     span_layout L;
     layout(s, w, &L);
@@ -270,40 +270,40 @@ static uint32_t collect_objects(span_state *S)
     return n;
 }
 
-static void box_add(int32_t box[4], const scn_vertex *p)
+static void box_add(int32_t box[BOX_SIDES], const scn_vertex *p)
 {
-    if (p->y > box[0]) box[0] = p->y;
-    if (p->y < box[1]) box[1] = p->y;
-    if (p->x < box[2]) box[2] = p->x;
-    if (p->x > box[3]) box[3] = p->x;
+    if (p->y > box[BOX_TOP]) box[BOX_TOP] = p->y;
+    if (p->y < box[BOX_BOTTOM]) box[BOX_BOTTOM] = p->y;
+    if (p->x < box[BOX_LEFT]) box[BOX_LEFT] = p->x;
+    if (p->x > box[BOX_RIGHT]) box[BOX_RIGHT] = p->x;
 }
 
 /* The objects whose box touches the leaf's bounding box (the compiler's: its
- * floor polygon and its segs; top, bottom, left, right) and that no earlier
+ * floor polygon and its segs) and that no earlier
  * leaf touched: this leaf's key is their kmin. */
 static void find_objects(span_state *S, uint32_t leaf)
 {
     const scene *sc = S->sc;
     const scn_leaf *f = &sc->leaves[leaf];
-    int32_t box[4] = {INT32_MIN, INT32_MAX, INT32_MAX, INT32_MIN};
+    int32_t box[BOX_SIDES] = {INT32_MIN, INT32_MAX, INT32_MAX, INT32_MIN}; /* empty */
     for (uint32_t i = 0; i < f->num_pverts; i++) box_add(box, &sc->pverts[f->first_pvert + i]);
     for (uint32_t i = 0; i < f->num_segs; i++) {
         const scn_seg *g = &sc->segs[f->first_seg + i];
         box_add(box, &sc->verts[g->v1]);
         box_add(box, &sc->verts[g->v2]);
     }
-    if (box[2] > box[3]) return; /* no geometry */
+    if (box[BOX_LEFT] > box[BOX_RIGHT]) return; /* no geometry */
     /* the first object that can reach the leaf from the left, by bisection */
-    int64_t from = (int64_t)box[2] - S->obj_span;
+    int64_t from = (int64_t)box[BOX_LEFT] - S->obj_span;
     uint32_t lo = 0, hi = S->nobjs;
     while (lo < hi) {
         uint32_t mid = lo + (hi - lo) / 2;
         if (S->objs[mid].x0 < from) lo = mid + 1;
         else hi = mid;
     }
-    for (uint32_t i = lo; i < S->nobjs && S->objs[i].x0 <= box[3]; i++) {
+    for (uint32_t i = lo; i < S->nobjs && S->objs[i].x0 <= box[BOX_RIGHT]; i++) {
         sp_obj *o = &S->objs[i];
-        if (o->kmin || o->x1 < box[2] || o->y0 > box[0] || o->y1 < box[1]) continue;
+        if (o->kmin || o->x1 < box[BOX_LEFT] || o->y0 > box[BOX_TOP] || o->y1 < box[BOX_BOTTOM]) continue;
         o->kmin = S->key;
         S->pending--;
     }
@@ -511,7 +511,9 @@ static int overtakes_at(span_state *S, sp_surf *top, sp_surf *p, int x, int y)
     return hi;
 }
 
-static void note(span_state *S, sp_next *n, sp_surf *top, sp_surf *p, int x, int y)
+/* Keep p's overtaking of top in *n if it comes before the one *n holds (at the
+ * same pixel: if p is nearer there than n's surface). */
+static void keep_sooner_overtake(span_state *S, sp_next *n, sp_surf *top, sp_surf *p, int x, int y)
 {
     int at = overtakes_at(S, top, p, x, y);
     if (at < n->x || (at == n->x && at < VIEW_W && in_front(S, p, n->s, at, y, 1))) {
@@ -521,10 +523,10 @@ static void note(span_state *S, sp_next *n, sp_surf *top, sp_surf *p, int x, int
 }
 
 /* The next overtaking of top from pixel x on. */
-static sp_next plan(span_state *S, sp_surf *top, int x, int y)
+static sp_next next_overtake(span_state *S, sp_surf *top, int x, int y)
 {
     sp_next n = {VIEW_W, 0};
-    for (sp_surf *p = top->below; p; p = p->below) note(S, &n, top, p, x, y);
+    for (sp_surf *p = top->below; p; p = p->below) keep_sooner_overtake(S, &n, top, p, x, y);
     return n;
 }
 
@@ -545,7 +547,7 @@ static sp_surf *overtake(span_state *S, sp_surf *top, sp_next *n, int *cur, int 
         emit_span(S, top, y, *cur, at);
         *cur = at;
         top = raise_surf(top, n->s);
-        *n = plan(S, top, at, y);
+        *n = next_overtake(S, top, at, y);
     }
     return top;
 }
@@ -575,7 +577,7 @@ static inline __attribute__((always_inline)) void scan_line(span_state *S, sp_ed
                 s->above = 0;
                 top->above = s;
                 top = s;
-                if (objects && nobj) next = plan(S, top, col, y);
+                if (objects && nobj) next = next_overtake(S, top, col, y);
             } else {                            /* slot it in below */
                 sp_surf *p = top;
                 while (!in_front(S, s, p->below, col, y, objects)) p = p->below;
@@ -583,7 +585,7 @@ static inline __attribute__((always_inline)) void scan_line(span_state *S, sp_ed
                 s->above = p;
                 p->below->above = s;
                 p->below = s;
-                if (objects && nobj) note(S, &next, top, s, col, y);
+                if (objects && nobj) keep_sooner_overtake(S, &next, top, s, col, y);
             }
         } else {
             if (--s->state != 0) continue;
@@ -594,11 +596,11 @@ static inline __attribute__((always_inline)) void scan_line(span_state *S, sp_ed
                 top = s->below;
                 top->above = 0;
                 if (objects && mixed) top = nearest(S, top, col, y);
-                if (objects) next = nobj ? plan(S, top, col, y) : (sp_next){VIEW_W, 0};
+                if (objects) next = nobj ? next_overtake(S, top, col, y) : (sp_next){VIEW_W, 0};
             } else if (s->below || s->above) {  /* leaves from inside the stack */
                 s->above->below = s->below;
                 s->below->above = s->above;
-                if (objects && s == next.s) next = nobj ? plan(S, top, col, y) : (sp_next){VIEW_W, 0};
+                if (objects && s == next.s) next = nobj ? next_overtake(S, top, col, y) : (sp_next){VIEW_W, 0};
             }
             s->below = s->above = 0;
         }
@@ -691,7 +693,7 @@ void spans_render(const scene *sc, const world_state *w, const view_xform *v, co
     layout(sc, w, &L);
     if (!work || L.total > 0xFFFFFFF0u || work_bytes < L.total) {
         st->refused = 1; /* the caller did not provide the memory this frame needs */
-        render_clear(t, BACKGROUND_COLOUR);
+        rast_clear(t, BACKGROUND_COLOUR);
         return;
     }
     uint8_t *mem = work;

@@ -1,4 +1,4 @@
-/* spans.h - render mode "spans": zero overdraw with sorted spans (prefix span_).
+/* spans.h - render mode "spans": zero overdraw with sorted spans (prefix spans_).
  *
  * The BSP tree is walked front to back; every visible leaf's surfaces (floor,
  * ceiling, wall parts) enter per-scan-line edge lists keyed by BSP order - the
@@ -16,7 +16,7 @@
  * claimed.
  *
  * Memory: all state lives in a caller-supplied work area of fixed-size pools
- * (edges, surfaces, 1/z planes), sized by the build (SPAN_POOL_*), or smaller
+ * (edges, surfaces, 1/z planes), sized by the build (SPANS_POOL_*), or smaller
  * when the compiler proved the scene never needs that many (docs/needs.md).
  * When a pool is full the frame is drawn in batches: what the pools hold is
  * drawn, every pixel it fills is marked, and the walk goes on behind it; later
@@ -27,28 +27,30 @@
 #define SPANS_H
 
 #include <stdint.h>
-#include "render.h"
+#include "objects.h"
+#include "raster.h"
+#include "render_stats.h"
 #include "scene.h"
 #include "view.h"
 
 /* World edges and surfaces one batch holds (a build may set them: -D or its
  * scene header). The defaults hold every view of the Freedoom maps measured so
  * far in one batch on the host (at most 1,688 edges and 514 surfaces). */
-#ifndef SPAN_POOL_EDGES
-#define SPAN_POOL_EDGES 2048u
+#ifndef SPANS_POOL_EDGES
+#define SPANS_POOL_EDGES 2048u
 #endif
-#ifndef SPAN_POOL_SURFACES
-#define SPAN_POOL_SURFACES 640u
+#ifndef SPANS_POOL_SURFACES
+#define SPANS_POOL_SURFACES 640u
 #endif
 
 /* Bytes of work memory spans_render needs for this scene and w's objects (w
  * NULL: none; see render_work_bytes), 0 if it would not fit in 32 bits: the
  * caller must refuse the scene. The world's part is fixed: min(the scene's
- * proven bound, SPAN_POOL_*) edges and surfaces. Objects add, for every face
+ * proven bound, SPANS_POOL_*) edges and surfaces. Objects add, for every face
  * of every object (all could be in view at once), a surface, its
  * clipping-maximal edges and a 1/z plane, a plane for every world surface of a
  * batch, and an entry per object for those in the frustum. */
-uint32_t span_work_bytes(const scene *s, const world_state *w);
+uint32_t spans_work_bytes(const scene *s, const world_state *w);
 
 /* w: doors and objects (NULL: the static world). Objects (docs/objects.md):
  * the walk finds, for each object in the frustum, the first visited leaf whose

@@ -8,7 +8,7 @@
 
 #include <stdint.h>
 #include "objects.h"
-#include "render.h"
+#include "render_stats.h"
 #include "scene.h"
 #include "texture.h"
 #include "occlusion.h"

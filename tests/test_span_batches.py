@@ -1,6 +1,6 @@
 """Modes spans and direct with pools of a few polygons draw the same frames as with the default pools.
 
-build/tinypools/render is build/render compiled with SPAN_POOL_EDGES=72 and SPAN_POOL_SURFACES=6,
+build/tinypools/render is build/render compiled with SPANS_POOL_EDGES=72 and SPANS_POOL_SURFACES=6,
 CFG_DIRECT_FACES=3 and CFG_DIRECT_EDGES=90 (the Makefile): in mode spans nearly every frame fills
 its pools many times, so it is drawn in many batches (firmware/spans.c); in mode direct the faces
 of all but an object or so do not fit, so they are worked out again wherever they are needed

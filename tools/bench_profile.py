@@ -95,12 +95,12 @@ STAGE_OF_FUNCTION = {
     "close_columns": COVER,          # surfaces.c: closing the columns a solid wall covers
     "obj_ceil": XFORM,               # objects.h: a sector's ceiling now (doors), read for its walls
     "rast_span": FILL,               # raster.c: one span to the target
-    "render_clear": FILL,
+    "rast_clear": FILL,
     "scene_node_side": WALK,         # scene.c: the walk's side of a partition
     "scene_model_edges": OBJECTS,    # scene.c: an object model's edges, for the edge bound
     # the set-up of a frame and of a mode, which no stage owns
     "spans_render": OTHER, "painter_render": OTHER, "layout": OTHER, "align8": OTHER,
-    "span_work_bytes": OTHER, "painter_work_bytes": OTHER,
+    "spans_work_bytes": OTHER, "painter_work_bytes": OTHER,
 }
 
 # Inlined helpers whose instructions count for the function they were inlined into.
