@@ -80,7 +80,7 @@ $(BOARD_OUT)/display-board.dfu: $(BOARD_OUT)/display-board.app.bin $(BUILD)/flas
 
 # The host tool that writes the flash image through firmware/dfu's device (a DFU
 # download over the loopback transport).
-BOARD_IMAGE_SRC := tools/board_image.c host/flash/dfu_host.c host/flash/dfu_loopback.c \
+BOARD_IMAGE_SRC := host/flash/board_image.c host/flash/dfu_host.c host/flash/dfu_loopback.c \
                    firmware/dfu/dfu_device.c firmware/dfu/dfu_image.c firmware/dfu/dfu_proto.c firmware/crc32.c
 $(BUILD)/board_image: $(patsubst %.c,$(BUILD)/obj/%.o,$(BOARD_IMAGE_SRC))
 	$(CC) $(REL) $^ -o $@

@@ -57,3 +57,11 @@ def test_a_long_circle_and_the_include_path(tmp_path):
     graph = include_graph.module_graph(str(tmp_path))
     assert include_graph.core_cycles(graph) == [["firmware/b", "hal/a", "hal/c"]]
     assert graph["host/d"] == {"firmware/b"}
+
+
+def test_host_and_tools_depend_one_way():
+    """host/ uses the compiler's library in tools/ (scene loading, fxtext); nothing in tools/
+    includes host/ (issue 19: the arrow points one way)."""
+    graph = include_graph.module_graph(str(ROOT))
+    assert include_graph.cross_edges(graph, "host", "tools"), "host/ no longer uses tools/: update this test"
+    assert include_graph.cross_edges(graph, "tools", "host") == []
