@@ -41,6 +41,16 @@ LINK_SRC   := $(wildcard hal/serial/*.c)
 BARE_SRC   := $(sort $(wildcard hal/bare/*.c))
 UNIT_EXTRA := tests/unit/scene_fixture.c
 EXTRA_NOFLOAT_SRC :=
+# The float checks (tools/check_nofloat.sh) take seconds, so each set of files is
+# checked again only when a file of it, a header it can include, the script or the
+# list of files changes: a stamp per set under build/nofloat/, next to the list it
+# was made for (nofloat_list rewrites that list only when it differs, so adding or
+# dropping a file, EXTRA_NOFLOAT=... included, reruns the check).
+NOFLOAT_DIR  := $(BUILD)/nofloat
+NOFLOAT_DEPS  = tools/check_nofloat.sh $(GEN)/fx_tables.c \
+                $(wildcard firmware/*.h firmware/*/*.h hal/*.h hal/*/*.h)
+nofloat_list  = $(shell mkdir -p $(NOFLOAT_DIR); f=$(NOFLOAT_DIR)/$(1).list; \
+                printf '%s\n' '$(2)' | cmp -s - $$f || printf '%s\n' '$(2)' > $$f; echo $$f)
 -include $(sort $(wildcard mk/*.mk))
 
 objs = $(patsubst %.c,$(1)/%.o,$(2))
@@ -169,8 +179,10 @@ run: deps all
 # in the code (comments stripped), the host compile with -mgeneral-regs-only above,
 # and a Cortex-M soft-float compile whose objects may not need any float helper.
 NOFLOAT_SRC = $(sort $(FW_SRC) $(HAL_SRC) $(NULL_SRC) $(SDL_SRC) $(LINK_SRC) $(EXTRA_NOFLOAT_SRC)) $(EXTRA_NOFLOAT)
-nofloat: $(GEN)/fx_tables.c
+nofloat: $(NOFLOAT_DIR)/core.ok
+$(NOFLOAT_DIR)/core.ok: $(NOFLOAT_SRC) $(NOFLOAT_DEPS) $(call nofloat_list,core,$(NOFLOAT_SRC))
 	@tools/check_nofloat.sh $(NOFLOAT_SRC)
+	@touch $@
 
 unit: $(addprefix $(BUILD)/san/,$(UNIT_TESTS))
 	@set -e; for t in $^; do echo "== $$t"; $$t; done

@@ -39,9 +39,11 @@ board_ld = -T hal/mps2/mps2.ld -Wl,--gc-sections -Wl,--defsym=MPS2_ROM_ORIGIN=$(
 # the images for soft-float helpers too).
 .PHONY: nofloat-board
 nofloat: nofloat-board
-nofloat-board: $(GEN)/fx_tables.c
+nofloat-board: $(NOFLOAT_DIR)/board.ok
+$(NOFLOAT_DIR)/board.ok: hal/board/main.c hal/board/board_args.c hal/board/boot.c $(NOFLOAT_DEPS)
 	@printf 'hal/board: '; NOFLOAT_INC='-Ihal/mps2 -Ihal/serial -Ihal/board' tools/check_nofloat.sh hal/board/main.c hal/board/board_args.c
 	@printf 'hal/board (bootloader): '; NOFLOAT_INC='-Ihal/mps2 -Ihal/board' tools/check_nofloat.sh hal/board/boot.c
+	@touch $@
 
 # No image may link libgcc's floating-point helpers.
 board_nofloat = helpers=$$($(ARMNM) $(1) | awk '{print $$NF}' | grep -E $(ARM_FLOAT_HELPERS)); \

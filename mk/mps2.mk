@@ -106,8 +106,11 @@ ARM_FLOAT_HELPERS := '^__aeabi_([fd]|[a-z]*2[fd]$$)|^__(add|sub|mul|div|neg|fix|
 # check's combined link); the firmware link below checks the whole image.
 .PHONY: nofloat-mps2
 nofloat: nofloat-mps2
-nofloat-mps2: $(GEN)/fx_tables.c
-	@printf 'hal/mps2: '; tools/check_nofloat.sh $(filter-out hal/mps2/stream_fl.c,$(MPS2_ALL_SRC))
+MPS2_NOFLOAT_SRC := $(filter-out hal/mps2/stream_fl.c,$(MPS2_ALL_SRC))
+nofloat-mps2: $(NOFLOAT_DIR)/mps2.ok
+$(NOFLOAT_DIR)/mps2.ok: $(MPS2_NOFLOAT_SRC) $(NOFLOAT_DEPS) $(call nofloat_list,mps2,$(MPS2_NOFLOAT_SRC))
+	@printf 'hal/mps2: '; tools/check_nofloat.sh $(MPS2_NOFLOAT_SRC)
+	@touch $@
 
 .PHONY: firmware run-firmware insn-plugin bench-m3 count-m3 FORCE
 FORCE:

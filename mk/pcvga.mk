@@ -43,8 +43,10 @@ PC_FLOAT_HELPERS := '^__(add|sub|mul|div|neg|fix|fixuns|float|floatun|extend|tru
 
 # hal/pcvga is a target like the others: no floating point (`make nofloat`).
 nofloat: nofloat-pcvga
-nofloat-pcvga: $(GEN)/fx_tables.c
+nofloat-pcvga: $(NOFLOAT_DIR)/pcvga.ok
+$(NOFLOAT_DIR)/pcvga.ok: $(PCVGA_SRC) $(NOFLOAT_DEPS) $(call nofloat_list,pcvga,$(PCVGA_SRC))
 	@printf 'hal/pcvga: '; tools/check_nofloat.sh $(PCVGA_SRC)
+	@touch $@
 
 pcvga: $(PC_OUT)/kernel.elf
 

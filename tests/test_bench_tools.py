@@ -163,3 +163,16 @@ def test_firmware_no_objects_draws_the_world_alone(tmp_path):
     assert alone != things                  # objects are in view: the option has something to leave out
     assert firmware("--no-objects") == alone
     assert firmware() == things
+
+
+def test_document_keeps_sections_no_generator_writes(tmp_path, monkeypatch):
+    # the other targets' figures (make bench-bsp, bench-size, ...) sit in sections of their own
+    doc, x86 = tmp_path / "benchmarks.md", tmp_path / "bench.md"
+    monkeypatch.setattr(bench_doc, "DOC", doc)
+    monkeypatch.setattr(bench_doc, "SECTIONS", {"x86": ("x86", "make bench", "tools/bench.py", x86)})
+    doc.write_text("# old head\n<!-- section bsp -->\n## bsp figures\n<!-- end bsp -->\n")
+    x86.write_text("x86 figures\n")
+    bench_doc.write("x86")
+    text = doc.read_text()
+    assert "x86 figures" in text and "## bsp figures" in text
+    assert text.index("x86 figures") < text.index("## bsp figures")
