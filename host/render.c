@@ -412,21 +412,24 @@ static int refuse_beyond_scene(const options *o, const scene *s)
  * all. The same answer as the compiler's winding number for closed sectors. */
 static int in_void(const scene *s, fx_t x, fx_t y)
 {
-    int64_t best_hx = -1, best_dy = 1; /* the nearest crossing so far, hx / dy past x; none yet */
+    __int128 best_hx = -1;             /* the nearest crossing so far, best_hx / best_dy past x; none yet */
+    int64_t best_dy = 1;
     uint32_t sector = SCN_NONE;
     for (uint32_t i = 0; i < s->nlines; i++) {
         const scn_line *l = &s->lines[i];
         const scn_vertex *a = &s->verts[l->v1], *b = &s->verts[l->v2];
         if ((a->y > y) == (b->y > y)) continue; /* half-open: a vertex on the ray counts once */
         /* where the wall crosses the ray's line, as hx / dy past x (dy != 0) */
-        int64_t dy = (int64_t)b->y - a->y, hx = ((int64_t)a->x - x) * dy + ((int64_t)b->x - a->x) * ((int64_t)y - a->y);
+        int64_t dy = (int64_t)b->y - a->y;
+        __int128 hx = (__int128)((int64_t)a->x - x) * dy + (__int128)((int64_t)b->x - a->x) * ((int64_t)y - a->y);
         if (dy < 0) {
             dy = -dy;
             hx = -hx;
         }
         if (hx < 0) continue;
-        /* hx / dy against the best so far without dividing (|hx| < 2^50, dy < 2^33) */
-        if (best_hx >= 0 && (__int128)hx * best_dy >= (__int128)best_hx * dy) continue;
+        /* hx / dy against the best so far without dividing: 16.16 coordinates
+         * differ by less than 2^33, so |hx| < 2^67 and dy < 2^33, products < 2^100 */
+        if (best_hx >= 0 && hx * best_dy >= best_hx * dy) continue;
         best_hx = hx;
         best_dy = dy;
         /* the front side is on the right going v1 -> v2: a wall going up (north)
