@@ -81,7 +81,7 @@ $(2)/obj/%.o: %.c $(GEN)/fx_tables.c $(KNOB)/$(1)/flags
 	@mkdir -p $$(@D)
 	$$(CC) $$(BASE) $(3) $$(KNOB_FLAGS_$(1)) $$(if $$(filter $$(FLOATFREE),$$<),$$(FW_FLAGS)) -MMD -MP -c $$< -o $$@
 $(2)/render: $(patsubst %.c,$(2)/obj/%.o,$(KNOB_SRC)) $(patsubst %.c,$(4)/obj/%.o,$(KNOB_SHARED))
-	$$(CC) $(3) $$^ -o $$@ -lm
+	$$(CC) $(3) $$^ -o $$@ $$(PNG_LIBS) -lm
 endef
 
 # The flags a configuration was built with, rewritten only when they change, so
