@@ -486,6 +486,7 @@ def plot(path, points, no_ir):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib import ticker
 
     fams = sorted({family(p["config"], p["flags"]) for p in points} - {"default"})
     colours = {f: plt.get_cmap("tab10")(i % 10) for i, f in enumerate(fams)}
@@ -505,7 +506,9 @@ def plot(path, points, no_ir):
     for row, (key, ylabel, scale) in enumerate(rows):
         values = [p[key] * scale for p in points if p.get(key) is not None]
         positive = [v for v in values if v > 0]
-        lo, hi = (min(positive) / 2, max(positive) * 2) if positive else (0.1, 10.0)
+        # whole decades, at least one, so that the log axis has labelled ticks
+        lo = 10.0 ** np.floor(np.log10(min(positive))) if positive else 0.1
+        hi = 10.0 ** np.ceil(np.log10(max(positive) * 1.5)) if positive else 10.0
         for col, mode in enumerate(modes):
             ax = fig.add_subplot(grid[2 * row, col])
             zero = fig.add_subplot(grid[2 * row + 1, col], sharex=ax)
@@ -526,6 +529,8 @@ def plot(path, points, no_ir):
                 items[target].append((x, y, str(order[p["config"]] + 1), colours[fam]))
             ax.set_yscale("log")
             ax.set_ylim(lo, hi)
+            ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+            ax.yaxis.set_minor_formatter(ticker.NullFormatter())
             ax.margins(x=0.12)
             ax.grid(True, which="both", alpha=0.3)
             ax.tick_params(labelbottom=False)
