@@ -19,12 +19,16 @@ painter):
   counts them ((Ir of --repeat 3 - Ir of --repeat 1) / 2); the bench views are WAD maps, so these
   are textured frames.
 
-Writes OUT/report.md (default build/report/) with a table of every point, OUT/error_vs_ir.png
+Writes OUT/report.md (default build/report/): a summary per render mode (the best configurations
+by error, by texel-and-light error and by instructions, the default's place in each, and those no
+other beats on both error and instructions), a table of every point, OUT/error_vs_ir.png
 (mean differing share, worst edge displacement and mean texel-and-light error against median
-instructions per frame, the default configuration marked), and a per-scene table of the extreme scenes for the default
+instructions per frame, on log axes with a band for exact zeros, points numbered with a key, the
+default configuration marked), and a per-scene table of the extreme scenes for the default
 configuration. Reference id buffers are kept in OUT/ref/, and every measured figure in
 OUT/cache.json keyed by the binary's and the scene's contents, so a re-run only measures what
-changed. Progress goes to stderr. A report, not a test: it asserts nothing about the figures.
+changed. Progress goes to stderr: tasks and configurations done, and the time left at the mean
+so far. A report, not a test: it asserts nothing about the figures.
 
 usage: tools/report.py [--configs NAME ...] [--views N] [--tex-views N] [--no-ir] [--jobs N] [--out DIR]
 """
@@ -348,7 +352,8 @@ def summary_lines(points):
                      f"({pct(min(p['mean_differ'] for p in pts))} of pixels differ)")
         tex = [p for p in pts if p["tex_bad_mean"] is not None]
         if tex:
-            lines[-1] += f"; fewest texels off: {best(tex, 'tex_bad_mean')} ({pct(min(p['tex_bad_mean'] for p in tex))})"
+            low = min(p["tex_bad_mean"] for p in tex)
+            lines[-1] += f"; fewest texels off: {best(tex, 'tex_bad_mean')} ({pct(low)})"
         timed = [p for p in pts if p["ir"] is not None]
         if timed:
             lines[-1] += f"; fewest instructions: {best(timed, 'ir')} ({min(p['ir'] for p in timed):,} per frame)"
