@@ -147,7 +147,8 @@ help:
 	@echo "                -> build/mutate/report.md and docs/benchmarks.md; not part of make test"
 	@echo "make bench-bsp  bspc over all 68 Freedoom maps per strategy, beside zdbsp and glbsp"
 	@echo "make report     error against the reference vs instructions per frame, per render mode and"
-	@echo "                precision-knob configuration (mk/report.mk) -> build/report/report.md and plots"
+	@echo "                precision-knob configuration (mk/report.mk) -> build/report/report.md and plots;"
+	@echo "                REPORT_CONFIGS=\"default subpix0\" for a few, REPORT_ARGS=\"--views 4\", V=1 shows the compiles"
 	@echo "make clean      remove build/"
 
 deps:
