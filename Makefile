@@ -9,6 +9,8 @@ ARMCC   := arm-none-eabi-gcc
 
 SDL_CFLAGS := $(shell sdl2-config --cflags 2>/dev/null)
 SDL_LIBS   := $(shell sdl2-config --libs 2>/dev/null)
+# host/png.c, linked into every program that takes HOST_LIB or host/png.c
+PNG_LIBS   := $(shell pkg-config --libs libpng 2>/dev/null || echo -lpng)
 
 WARN     := -Wall -Wextra -Wshadow -Wstrict-prototypes -Wno-missing-field-initializers
 INC      := -Ifirmware -Ihal -Ihal/null -Ihal/sdl -Ihal/serial -Itools/bspc -Ihost
@@ -68,11 +70,11 @@ $(1)/obj/$(GEN)/%.o: $(GEN)/%.c
 $(1)/bspc: $(call objs,$(1)/obj,tools/bspc/main.c $(BSPC_LIB) tools/bspc/crc_fast.c firmware/scene.c)
 	$$(CC) $(2) $$^ -o $$@ -lm
 $(1)/render: $(call objs,$(1)/obj,host/render.c $(HOST_ENG) $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC))
-	$$(CC) $(2) $$^ -o $$@ -lm
+	$$(CC) $(2) $$^ -o $$@ $$(PNG_LIBS) -lm
 $(1)/emu: $(call objs,$(1)/obj,host/emu.c $(HOST_ENG) $(GEN)/default_scene.c $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(SDL_SRC))
-	$$(CC) $(2) $$^ -o $$@ $$(SDL_LIBS) -lm
+	$$(CC) $(2) $$^ -o $$@ $$(SDL_LIBS) $$(PNG_LIBS) -lm
 $(1)/display: $(call objs,$(1)/obj,host/display.c host/png.c host/port.c firmware/crc32.c $(HAL_SRC) $(SDL_SRC) $(sort $(LINK_SRC)))
-	$$(CC) $(2) $$^ -o $$@ $$(SDL_LIBS)
+	$$(CC) $(2) $$^ -o $$@ $$(SDL_LIBS) $$(PNG_LIBS)
 # test_planar brings its own fake VGA target (hal_target_*): only fb.c and perf.c beside it
 $(1)/test_planar: $(call objs,$(1)/obj,tests/unit/test_planar.c $(HAL_SRC))
 	$$(CC) $(2) $$^ -o $$@ -lcmocka
@@ -155,7 +157,8 @@ help:
 	@echo "                -> build/mutate/report.md and docs/benchmarks.md; not part of make test"
 	@echo "make bench-bsp  bspc over all 68 Freedoom maps per strategy, beside zdbsp and glbsp"
 	@echo "make report     error against the reference vs instructions per frame, per render mode and"
-	@echo "                precision-knob configuration (mk/report.mk) -> build/report/report.md and plots"
+	@echo "                precision-knob configuration (mk/report.mk) -> build/report/report.md and plots;"
+	@echo "                REPORT_CONFIGS=\"default subpix0\" for a few, REPORT_ARGS=\"--views 4\", V=1 shows the compiles"
 	@echo "make clean      remove build/"
 
 deps:

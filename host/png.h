@@ -1,4 +1,4 @@
-/* png.h - writing 8-bit palette PNG files (host only, no dependencies). */
+/* png.h - writing 8-bit palette PNG files (host only, libpng). */
 #ifndef HOST_PNG_H
 #define HOST_PNG_H
 

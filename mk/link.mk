@@ -17,9 +17,9 @@ LINK_SRC := $(sort $(wildcard hal/serial/*.c))
 
 FLTOOL_SRC := host/fltool.c $(HOST_ENG) $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC) $(LINK_SRC)
 $(BUILD)/fltool: $(patsubst %.c,$(BUILD)/obj/%.o,$(FLTOOL_SRC))
-	$(CC) $(REL) $^ -o $@ -lm
+	$(CC) $(REL) $^ -o $@ $(PNG_LIBS) -lm
 $(BUILD)/san/fltool: $(patsubst %.c,$(BUILD)/san/obj/%.o,$(FLTOOL_SRC))
-	$(CC) $(SAN) $^ -o $@ -lm
+	$(CC) $(SAN) $^ -o $@ $(PNG_LIBS) -lm
 
 # The tests run build/san/fltool (the decoder on damaged streams under ASan + UBSan).
 pytest: $(BUILD)/fltool $(BUILD)/san/fltool

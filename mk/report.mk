@@ -21,6 +21,9 @@
 # build/render draws.
 
 KNOB := $(BUILD)/knob
+# The configurations' compile lines (some 480 of them) are shown with V=1 only;
+# each finished binary is named instead.
+KNOB_Q := $(if $(filter 1,$(V)),,@)
 
 # name -> flags. A few values of each knob, from nearly exact to coarse, and one
 # configuration that combines cheap choices of three of them.
@@ -79,9 +82,10 @@ REPORT_FORCE:
 define knob_variant
 $(2)/obj/%.o: %.c $(GEN)/fx_tables.c $(KNOB)/$(1)/flags
 	@mkdir -p $$(@D)
-	$$(CC) $$(BASE) $(3) $$(KNOB_FLAGS_$(1)) $$(if $$(filter $$(FLOATFREE),$$<),$$(FW_FLAGS)) -MMD -MP -c $$< -o $$@
+	$$(KNOB_Q)$$(CC) $$(BASE) $(3) $$(KNOB_FLAGS_$(1)) $$(if $$(filter $$(FLOATFREE),$$<),$$(FW_FLAGS)) -MMD -MP -c $$< -o $$@
 $(2)/render: $(patsubst %.c,$(2)/obj/%.o,$(KNOB_SRC)) $(patsubst %.c,$(4)/obj/%.o,$(KNOB_SHARED))
-	$$(CC) $(3) $$^ -o $$@ -lm
+	$$(KNOB_Q)$$(CC) $(3) $$^ -o $$@ $$(PNG_LIBS) -lm
+	$$(if $$(KNOB_Q),@echo "report: built $$@")
 endef
 
 # The flags a configuration was built with, rewritten only when they change, so
@@ -100,8 +104,10 @@ KNOB_RENDERS := $(foreach c,$(REPORT_CONFIGS),$(KNOB)/$(c)/render)
 report-configs:
 	@$(foreach c,$(REPORT_CONFIGS),echo '$(c): $(strip $(KNOB_FLAGS_$(c)))';)
 
+# make report REPORT_CONFIGS="default subpix0": a few configurations only;
+# REPORT_ARGS: more options of tools/report.py (--views N, --tex-views N, --no-ir, --jobs N).
 report: deps $(BUILD)/bspc $(BUILD)/render $(KNOB_RENDERS)
-	$(PY) tools/report.py --configs $(REPORT_CONFIGS)
+	$(PY) tools/report.py --configs $(REPORT_CONFIGS) $(REPORT_ARGS)
 
 # tests/test_report.py renders with two knob configurations beside the default.
 pytest: $(KNOB)/default/render $(KNOB)/subpix0/render $(KNOB)/subpix0/san/render $(KNOB)/texlight2/render

@@ -62,7 +62,7 @@ $(1)/obj/%.o: %.c $(GEN)/fx_tables.c $(SCENE_OUT)/scene_config.h
 	@mkdir -p $$(@D)
 	$$(CC) $$(BASE) $(2) $$(SCENE_DEF) $$(call fwflags,$$<) $$(if $$(filter host/emu.c,$$<),$$(SDL_CFLAGS)) -MMD -MP -c $$< -o $$@
 $(1)/render: $(patsubst %.c,$(1)/obj/%.o,$(SCENE_SRC)) $(patsubst %.c,$(3)/obj/%.o,$(SCENE_SHARED))
-	$$(CC) $(2) $$^ -o $$@ -lm
+	$$(CC) $(2) $$^ -o $$@ $$(PNG_LIBS) -lm
 endef
 $(eval $(call scene_variant,$(SCENE_OUT),$(REL),$(BUILD)))
 $(eval $(call scene_variant,$(SCENE_OUT)/san,$(SAN),$(BUILD)/san))
@@ -76,7 +76,7 @@ $(SCENE_OUT)/obj/gen/scene_blob.o: $(SCENE_OUT)/gen/scene_blob.c
 	$(CC) $(BASE) $(REL) $(FW_FLAGS) -c $< -o $@
 $(SCENE_OUT)/emu: $(patsubst %.c,$(SCENE_OUT)/obj/%.o,$(FW_SRC) $(HOST_ENG) host/emu.c) $(SCENE_OUT)/obj/gen/scene_blob.o \
                   $(patsubst %.c,$(BUILD)/obj/%.o,$(HOST_LIB) $(BSPC_LIB) $(HAL_SRC) $(SDL_SRC))
-	$(CC) $(REL) $^ -o $@ $(SDL_LIBS) -lm
+	$(CC) $(REL) $^ -o $@ $(SDL_LIBS) $(PNG_LIBS) -lm
 
 scene-host: $(SCENE_OUT)/render $(SCENE_OUT)/san/render $(SCENE_OUT)/emu
 	@echo "scene-host: $(SCENE_OUT)/render, emu, san/render built for $(SCENE) ($$(sed -n 's/^#define CFG_FEATURES \(0x[0-9a-f]*\)u.*/features \1/p' $(SCENE_OUT)/scene_config.h))"

@@ -275,6 +275,10 @@ def test_cli(tmp_path):
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     a = accuracy.read_ids(ids)
     assert (a == refrender.render_ids(DEFAULT, -100, 160, 41, 0)).all()
+    from PIL import Image
+    with Image.open(png) as im:   # the false-colour picture of exactly these ids
+        assert (im.mode, im.size) == ("RGB", (320, 200))
+        assert (np.asarray(im) == refrender.false_colour(a)).all()
     run([PY, ROOT / "tools" / "refrender.py", DEFAULT, "--ids", ids])          # the player start
     assert (accuracy.read_ids(ids) == refrender.render_ids(DEFAULT, 96, 160, None, 20)).all()
     bad = run([PY, ROOT / "tools" / "refrender.py", tmp_path / "none.scene", "--ids", ids], check=False)

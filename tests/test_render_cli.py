@@ -80,6 +80,25 @@ def test_outputs_agree(compiled, tmp_path):
     assert all((v & 0xFFFFFF) < 1 << 20 for v in vals)
 
 
+@pytest.mark.parametrize("scene", [DEFAULT, "freedoom2.wad:MAP01"])
+def test_png_is_compressed_and_decodes_to_the_raw_frame(scene, tmp_path):
+    """host/png.c deflates: a frame of few colours is a small fraction of its 64,000 pixels (stored
+    blocks made every frame 64 KB), and any decoder (Pillow here) gives back the same palette indices
+    as --raw, in colour type 3 with the 256-entry palette."""
+    from PIL import Image
+    png, raw = tmp_path / "f.png", tmp_path / "f.bin"
+    render(scene, "-o", png, "--raw", raw)
+    frame = raw.read_bytes()
+    limit = 8000 if scene == DEFAULT else 32000
+    assert png.stat().st_size < limit, png.stat().st_size
+    with Image.open(png) as im:
+        assert (im.format, im.mode, im.size) == ("PNG", "P", (320, 200))
+        assert im.tobytes() == frame
+        assert len(im.getpalette()) == 768
+        palette = bytes(im.getpalette())
+    assert read_png_indexed(png)[3] == palette
+
+
 def test_repeat_renders_the_same_frame(compiled):
     one = render(str(compiled))
     many = render(str(compiled), "--repeat", "5")

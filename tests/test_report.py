@@ -140,3 +140,48 @@ def test_report_writes_tables_and_figure_from_fake_points(tmp_path):
     assert report.hist_percentile([0, 0, 5], 99) == 2 and report.hist_percentile([0] * 4, 99) == 0
     assert points[0]["worst_moved_edge"] == 2 and points[0]["worst_edge"] == report.CAP
     assert report.sparse_hist(np.array([3, 3, 400])) == [[3, 2], [report.CAP, 1]]
+
+
+def test_progress_gives_configurations_done_and_time_left():
+    groups = ["a"] * 4 + ["b"] * 4 + ["c"] * 2
+    line = report.progress("error", 4, 10, 8.0, groups)
+    assert line == "error: 4/10, configurations 1/3 done, 8 s, about 12 s left", line
+    assert report.progress("error", 3, 10, 8.0, groups).startswith("error: 3/10, configurations 0/3 done")
+    assert report.progress("callgrind", 10, 10, 200.0, groups) == \
+        "callgrind: 10/10, configurations 3/3 done, 3 min 20 s"
+    assert report.progress("texels", 1, 3, 4000.0) == "texels: 1/3, 1 h 06 min, about 2 h 13 min left"
+
+
+def fake_point(config, mode, ir, differ, flags="", tex=None, edge=0):
+    return {"config": config, "flags": flags, "mode": mode, "ir": ir, "views": 1, "mean_differ": differ,
+            "mean_differ_bench": differ, "mean_differ_extreme": None, "worst_differ": differ, "worst_view": "v",
+            "worst_edge": edge, "worst_moved_edge": edge, "p99_edge": edge, "views_at_cap": 0, "failed": [],
+            "tex_views": 1 if tex is not None else 0, "tex_bad_mean": tex, "tex_bad_worst": tex,
+            "tex_worst_view": "v" if tex is not None else ""}
+
+
+def test_report_summary_names_the_best_and_the_default_place(tmp_path):
+    points = [fake_point("default", "spans", 1000, 0.0, tex=0.01),
+              fake_point("fine", "spans", 1200, 0.0, "-DVIEW_SUBPIXEL_BITS=8", tex=0.005),
+              fake_point("cheap", "spans", 800, 0.02, "-DRAST_STEP_BITS=8", tex=0.2, edge=3),
+              fake_point("worse", "spans", 900, 0.03, "-DRAST_STEP_BITS=6", tex=0.3, edge=5),
+              fake_point("default", "painter", 5000, 0.001, tex=0.01),
+              fake_point("cheap", "painter", 4000, 0.0, "-DRAST_STEP_BITS=8", tex=0.01)]
+    assert [p["config"] for p in report.pareto([p for p in points if p["mode"] == "spans"])] == ["default", "cheap"]
+    views = [{"set": "bench", "group": "bench", "name": "v"}]
+    report.write_markdown(tmp_path / "r.md", points, {}, views,
+                          {"default": "", "fine": "x", "cheap": "y", "worse": "z"}, "p.png", no_ir=False,
+                          tex_names=["v"])
+    md = (tmp_path / "r.md").read_text()
+    summary = md[md.index("## Summary"):md.index("| config |")]
+    assert "- **spans**: least error: default, fine (0.000% of pixels differ); fewest texels off: fine (0.500%); " \
+           "fewest instructions: cheap (800 per frame)." in summary, summary
+    assert "The default's place (1 = lowest): error 1 of 4 (0.000%), texels off 2 of 4 (1.000%), " \
+           "instructions 3 of 4 (1,000)." in summary, summary
+    assert "(the lower-left edge of the plot): cheap, default." in summary, summary
+    assert "- **painter**: least error: cheap (0.000% of pixels differ)" in summary, summary
+    assert "error 2 of 2 (0.100%)" in summary, summary
+    # zeros go to the band below each log axis, and a row with nothing above zero still draws
+    report.plot(tmp_path / "p.png", points, no_ir=False)
+    report.plot(tmp_path / "q.png", [fake_point("default", "spans", None, 0.0)], no_ir=True)
+    assert (tmp_path / "p.png").stat().st_size > 10000 and (tmp_path / "q.png").stat().st_size > 10000

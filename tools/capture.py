@@ -36,7 +36,6 @@ Exits 0 when N frames were captured, 1 when the stream ended or went quiet first
 import argparse
 import json
 import os
-import struct
 import sys
 import time
 import zlib
@@ -91,13 +90,11 @@ def frame_record(ev, hello=None):
 
 
 def write_png(path, pixels, palette, width=framelink.W, height=framelink.H):
-    """8-bit palette PNG (colour type 3)."""
-    def chunk(kind, body):
-        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
-    raw = b"".join(b"\x00" + bytes(pixels[y * width:(y + 1) * width]) for y in range(height))
-    data = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 3, 0, 0, 0)) +
-            chunk(b"PLTE", bytes(palette)) + chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b""))
-    Path(path).write_bytes(data)
+    """8-bit palette PNG (colour type 3, unfiltered rows, the 256-entry palette as received)."""
+    from PIL import Image  # only the PNG outputs need it
+    im = Image.frombytes("P", (width, height), bytes(pixels[:width * height]))
+    im.putpalette(bytes(palette))
+    im.save(path)
 
 
 def feed_at(dec, data):
@@ -273,24 +270,13 @@ def render_frame(out, frame, log=sys.stderr):
 
 
 def read_png_pixels(path):
-    """The palette indices of an 8-bit palette PNG as write_png writes it, or None if absent."""
+    """The palette indices of an 8-bit palette PNG, or None if absent or not one."""
+    from PIL import Image
     try:
-        data = Path(path).read_bytes()
+        with Image.open(path) as im:
+            return im.tobytes() if im.mode == "P" else None
     except OSError:
         return None
-    pos, idat, width = 8, b"", framelink.W
-    while pos < len(data):
-        n, kind = struct.unpack_from(">I4s", data, pos)
-        if kind == b"IHDR":
-            width = struct.unpack_from(">I", data, pos + 8)[0]
-        elif kind == b"IDAT":
-            idat += data[pos + 8:pos + 8 + n]
-        pos += 12 + n
-    raw = zlib.decompress(idat)
-    rows = [raw[y * (width + 1) + 1:(y + 1) * (width + 1)] for y in range(len(raw) // (width + 1))]
-    if any(raw[y * (width + 1)] != 0 for y in range(len(rows))):
-        return None  # filtered rows: not one of ours
-    return b"".join(rows)
 
 
 def main(argv=None):

@@ -9,6 +9,7 @@ VENV=${VENV:-build/venv}
 PACKAGES=(
   gcc make libc6-dev          # host build
   libsdl2-dev                 # hal/sdl: the host window
+  libpng-dev                  # host/png.c: the PNG files of build/render, emu, display, fltool
   libcmocka-dev               # C unit tests
   gcc-arm-none-eabi           # Cortex-M build (firmware, no-float check)
   qemu-system-arm             # the Cortex-M3 board (mps2-an385) the firmware runs on in tests

@@ -110,7 +110,6 @@ import math
 import os
 import struct
 import sys
-import zlib
 from fractions import Fraction
 
 import numpy as np
@@ -908,17 +907,9 @@ def false_colour(ids):
 
 
 def write_png_rgb(path, rgb):
-    """An 8-bit RGB PNG with zlib and struct only."""
-    h, w, _ = rgb.shape
-    raw = b"".join(b"\0" + rgb[y].tobytes() for y in range(h))
-
-    def chunk(kind, body):
-        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
-
-    png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
-           + chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
-    with open(path, "wb") as fh:
-        fh.write(png)
+    """An 8-bit RGB PNG (h x w x 3 uint8) through Pillow."""
+    from PIL import Image  # only the PNG outputs need it; the ids alone need numpy only
+    Image.fromarray(np.ascontiguousarray(rgb, dtype=np.uint8)).save(path, optimize=True)
 
 
 def main(argv=None):

@@ -19,12 +19,16 @@ painter):
   counts them ((Ir of --repeat 3 - Ir of --repeat 1) / 2); the bench views are WAD maps, so these
   are textured frames.
 
-Writes OUT/report.md (default build/report/) with a table of every point, OUT/error_vs_ir.png
+Writes OUT/report.md (default build/report/): a summary per render mode (the best configurations
+by error, by texel-and-light error and by instructions, the default's place in each, and those no
+other beats on both error and instructions), a table of every point, OUT/error_vs_ir.png
 (mean differing share, worst edge displacement and mean texel-and-light error against median
-instructions per frame, the default configuration marked), and a per-scene table of the extreme scenes for the default
+instructions per frame, on log axes with a band for exact zeros, points numbered with a key, the
+default configuration marked), and a per-scene table of the extreme scenes for the default
 configuration. Reference id buffers are kept in OUT/ref/, and every measured figure in
 OUT/cache.json keyed by the binary's and the scene's contents, so a re-run only measures what
-changed. Progress goes to stderr. A report, not a test: it asserts nothing about the figures.
+changed. Progress goes to stderr: tasks and configurations done, and the time left at the mean
+so far. A report, not a test: it asserts nothing about the figures.
 
 usage: tools/report.py [--configs NAME ...] [--views N] [--tex-views N] [--no-ir] [--jobs N] [--out DIR]
 """
@@ -235,13 +239,36 @@ class Cache:
         tmp.replace(self.path)
 
 
-def run_tasks(pool, fn, tasks, what, every=25):
-    """Map fn over tasks in the pool, in order, logging progress."""
+def duration(seconds):
+    """A short human duration: 45 s, 3 min 20 s, 1 h 05 min."""
+    s = int(round(seconds))
+    if s < 60:
+        return f"{s} s"
+    if s < 3600:
+        return f"{s // 60} min {s % 60:02d} s"
+    return f"{s // 3600} h {s % 3600 // 60:02d} min"
+
+
+def progress(what, done, total, elapsed, groups=None):
+    """One progress line: tasks done of total, the configurations finished (groups: the
+    configuration of each task, in order), the time so far and the time left at the mean so far."""
+    line = f"{what}: {done}/{total}"
+    if groups:
+        last = {g: i for i, g in enumerate(groups)}
+        line += f", configurations {sum(i < done for i in last.values())}/{len(last)} done"
+    line += f", {duration(elapsed)}"
+    if done < total:
+        line += f", about {duration(elapsed / done * (total - done))} left"
+    return line
+
+
+def run_tasks(pool, fn, tasks, what, every=25, groups=None):
+    """Map fn over tasks in the pool, in order, logging progress (groups: see progress)."""
     out, t0 = [], time.time()
     for i, r in enumerate(pool.map(fn, tasks), 1):
         out.append(r)
         if i % every == 0 or i == len(tasks):
-            log(f"{what}: {i}/{len(tasks)} ({time.time() - t0:.0f} s)")
+            log(progress(what, i, len(tasks), time.time() - t0, groups))
     return out
 
 
@@ -294,6 +321,58 @@ def pct(x, digits=3):
     return "—" if x is None else f"{100 * x:.{digits}f}%"
 
 
+def rank(points, p, key):
+    """p's place (1 = best, lowest) among points by key; ties share the better place."""
+    return 1 + sum(1 for q in points if q[key] < p[key])
+
+
+def best(points, key, shown=4):
+    """The configurations with the lowest key, ties named together (the default first)."""
+    low = min(p[key] for p in points)
+    names = sorted((p["config"] for p in points if p[key] == low), key=lambda c: c != DEFAULT)
+    more = f" and {len(names) - shown} more" if len(names) > shown else ""
+    return ", ".join(names[:shown]) + more
+
+
+def pareto(points):
+    """The points no other point beats on both error and instructions (lower left of the plot)."""
+    return [p for p in points
+            if not any(q["ir"] <= p["ir"] and q["mean_differ"] <= p["mean_differ"] and
+                       (q["ir"], q["mean_differ"]) != (p["ir"], p["mean_differ"]) for q in points)]
+
+
+def summary_lines(points):
+    """Per render mode: the best configuration by error, by texel-and-light error and by
+    instructions, the default's place in each, and the configurations worth choosing."""
+    lines = ["## Summary", ""]
+    for mode in dict.fromkeys(p["mode"] for p in points):
+        pts = [p for p in points if p["mode"] == mode]
+        n = len(pts)
+        lines.append(f"- **{mode}**: least error: {best(pts, 'mean_differ')} "
+                     f"({pct(min(p['mean_differ'] for p in pts))} of pixels differ)")
+        tex = [p for p in pts if p["tex_bad_mean"] is not None]
+        if tex:
+            low = min(p["tex_bad_mean"] for p in tex)
+            lines[-1] += f"; fewest texels off: {best(tex, 'tex_bad_mean')} ({pct(low)})"
+        timed = [p for p in pts if p["ir"] is not None]
+        if timed:
+            lines[-1] += f"; fewest instructions: {best(timed, 'ir')} ({min(p['ir'] for p in timed):,} per frame)"
+        lines[-1] += "."
+        d = next((p for p in pts if p["config"] == DEFAULT), None)
+        if d is not None:
+            where = [f"error {rank(pts, d, 'mean_differ')} of {n} ({pct(d['mean_differ'])})"]
+            if d["tex_bad_mean"] is not None:
+                where.append(f"texels off {rank(tex, d, 'tex_bad_mean')} of {len(tex)} ({pct(d['tex_bad_mean'])})")
+            if d["ir"] is not None:
+                where.append(f"instructions {rank(timed, d, 'ir')} of {len(timed)} ({d['ir']:,})")
+            lines.append(f"  The default's place (1 = lowest): " + ", ".join(where) + ".")
+        if len(timed) > 1:
+            front = sorted(pareto(timed), key=lambda p: p["ir"])
+            lines.append("  Not beaten on both error and instructions by any other (the lower-left edge of the "
+                         "plot): " + ", ".join(p["config"] for p in front) + ".")
+    return lines + [""]
+
+
 def write_markdown(path, points, per_scene, views, configs, png_name, no_ir, tex_names=()):
     """The report: how it was measured, every point, the default's extreme scenes."""
     n_bench = sum(1 for v in views if v["set"] == "bench")
@@ -303,6 +382,7 @@ def write_markdown(path, points, per_scene, views, configs, png_name, no_ir, tex
     lines = [
         "# Error against run time",
         "",
+        *summary_lines(points),
         f"Views: {n_bench} bench views (tests/bench_views.json) and {n_ext} views of {len(groups)} extreme "
         f"scenes (tests/scenes/extreme/). Error: each view's surface ids against tools/refrender.py "
         f"(tools/accuracy.py): the share of differing pixels, and the displacement of edges: for each "
@@ -404,57 +484,95 @@ def _place_labels(ax, items, fontsize=7):
 
 def plot(path, points, no_ir):
     """Per render mode (a column each), against median instructions per frame: the mean share of
-    differing pixels (top) and the largest displacement of an edge both buffers have (bottom)."""
+    differing pixels, the largest displacement of an edge both buffers have, and the texel-and-light
+    error. Each figure is on a log axis, with a band below it for the points at exactly 0 (a log axis
+    has no 0, and a symlog one puts a jump there); the points are numbered, and the key beside the
+    plots names each number's configuration and flags."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib import ticker
 
     fams = sorted({family(p["config"], p["flags"]) for p in points} - {"default"})
     colours = {f: plt.get_cmap("tab10")(i % 10) for i, f in enumerate(fams)}
     colours["default"] = "black"
     modes = [m for m in MODES if any(p["mode"] == m for p in points)]
     order = {c: i for i, c in enumerate(dict.fromkeys(p["config"] for p in points))}
-    rows = [("mean_differ", "mean share of pixels differing\nfrom the reference (%)", 100.0, 0.001),
-            ("worst_moved_edge", f"worst edge displacement (px),\nbelow 320 (found within {accuracy.SEARCH} px)", 1.0, 1.0)]
+    flags = {p["config"]: p["flags"] for p in points}
+    rows = [("mean_differ", "mean share of pixels differing\nfrom the reference (%)", 100.0),
+            ("worst_moved_edge", f"worst edge displacement (px),\nbelow 320 (found within {accuracy.SEARCH} px)", 1.0)]
     if any(p.get("tex_bad_mean") is not None for p in points):
-        rows.append(("tex_bad_mean", "mean share of pixels not within one\ntexel and one light step (%)", 100.0, 0.01))
-    fig, axes = plt.subplots(len(rows), len(modes), figsize=(7.5 * len(modes), 5 * len(rows)), squeeze=False,
-                             sharey="row")
+        rows.append(("tex_bad_mean", "mean share of pixels not within one\ntexel and one light step (%)", 100.0))
+    fig = plt.figure(figsize=(7.5 * len(modes) + 4.5, 5.6 * len(rows)))
+    grid = fig.add_gridspec(2 * len(rows), len(modes) + 1, height_ratios=[5, 0.6] * len(rows),
+                            width_ratios=[7.5] * len(modes) + [4.5], hspace=0.08, wspace=0.12)
+    better = "lower is better \u2193" if no_ir else "lower left is better \u2199"
     labels = []
-    for col, mode in enumerate(modes):
-        pts = [p for p in points if p["mode"] == mode]
-        for row, (key, ylabel, scale, linthresh) in enumerate(rows):
-            ax = axes[row][col]
-            items = []
-            for p in pts:
-                if p.get(key) is None:
+    for row, (key, ylabel, scale) in enumerate(rows):
+        values = [p[key] * scale for p in points if p.get(key) is not None]
+        positive = [v for v in values if v > 0]
+        # whole decades, at least one, so that the log axis has labelled ticks
+        lo = 10.0 ** np.floor(np.log10(min(positive))) if positive else 0.1
+        hi = 10.0 ** np.ceil(np.log10(max(positive) * 1.5)) if positive else 10.0
+        for col, mode in enumerate(modes):
+            ax = fig.add_subplot(grid[2 * row, col])
+            zero = fig.add_subplot(grid[2 * row + 1, col], sharex=ax)
+            items = {ax: [], zero: []}
+            for p in points:
+                if p["mode"] != mode or p.get(key) is None:
                     continue
                 x = order[p["config"]] if no_ir or p["ir"] is None else p["ir"]
                 y = p[key] * scale
+                target = ax if y > 0 else zero
                 fam = family(p["config"], p["flags"])
                 if p["config"] == DEFAULT:
-                    ax.scatter([x], [y], marker="*", s=420, c="gold", edgecolors="black", linewidths=1.5, zorder=5)
+                    target.scatter([x], [y], marker="*", s=420, c="gold", edgecolors="black", linewidths=1.5,
+                                   zorder=5)
                 else:
-                    ax.scatter([x], [y], marker="o", s=46, color=colours[fam], edgecolors="black", linewidths=0.4,
-                               zorder=3)
-                items.append((x, y, p["config"], colours[fam]))
-            ax.set_yscale("symlog", linthresh=linthresh)
-            ax.margins(x=0.2, y=0.15)
+                    target.scatter([x], [y], marker="o", s=46, color=colours[fam], edgecolors="black",
+                                   linewidths=0.4, zorder=3)
+                items[target].append((x, y, str(order[p["config"]] + 1), colours[fam]))
+            ax.set_yscale("log")
+            ax.set_ylim(lo, hi)
+            ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+            ax.yaxis.set_minor_formatter(ticker.NullFormatter())
+            ax.margins(x=0.12)
             ax.grid(True, which="both", alpha=0.3)
+            ax.tick_params(labelbottom=False)
+            ax.text(0.98, 0.97, better, transform=ax.transAxes, ha="right", va="top", fontsize=10,
+                    color="dimgray", bbox=dict(boxstyle="round", fc="white", ec="lightgray", alpha=0.9))
+            zero.set_ylim(-1, 1)
+            zero.set_yticks([0])
+            zero.set_yticklabels(["0"])
+            zero.grid(True, axis="x", alpha=0.3)
             if col == 0:
                 ax.set_ylabel(ylabel)
+            else:
+                ax.tick_params(labelleft=False)
+                zero.tick_params(labelleft=False)
             if row == 0:
                 ax.set_title(f"mode {mode}")
             if row == len(rows) - 1:
-                ax.set_xlabel("configuration (instructions not measured: --no-ir)" if no_ir else
-                              "median instructions per frame, bench views (x86-64, callgrind)")
-            labels.append((ax, items))
+                zero.set_xlabel("configuration (instructions not measured: --no-ir)" if no_ir else
+                                "median instructions per frame, bench views (x86-64, callgrind)")
+            else:
+                zero.tick_params(labelbottom=False)
+            labels += list(items.items())
+    key_ax = fig.add_subplot(grid[:, len(modes)])
+    key_ax.axis("off")
     handles = [plt.Line2D([], [], marker="*", color="gold", markeredgecolor="black", markersize=15, linestyle="",
                           label="default")]
     handles += [plt.Line2D([], [], marker="o", color=colours[f], linestyle="", label=f) for f in fams]
-    axes[0][0].legend(handles=handles, fontsize=8, loc="lower right")
-    fig.suptitle("Precision knobs: error against the reference renderer vs. instructions per frame")
-    fig.tight_layout()
+    key_ax.legend(handles=handles, fontsize=8, loc="upper left", title="knob", title_fontsize=9)
+    key = [(f"{i + 1:>2}  {c}  " + " ".join(f.replace("-D", "", 1) for f in flags[c].split()),
+            colours[family(c, flags[c])]) for c, i in order.items()]
+    top = 0.97 - 0.03 * (len(handles) + 2)
+    step = min(0.025, top / max(len(key), 1))
+    for k, (text, colour) in enumerate(key):
+        key_ax.text(0.0, top - k * step, text, transform=key_ax.transAxes, fontsize=7, family="monospace",
+                    color=colour, va="top")
+    fig.suptitle(f"Precision knobs: error against the reference renderer vs. instructions per frame ({better})")
+    fig.subplots_adjust(left=0.07, right=0.99, top=0.95, bottom=0.06)
     for ax, items in labels:  # placed in figure pixels, so after the layout is final
         _place_labels(ax, items)
     fig.savefig(path, dpi=fig.dpi)
@@ -526,7 +644,8 @@ def main(argv=None):
                         todo_keys.append((c, m, i, key))
                     errors[(c, m, i)] = hit
         log(f"error: {len(todo)} renders to compare ({len(errors) - len(todo)} cached)")
-        for (c, m, i, key), r in zip(todo_keys, run_tasks(pool, _error_task, todo, "error", every=100)):
+        for (c, m, i, key), r in zip(todo_keys, run_tasks(pool, _error_task, todo, "error", every=100,
+                                                             groups=[k[0] for k in todo_keys])):
             errors[(c, m, i)] = r
             cache.put(key, r)
         cache.save()
@@ -575,7 +694,8 @@ def main(argv=None):
                     irs[(c, m, i)] = hit
         log(f"instructions per frame: {len(todo)} callgrind pairs ({len(irs) - len(todo)} cached)")
         with cf.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-            for (c, m, i, key), r in zip(todo_keys, run_tasks(pool, _ir_task, todo, "callgrind", every=20)):
+            for (c, m, i, key), r in zip(todo_keys, run_tasks(pool, _ir_task, todo, "callgrind", every=20,
+                                                                 groups=[k[0] for k in todo_keys])):
                 irs[(c, m, i)] = r
                 cache.put(key, r)
         cache.save()
