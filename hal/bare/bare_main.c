@@ -58,8 +58,8 @@ static void bare_modes(bare_run *r)
 }
 
 /* The frames, each between the target's frame hooks. Returns 0 or an exit status.
- * What the loop reads is held in locals: between hal/mps2's markers it then
- * costs the instructions the step itself does and no loads (count-m3). */
+ * What the loop reads is held in locals, so that between hal/mps2's markers
+ * the loop adds to the step only register tests, no loads (make count-m3). */
 static int bare_frames(const bare_target *t, bare_run *r)
 {
     void (*begin)(uint32_t) = t->frame_begin, (*end)(uint32_t) = t->frame_end;
