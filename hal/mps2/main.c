@@ -1,11 +1,11 @@
-/* main.c - the Cortex-M3 firmware's main loop (hal/mps2).
+/* main.c - the Cortex-M3 firmware's hooks into the shared main loop (hal/mps2,
+ * hal/bare/bare_main.h).
  *
- * Validate the built-in scene, hand the engine the work area the build sized
- * for it, then for each frame of the scripted camera path: step the engine
- * between the two frame markers the instruction-counting plugin watches
- * (tools/qemu_plugin/insn_count.c), and stream the shown page over UART0.
- * After the last frame, return 0: startup.c exits through semihosting with
- * main's return value as QEMU's exit status.
+ * The work area is the one the build sized for the scene. Each frame's engine
+ * step runs between the two frame markers the instruction-counting plugin
+ * watches (tools/qemu_plugin/insn_count.c), and the shown page is streamed
+ * over UART0. After the last frame, main returns: startup.c exits through
+ * semihosting with main's return value as QEMU's exit status.
  *
  * Exit status: 0 done; 2 the built-in scene is invalid; 3 a fault (startup.c);
  * 4 the scene needs more work memory than the build has; 5 bad run-time
@@ -18,31 +18,19 @@
  */
 #include <stdint.h>
 
-#include "args.h"
-#include "campath.h"
+#include "bare_main.h"
 #include "crc32.h"
-#include "engine.h"
-#include "fixed_view.h"
 #include "hal.h"
 #include "hal_mps2.h"
 #include "log.h"
 #include "mps2.h"
-#include "scene_refusal.h"
 #include "semihost.h"
 #include "stream.h"
 #include "tick.h"
 
-#define FW_EXIT_OK 0
-#define FW_EXIT_SCENE 2
-#define FW_EXIT_WORK 4
-#define FW_EXIT_ARGS 5
 #define FW_EXIT_LINK 6
 
-/* ---- from the generated scene file (mk/mps2.mk) ------------------------- */
-extern const uint8_t fw_scene[];
-extern const uint32_t fw_scene_len;
-extern const char fw_scene_name[];
-extern const char fw_campath_name[];
+/* ---- the work area, from the generated scene file (mk/mps2.mk) ----------- */
 extern uint8_t fw_work[];
 extern const uint32_t fw_work_bytes;
 
@@ -63,102 +51,108 @@ __attribute__((noinline, noipa, used)) void fw_mark_frame_end(uint32_t frame)
     fw_mark_done = frame + 1u;
 }
 
+static void mps2_options(const fw_args *a)
+{
+    if (a->no_tick) tick_stop();
+}
+
+static void mps2_fault(void)
+{
+    __asm__ volatile("udf #0");
+}
+
+static bare_work mps2_work(uint32_t need)
+{
+    (void)need;
+    return (bare_work){fw_work, fw_work_bytes, fw_work_bytes};
+}
+
+/* mk/mps2.mk's sizing image reads "needs N bytes of work memory" from this line. */
+static void mps2_work_refused(uint32_t need, uint32_t avail)
+{
+    log_printf("firmware: the scene %s needs %u bytes of work memory; this build has %u "
+               "(rebuild with make firmware SCENE=...)\n",
+               fw_scene_name, (unsigned)need, (unsigned)avail);
+}
+
 static stream_acks acks_of(int a)
 {
     return a == ARGS_ACKS_ON ? STREAM_ACKS_ON : a == ARGS_ACKS_OFF ? STREAM_ACKS_OFF : STREAM_ACKS_AUTO;
 }
 
-int main(void)
+static int mps2_start(const bare_run *r)
 {
-    static engine e;
-    static char cmdline[256], err[128];
-    static fw_args args;
-
-    mps2_board_init();
-    if (sh_get_cmdline(cmdline, sizeof cmdline) != 0) cmdline[0] = '\0';
-    if (args_parse(&args, cmdline, ARGS_STREAM | ARGS_NO_TICK, err, sizeof err) != 0) {
-        log_printf("firmware: %s\n", err);
-        return FW_EXIT_ARGS;
-    }
-    const campath *path = campath_find(args.path ? args.path : fw_campath_name);
-    if (!path) {
-        log_printf("firmware: no camera path named '%s' (default, map01)\n", args.path ? args.path : fw_campath_name);
-        return FW_EXIT_ARGS;
-    }
-    if (args.no_tick) tick_stop();
-    if (args.fault) __asm__ volatile("udf #0");
-    int fixed_view = fixed_view_wanted(&args);
-
-    scene_error se;
-    scene_status st = eng_init(&e, fw_scene, fw_scene_len, &se);
-    if (st != SCENE_OK) {
-        static char why[240]; /* with the prefix, within a log line (256) */
-        scene_refusal_format(why, sizeof why, fw_scene_name, st, &se);
-        log_printf("firmware: %s\n", why);
-        return FW_EXIT_SCENE;
-    }
-    uint32_t need = eng_work_bytes(&e);
-    if (eng_set_work(&e, fw_work, fw_work_bytes) != 0) {
-        log_printf("firmware: the scene %s needs %u bytes of work memory; this build has %u "
-                   "(rebuild with make firmware SCENE=...)\n",
-                   fw_scene_name, (unsigned)need, (unsigned)fw_work_bytes);
-        return FW_EXIT_WORK;
-    }
-    if (args.mode >= 0) e.mode = (render_mode)args.mode;
-    e.flat = (uint8_t)args.flat;
-    if (args.present >= 0) e.present = (hal_present_mode)args.present;
-    if (fixed_view) fixed_view_apply(&e, &args);
-
-    uint32_t frames = args.frames >= 0 ? (uint32_t)args.frames : campath_frames(path);
-    mps2_set_path(fixed_view ? 0 : path);
+    const fw_args *a = &r->args;
+    mps2_set_path(r->fixed_view ? 0 : r->path);
     /* the ack timeout runs on the tick: without it a silent receiver would stall the firmware */
-    stream_set_acks(args.no_tick ? STREAM_ACKS_OFF : acks_of(args.acks));
+    stream_set_acks(a->no_tick ? STREAM_ACKS_OFF : acks_of(a->acks));
     /* Once a frame-link stream is on the UART, text goes to the semihosting
      * console only: text between its messages would cost the receiver a bad
      * message. Errors before that point go to both. */
-    if (!args.no_stream && !stream_text_ok()) log_set_sinks(LOG_TO_SEMIHOST);
+    if (!a->no_stream && !stream_text_ok()) log_set_sinks(LOG_TO_SEMIHOST);
     /* the blob's CRC names exactly what was built in: the hello carries it, a capture checks it */
     uint32_t scene_crc = crc_update(0, fw_scene, fw_scene_len);
     log_printf("firmware: mps2-an385 Cortex-M3; scene %s (%u bytes, CRC-32 %08x, work %u of %u bytes, world state %u); "
                "%s %u frames; mode %s, present %s; stream %s\n",
-               fw_scene_name, (unsigned)fw_scene_len, (unsigned)scene_crc, (unsigned)need, (unsigned)fw_work_bytes,
-               (unsigned)obj_state_bytes(&e.sc),
-               fixed_view ? "fixed view," : path->name, (unsigned)frames, render_mode_name(e.mode),
-               hal_present_name(e.present), args.no_stream ? "off" : stream_kind());
-
-    if (!args.no_stream && stream_begin(&e, fw_scene_name, scene_crc) != 0) {
+               fw_scene_name, (unsigned)fw_scene_len, (unsigned)scene_crc, (unsigned)r->need, (unsigned)r->avail,
+               (unsigned)obj_state_bytes(&r->e.sc), r->fixed_view ? "fixed view," : r->path->name,
+               (unsigned)r->frames, render_mode_name(r->e.mode), hal_present_name(r->e.present),
+               a->no_stream ? "off" : stream_kind());
+    if (!a->no_stream && stream_begin(&r->e, fw_scene_name, scene_crc) != 0) {
         log_printf("firmware: the frame link did not start\n");
         return FW_EXIT_LINK;
     }
-    uint32_t t0 = hal_ticks_ms();
-    for (uint32_t f = 0; f < frames; f++) {
-        uint32_t input = hal_input();
-        fw_mark_frame_begin(f);
-        if (fixed_view) {
-            eng_render(&e, 0);
-            hal_frame_done();
-        } else {
-            eng_step(&e, input, campath_dt_ms(f));
-        }
-        fw_mark_frame_end(f);
-        if (!args.no_stream && stream_frame(&e, f) != 0) {
-            log_printf("firmware: the frame link failed at frame %u\n", (unsigned)f);
-            return FW_EXIT_LINK;
-        }
+    return 0;
+}
+
+static int mps2_frame_out(const bare_run *r, uint32_t f)
+{
+    if (!r->args.no_stream && stream_frame(&r->e, f) != 0) {
+        log_printf("firmware: the frame link failed at frame %u\n", (unsigned)f);
+        return FW_EXIT_LINK;
     }
-    if (!args.no_stream) {
-        stream_end(frames);
+    return 0;
+}
+
+static int mps2_finish(const bare_run *r)
+{
+    const fw_args *a = &r->args;
+    if (!a->no_stream) {
+        stream_end(r->frames);
         if (stream_summary()[0]) log_printf("firmware: %s\n", stream_summary());
     }
-    uint32_t ms = hal_ticks_ms() - t0;
+    uint32_t ms = hal_ticks_ms() - r->t0;
     /* QEMU discards what a pty's reader has not read yet when it exits: give the
      * reader time to drain the stream (needs the tick). */
-    if (args.linger_ms > 0 && !args.no_tick)
-        for (uint32_t start = hal_ticks_ms(); hal_ticks_ms() - start < (uint32_t)args.linger_ms;) {
+    if (a->linger_ms > 0 && !a->no_tick)
+        for (uint32_t start = hal_ticks_ms(); hal_ticks_ms() - start < (uint32_t)a->linger_ms;) {
         }
     uint32_t stack = (uint32_t)((uintptr_t)__stack_top - (uintptr_t)__stack_limit), unused = mps2_stack_unused();
-    log_printf("firmware: done, %u frames in %u ms (SysTick); stack used %u of %u bytes%s\n", (unsigned)frames,
+    log_printf("firmware: done, %u frames in %u ms (SysTick); stack used %u of %u bytes%s\n", (unsigned)r->frames,
                (unsigned)ms, (unsigned)(stack - unused), (unsigned)stack,
                unused ? "" : " (all of it: it may have overflowed; rebuild with a larger STACK_BYTES)");
-    return FW_EXIT_OK;
+    return BARE_EXIT_OK;
+}
+
+static const bare_target mps2_target = {
+    .name = "firmware",
+    .offered = ARGS_STREAM | ARGS_NO_TICK,
+    .log = log_printf,
+    .options = mps2_options,
+    .fault = mps2_fault,
+    .work = mps2_work,
+    .work_refused = mps2_work_refused,
+    .start = mps2_start,
+    .frame_begin = fw_mark_frame_begin,
+    .frame_end = fw_mark_frame_end,
+    .frame_out = mps2_frame_out,
+    .finish = mps2_finish,
+};
+
+int main(void)
+{
+    static char cmdline[256];
+    mps2_board_init();
+    if (sh_get_cmdline(cmdline, sizeof cmdline) != 0) cmdline[0] = '\0';
+    return bare_main(&mps2_target, cmdline);
 }
