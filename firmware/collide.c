@@ -6,6 +6,8 @@
  * candidate segs of a move piece, and cutting a blocked piece to its furthest
  * clear point and sliding the rest along the wall met. Ranges: collide_geom.c.
  */
+#include "collide.h"
+
 #include "collide_int.h"
 
 #define MOVE_MAX ((int64_t)1 << 33) /* |dx|, |dy| clamp (2 worlds) */

@@ -10,9 +10,11 @@
 #ifndef COLLIDE_INT_H
 #define COLLIDE_INT_H
 
-#include "collide.h"
+#include <stdint.h>
 
 #include "bsp_walk.h"
+#include "fixed.h"
+#include "scene.h"
 #include "wide128.h"
 
 #define G_SHIFT 4                                      /* grid = 16.16 >> 4: 1/4096 unit */

@@ -3,6 +3,8 @@
  * box-and-line walk of the tree, and the openings of the two-sided ones.
  * Geometry and ranges: collide_geom.c.
  */
+#include "collide.h"
+
 #include "collide_int.h"
 
 /* ------------------------------------------------------------ line of sight */
