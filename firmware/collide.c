@@ -1,215 +1,23 @@
 /* collide.c - the player against the world (see collide.h): swept-circle moves
- * with sliding, the floor under a point, and line of sight.
+ * with sliding, and the floor under a point (as Doom's p_map.c: the geometry it
+ * uses is collide_geom.c's, line of sight is collide_sight.c).
  *
- * Owns: exact integer geometry on the 1/4096-unit grid (orientation, point to
- * segment distance, segment crossing), the box tests by which bsp_walk.c's
- * walk finds candidate segs, and the move and sight rules.
- *
- * Ranges. Map coordinates are inside +-SCN_COORD_MAX units (vertices by the
- * loader, positions clamped here), so a grid coordinate (16.16 >> 4) is below
- * 2^27 in magnitude, a difference of two below 2^28, a product of two
- * differences below 2^56 and a cross or dot product below 2^57: all int64. A
- * squared distance compared with r^2 * |ab|^2 (up to 2^114) goes through the
- * exact 128-bit w128_sign_diff(). Nothing here divides by a value that can be 0.
+ * Owns: the move rules (which wall blocks a body, where it stands), the
+ * candidate segs of a move piece, and cutting a blocked piece to its furthest
+ * clear point and sliding the rest along the wall met. Ranges: collide_geom.c.
  */
 #include "collide.h"
 
-#include "bsp_walk.h"
-#include "wide128.h"
+#include "collide_int.h"
 
-#define G_SHIFT 4                                        /* grid = 16.16 >> 4: 1/4096 unit */
-#define WORLD_RAW ((int64_t)SCN_COORD_MAX << FX_SHIFT)   /* positions are clamped to +-this */
-#define MOVE_MAX ((int64_t)1 << 33)                      /* |dx|, |dy| clamp (2 worlds) */
-#define SUB_MAX (16 * FX_ONE)                            /* longest sub-step */
-#define BISECT_BITS 12                                   /* a blocked sub-step is cut to 1/4096 */
-#define SLIDES 4                                         /* tries per sub-step: 1 + 3 slides */
-#define SKIN (FX_ONE / 64)                               /* a slide leaves the wall by this */
-#define MIN_SLIDE (FX_ONE / 256)                         /* shorter slides are dropped */
-#define UNIT_SHIFT 30                                    /* unit normals are 2.30 */
-#define CAND_MAX 128                                     /* candidate segs kept per move piece */
-#define HUGE_H ((int64_t)1 << 40)                        /* "no ceiling" (heights are < 2^31) */
-
-/* A point on the 1/4096-unit grid. */
-typedef struct {
-    int64_t x, y; /* grid units, |x|, |y| < 2^27 */
-} grid_pt;
-
-/* The map box a tree query covers: leaves under node boxes that overlap it. */
-typedef struct {
-    int64_t x0, y0, x1, y1; /* 16.16, inclusive */
-} query_box;
-
-static int64_t min64(int64_t a, int64_t b) { return a < b ? a : b; }
-static int64_t max64(int64_t a, int64_t b) { return a > b ? a : b; }
-static int64_t clamp64(int64_t v, int64_t lo, int64_t hi) { return v < lo ? lo : (v > hi ? hi : v); }
-static int64_t clampw(int64_t v) { return clamp64(v, -WORLD_RAW, WORLD_RAW); }
-static int sgn64(int64_t v) { return (v > 0) - (v < 0); }
-
-/* ------------------------------------------------------------ grid geometry */
-
-static grid_pt to_grid(int64_t x, int64_t y)
-{
-    grid_pt p = {fx_asr64(x, G_SHIFT), fx_asr64(y, G_SHIFT)};
-    return p;
-}
-
-static grid_pt vert(const scene *s, uint32_t v)
-{
-    return to_grid(s->verts[v].x, s->verts[v].y);
-}
-
-/* (b - a) x (p - a): > 0 when p is left of a->b (behind a seg), < 0 right (in front). */
-static int64_t orient(grid_pt a, grid_pt b, grid_pt p)
-{
-    return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x);
-}
-
-/* 1 if the distance from p to the closed segment ab is below r (r2 = r*r, r < 2^23). */
-static int near_seg(grid_pt p, grid_pt a, grid_pt b, int64_t r, int64_t r2)
-{
-    if (p.x + r <= min64(a.x, b.x) || p.x - r >= max64(a.x, b.x) || p.y + r <= min64(a.y, b.y) ||
-        p.y - r >= max64(a.y, b.y))
-        return 0;
-    int64_t abx = b.x - a.x, aby = b.y - a.y, apx = p.x - a.x, apy = p.y - a.y;
-    int64_t t = abx * apx + aby * apy;
-    if (t <= 0) return apx * apx + apy * apy < r2;
-    int64_t l2 = abx * abx + aby * aby;
-    if (t >= l2) {
-        int64_t bpx = p.x - b.x, bpy = p.y - b.y;
-        return bpx * bpx + bpy * bpy < r2;
-    }
-    int64_t c = abx * apy - aby * apx;
-    return w128_sign_diff(c, c, r2, l2) < 0; /* c^2 / l2 < r^2 */
-}
-
-/* Distance from p to the closed segment ab in grid units, rounded down (for
- * comparisons that need no exactness). */
-static int64_t dist_seg(grid_pt p, grid_pt a, grid_pt b)
-{
-    int64_t abx = b.x - a.x, aby = b.y - a.y, apx = p.x - a.x, apy = p.y - a.y;
-    int64_t t = abx * apx + aby * apy;
-    int64_t l2 = abx * abx + aby * aby;
-    if (t <= 0) return (int64_t)fx_isqrt64((uint64_t)(apx * apx + apy * apy));
-    if (t >= l2) {
-        int64_t bpx = p.x - b.x, bpy = p.y - b.y;
-        return (int64_t)fx_isqrt64((uint64_t)(bpx * bpx + bpy * bpy));
-    }
-    int64_t len = (int64_t)fx_isqrt64((uint64_t)l2); /* >= 1: l2 > t > 0 */
-    return (int64_t)(w128_uabs(abx * apy - aby * apx) / (uint64_t)len);
-}
-
-/* 1 if the closed segments pq and ab share a point. */
-static int seg_cross(grid_pt p, grid_pt q, grid_pt a, grid_pt b)
-{
-    int d1 = sgn64(orient(a, b, p)), d2 = sgn64(orient(a, b, q));
-    int d3 = sgn64(orient(p, q, a)), d4 = sgn64(orient(p, q, b));
-    if (d1 * d2 > 0 || d3 * d4 > 0) return 0;
-    if (d1 || d2 || d3 || d4) return 1;
-    /* collinear (or a point): the boxes must overlap */
-    return max64(min64(p.x, q.x), min64(a.x, b.x)) <= min64(max64(p.x, q.x), max64(a.x, b.x)) &&
-           max64(min64(p.y, q.y), min64(a.y, b.y)) <= min64(max64(p.y, q.y), max64(a.y, b.y));
-}
-
-/* 1 if a circle of radius r moving along pq comes nearer than r to segment ab:
- * the distance between two segments is 0 if they cross, else the least of the
- * four end-point-to-segment distances. */
-static int sweep_near(grid_pt p, grid_pt q, grid_pt a, grid_pt b, int64_t r, int64_t r2)
-{
-    return seg_cross(p, q, a, b) || near_seg(p, a, b, r, r2) || near_seg(q, a, b, r, r2) ||
-           near_seg(a, p, q, r, r2) || near_seg(b, p, q, r, r2);
-}
-
-/* (vx, vy) scaled to length 2^30 (2.30); 0 for the zero vector. |v| < 2^62. */
-static int unit_vec(int64_t vx, int64_t vy, int32_t *nx, int32_t *ny)
-{
-    uint64_t m = w128_uabs(vx) > w128_uabs(vy) ? w128_uabs(vx) : w128_uabs(vy);
-    if (m == 0) return 0;
-    while (m < ((uint64_t)1 << 28)) {
-        vx *= 2;
-        vy *= 2;
-        m <<= 1;
-    }
-    while (m >= ((uint64_t)1 << 29)) {
-        vx = fx_asr64(vx, 1);
-        vy = fx_asr64(vy, 1);
-        m >>= 1;
-    }
-    /* |vx|, |vy| < 2^29: the square sum is below 2^59, its root at least max(|vx|, |vy|) */
-    int64_t len = (int64_t)fx_isqrt64((uint64_t)(vx * vx + vy * vy));
-    *nx = (int32_t)(vx * ((int64_t)1 << UNIT_SHIFT) / len);
-    *ny = (int32_t)(vy * ((int64_t)1 << UNIT_SHIFT) / len);
-    return 1;
-}
-
-/* The unit normal of segment ab at its point nearest p, pointing at p (the seg's
- * front normal if p is on it). */
-static int seg_normal(grid_pt p, grid_pt a, grid_pt b, int32_t *nx, int32_t *ny)
-{
-    int64_t abx = b.x - a.x, aby = b.y - a.y, apx = p.x - a.x, apy = p.y - a.y;
-    int64_t t = abx * apx + aby * apy, l2 = abx * abx + aby * aby;
-    int64_t vx, vy;
-    if (t <= 0) {
-        vx = apx;
-        vy = apy;
-    } else if (t >= l2) {
-        vx = p.x - b.x;
-        vy = p.y - b.y;
-    } else if (abx * apy - aby * apx > 0) { /* behind: left normal */
-        vx = -aby;
-        vy = abx;
-    } else {
-        vx = aby;
-        vy = -abx;
-    }
-    if (vx == 0 && vy == 0) {
-        vx = aby;
-        vy = -abx;
-    }
-    return unit_vec(vx, vy, nx, ny);
-}
-
-/* ------------------------------------------------------------ tree walk */
-
-static int box_meets(const int32_t bb[BOX_SIDES], const query_box *b)
-{
-    return bb[BOX_LEFT] <= b->x1 && bb[BOX_RIGHT] >= b->x0 && bb[BOX_BOTTOM] <= b->y1 && bb[BOX_TOP] >= b->y0;
-}
-
-/* 1 unless the line through p, q leaves every corner of bb strictly on one side. */
-static int line_meets(const int32_t bb[BOX_SIDES], grid_pt p, grid_pt q)
-{
-    grid_pt lo = to_grid(bb[BOX_LEFT], bb[BOX_BOTTOM]), hi = to_grid(bb[BOX_RIGHT], bb[BOX_TOP]);
-    grid_pt c[4] = {{lo.x, lo.y}, {hi.x, lo.y}, {hi.x, hi.y}, {lo.x, hi.y}};
-    int pos = 0, neg = 0;
-    for (int k = 0; k < 4; k++) {
-        int64_t o = orient(p, q, c[k]);
-        pos |= o >= 0;
-        neg |= o <= 0;
-    }
-    return pos && neg;
-}
-
-typedef struct {
-    const query_box *box;
-    const grid_pt *line; /* NULL: any box that overlaps box */
-} tree_query;
-
-static int query_meets(void *ctx, const int32_t bb[BOX_SIDES], unsigned state)
-{
-    const tree_query *q = ctx;
-    if (!box_meets(bb, q->box) || (q->line && !line_meets(bb, q->line[0], q->line[1]))) return -1;
-    return (int)state;
-}
-
-/* Visit every leaf under a node box that overlaps b (and, with line, that the
- * line through line[0], line[1] meets), child 0 first. Returns 1 if fn stopped
- * the walk. */
-static int walk_leaves(const scene *s, const query_box *b, const grid_pt *line, walk_visit fn, void *ctx)
-{
-    tree_query q = {b, line};
-    const walk_rules rules = {0, query_meets, fn, ctx, 0};
-    return walk_boxes(s, &rules, &q, 0, 0);
-}
+#define MOVE_MAX ((int64_t)1 << 33) /* |dx|, |dy| clamp (2 worlds) */
+#define SUB_MAX (16 * FX_ONE)       /* longest sub-step */
+#define BISECT_BITS 12              /* a blocked sub-step is cut to 1/4096 */
+#define SLIDES 4                    /* tries per sub-step: 1 + 3 slides */
+#define SKIN (FX_ONE / 64)          /* a slide leaves the wall by this */
+#define MIN_SLIDE (FX_ONE / 256)    /* shorter slides are dropped */
+#define CAND_MAX 128                /* candidate segs kept per move piece */
+#define HUGE_H ((int64_t)1 << 40)   /* "no ceiling" (heights are < 2^31) */
 
 /* ------------------------------------------------------------ moving */
 
@@ -283,7 +91,7 @@ static void gather(mover *m, int64_t px, int64_t py, int64_t qx, int64_t qy)
     m->gy1 = fx_asr64(m->box.y1, G_SHIFT);
     m->n = 0;
     m->overflow = 0;
-    walk_leaves(m->s, &m->box, 0, gather_leaf, m);
+    colg_walk_leaves(m->s, &m->box, 0, gather_leaf, m);
 }
 
 static void for_candidates(const mover *m, seg_fn fn, void *ctx)
@@ -293,7 +101,7 @@ static void for_candidates(const mover *m, seg_fn fn, void *ctx)
         return;
     }
     seg_walk w = {m, fn, ctx};
-    walk_leaves(m->s, &m->box, 0, walk_leaf_segs, &w);
+    colg_walk_leaves(m->s, &m->box, 0, walk_leaf_segs, &w);
 }
 
 /* Where the body stands (its footing): highest floor and lowest ceiling over
@@ -338,8 +146,8 @@ static void touch_sector(path_check *c, uint32_t sec)
  * nearer or takes it across (or, for a one-sided wall, from on it to behind it). */
 static int escape_blocked(grid_pt p, grid_pt q, grid_pt a, grid_pt b, int one_sided)
 {
-    if (dist_seg(q, a, b) < dist_seg(p, a, b)) return 1;
-    if (!seg_cross(p, q, a, b)) return 0;
+    if (colg_dist_seg(q, a, b) < colg_dist_seg(p, a, b)) return 1;
+    if (!colg_seg_cross(p, q, a, b)) return 0;
     int sp = sgn64(orient(a, b, p)), sq = sgn64(orient(a, b, q));
     if (sp * sq < 0) return 1;
     return one_sided && sp == 0 && sq > 0;
@@ -353,13 +161,13 @@ static void check_seg(void *ctx, uint32_t si)
     const scn_seg *g = &m->s->segs[si];
     const scn_line *ln = &m->s->lines[g->line];
     grid_pt a = vert(m->s, g->v1), b = vert(m->s, g->v2);
-    if (near_seg(c->q, a, b, m->r, m->r2)) {
+    if (colg_near_seg(c->q, a, b, m->r, m->r2)) {
         touch_sector(c, ln->sector[0]);
         touch_sector(c, ln->sector[1]);
     }
     if (!wall_blocks(m, ln, c->z)) return;
-    if (!near_seg(c->p, a, b, m->r, m->r2)) {
-        if (sweep_near(c->p, c->q, a, b, m->r, m->r2)) c->blocked = 1;
+    if (!colg_near_seg(c->p, a, b, m->r, m->r2)) {
+        if (colg_sweep_near(c->p, c->q, a, b, m->r, m->r2)) c->blocked = 1;
         return;
     }
     if (escape_blocked(c->p, c->q, a, b, ln->sector[1] == SCN_NONE)) c->blocked = c->stuck = 1;
@@ -416,12 +224,12 @@ static void contact_seg(void *ctx, uint32_t si)
     const scn_line *ln = &m->s->lines[g->line];
     if (!wall_blocks(m, ln, c->z)) return;
     grid_pt a = vert(m->s, g->v1), b = vert(m->s, g->v2);
-    if (near_seg(c->l, a, b, m->r, m->r2)) { /* already overlapped: only if it holds the move */
+    if (colg_near_seg(c->l, a, b, m->r, m->r2)) { /* already overlapped: only if it holds the move */
         if (!escape_blocked(c->l, c->h, a, b, ln->sector[1] == SCN_NONE)) return;
-    } else if (!sweep_near(c->l, c->h, a, b, m->r, m->r2)) {
+    } else if (!colg_sweep_near(c->l, c->h, a, b, m->r, m->r2)) {
         return;
     }
-    int64_t d = dist_seg(c->l, a, b);
+    int64_t d = colg_dist_seg(c->l, a, b);
     if (!c->found || d < c->best) {
         c->found = 1;
         c->best = d;
@@ -443,7 +251,7 @@ static int contact_normal(const mover *m, int64_t z, int64_t lx, int64_t ly, int
     c.best = 0;
     c.a = c.b = c.l;
     for_candidates(m, contact_seg, &c);
-    return c.found && seg_normal(c.l, c.a, c.b, nx, ny);
+    return c.found && colg_seg_normal(c.l, c.a, c.b, nx, ny);
 }
 
 col_body col_player(void)
@@ -557,87 +365,4 @@ int col_floor_at(const scene *s, fx_t x, fx_t y, fx_t *floor)
     if (sec == SCN_NONE) return 0;
     *floor = s->sectors[sec].floor_h;
     return 1;
-}
-
-/* ------------------------------------------------------------ line of sight */
-
-typedef struct {
-    const scene *s;
-    const world_state *w;
-    grid_pt p, q;
-    int64_t gx0, gy0, gx1, gy1; /* box of pq on the grid */
-    int64_t z1, z2;
-} sight_check;
-
-/* Is the height z1 + (z2 - z1) * num / den (0 <= num <= den, den > 0) above hi
- * or below lo? |z1 - hi|, |z2 - z1| < 2^33 and den < 2^59: exact via w128_sign_diff. */
-static int z_outside(const sight_check *c, int64_t num, int64_t den, int64_t lo, int64_t hi)
-{
-    int64_t dz = c->z2 - c->z1;
-    if (w128_sign_diff(c->z1 - hi, den, -dz, num) > 0) return 1; /* (z1-hi)*den + dz*num > 0 */
-    return w128_sign_diff(c->z1 - lo, den, -dz, num) < 0;        /* (z1-lo)*den + dz*num < 0 */
-}
-
-static int sight_leaf(void *vctx, uint32_t leaf, unsigned state)
-{
-    (void)state;
-    sight_check *c = (sight_check *)vctx;
-    const scene *s = c->s;
-    const scn_leaf *l = &s->leaves[leaf];
-    for (uint32_t i = 0; i < l->num_segs; i++) {
-        const scn_seg *g = &s->segs[l->first_seg + i];
-        grid_pt a = vert(s, g->v1), b = vert(s, g->v2);
-        if (max64(a.x, b.x) < c->gx0 || min64(a.x, b.x) > c->gx1 || max64(a.y, b.y) < c->gy0 ||
-            min64(a.y, b.y) > c->gy1)
-            continue;
-        if (!seg_cross(c->p, c->q, a, b)) continue;
-        const scn_line *ln = &s->lines[g->line];
-        if (!CFG_TWO_SIDED || ln->sector[1] == SCN_NONE) return 1;
-        const scn_sector *f = &s->sectors[ln->sector[0]], *k = &s->sectors[ln->sector[1]];
-        int64_t lo = max64(f->floor_h, k->floor_h);
-        int64_t hi = min64(obj_ceil(c->w, s, ln->sector[0]), obj_ceil(c->w, s, ln->sector[1]));
-        if (hi <= lo) return 1; /* closed (a shut door): nothing passes, not even on the edge */
-        int64_t o1 = orient(a, b, c->p), o2 = orient(a, b, c->q);
-        if (o1 != o2) { /* crosses at t = o1 / (o1 - o2), in [0, 1] */
-            int64_t num = o1, den = o1 - o2;
-            if (den < 0) {
-                num = -num;
-                den = -den;
-            }
-            if (z_outside(c, num, den, lo, hi)) return 1;
-            continue;
-        }
-        /* along the wall: the heights where the overlap starts and ends */
-        int64_t dx = c->q.x - c->p.x, dy = c->q.y - c->p.y;
-        int64_t dd = dx * dx + dy * dy;
-        if (dd == 0) {
-            if (z_outside(c, 0, 1, lo, hi) || z_outside(c, 1, 1, lo, hi)) return 1;
-            continue;
-        }
-        int64_t ta = clamp64((a.x - c->p.x) * dx + (a.y - c->p.y) * dy, 0, dd);
-        int64_t tb = clamp64((b.x - c->p.x) * dx + (b.y - c->p.y) * dy, 0, dd);
-        if (z_outside(c, ta, dd, lo, hi) || z_outside(c, tb, dd, lo, hi)) return 1;
-    }
-    return 0;
-}
-
-int col_line_of_sight(const scene *s, const world_state *w, fx_t x1, fx_t y1, fx_t z1, fx_t x2, fx_t y2, fx_t z2)
-{
-    int64_t ax = clampw(x1), ay = clampw(y1), bx = clampw(x2), by = clampw(y2);
-    sight_check c;
-    c.s = s;
-    c.w = w;
-    c.p = to_grid(ax, ay);
-    c.q = to_grid(bx, by);
-    c.gx0 = min64(c.p.x, c.q.x);
-    c.gx1 = max64(c.p.x, c.q.x);
-    c.gy0 = min64(c.p.y, c.q.y);
-    c.gy1 = max64(c.p.y, c.q.y);
-    c.z1 = z1;
-    c.z2 = z2;
-    /* one grid step wider than the segment, so no seg the grid test can see is culled */
-    int64_t e = (int64_t)1 << G_SHIFT;
-    query_box b = {min64(ax, bx) - e, min64(ay, by) - e, max64(ax, bx) + e, max64(ay, by) + e};
-    grid_pt line[2] = {c.p, c.q};
-    return !walk_leaves(s, &b, line, sight_leaf, &c);
 }

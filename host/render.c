@@ -267,9 +267,114 @@ static void file_error(const char *path, int lineno, const char *fmt, ...)
     va_end(ap);
 }
 
-/* --objects FILE: 'object MODEL X Y Z YAW' lines into a malloc'd array. Positions must be
- * inside the world box, as the loader demands of compiled objects. Returns the count, or
- * -1 after a message naming the file and line. */
+/* An --objects line's words, up to 7 kept (the count goes on, so a line with too
+ * many is refused): returns the count. The line is cut at '#' and tokenised in place. */
+static int object_words(char *line, char *tok[7])
+{
+    char *hash = strchr(line, '#');
+    if (hash) *hash = 0;
+    char *save;
+    int nt = 0;
+    for (char *t = strtok_r(line, " \t\r\n", &save); t; t = strtok_r(NULL, " \t\r\n", &save))
+        if (nt < 7) tok[nt++] = t;
+        else nt++;
+    return nt;
+}
+
+/* MODEL: a text scene's model name, else a model number below the scene's count. */
+static int object_model(const char *path, int lineno, const char *m, const scene *s, const bspc_name *names,
+                        int nnames, uint32_t *model)
+{
+    int named = -1;
+    for (int i = 0; i < nnames; i++)
+        if (!strcmp(names[i].name, m)) named = i;
+    if (named >= 0) {
+        *model = (uint32_t)named;
+        return 0;
+    }
+    char *end;
+    errno = 0;
+    unsigned long v = strtoul(m, &end, 10);
+    if (*end || m[0] < '0' || m[0] > '9' || errno || v >= s->nmodels) {
+        if (s->nmodels == 0)
+            file_error(path, lineno, "model '%s': the scene has no models", m);
+        else if (nnames > 0)
+            file_error(path, lineno, "model '%s': no model of that name or number (numbers 0..%u)", m,
+                       (unsigned)s->nmodels - 1);
+        else
+            file_error(path, lineno, "model '%s': expected a model number 0..%u (only a text scene's "
+                       "models have names)", m, (unsigned)s->nmodels - 1);
+        return -1;
+    }
+    *model = (uint32_t)v;
+    return 0;
+}
+
+/* X Y Z YAW (xyz[0..3]): numbers, X and Y inside the world box and Z inside the
+ * height range, as the loader demands of compiled objects. */
+static int object_place(const char *path, int lineno, char *const xyz[4], obj_state *o)
+{
+    static const char *const what[4] = {"X", "Y", "Z", "YAW"};
+    const int64_t coord_max = (int64_t)SCN_COORD_MAX << 16, height_max = (int64_t)SCN_HEIGHT_MAX << 16;
+    const int64_t limit[4] = {coord_max, coord_max, height_max, INT32_MAX};
+    int64_t v[4];
+    int k = 0;
+    for (; k < 4; k++) {
+        if (fxtext_parse64(xyz[k], &v[k])) {
+            file_error(path, lineno, "%s '%s' is not a number", what[k], xyz[k]);
+            return -1;
+        }
+        if (v[k] < -limit[k] || v[k] > limit[k]) break;
+    }
+    if (k < 2) {
+        file_error(path, lineno, "X, Y outside the world box (|coordinate| <= %d)", SCN_COORD_MAX);
+        return -1;
+    } else if (k == 2) {
+        file_error(path, lineno, "Z outside the height range (|Z| <= %d)", SCN_HEIGHT_MAX);
+        return -1;
+    } else if (k == 3) {
+        file_error(path, lineno, "YAW '%s' outside the 16.16 range", xyz[3]);
+        return -1;
+    }
+    o->x = (fx_t)v[0];
+    o->y = (fx_t)v[1];
+    o->z = (fx_t)v[2];
+    o->yaw_deg = (fx_t)v[3];
+    return 0;
+}
+
+/* One line of getline's (got bytes): 1 and *o for an object, 0 for a blank or
+ * comment line, -1 after a message. n objects came before it. */
+static int object_line(const char *path, int lineno, char *line, ssize_t got, long n, const scene *s,
+                       const bspc_name *names, int nnames, obj_state *o)
+{
+    if (strlen(line) != (size_t)got) {
+        file_error(path, lineno, "holds a NUL byte (not a text file?)");
+        return -1;
+    }
+    if (got > OBJECTS_LINE_MAX + (line[got - 1] == '\n')) {
+        file_error(path, lineno, "line longer than %u characters", OBJECTS_LINE_MAX);
+        return -1;
+    }
+    char *tok[7];
+    int nt = object_words(line, tok);
+    if (nt == 0) return 0;
+    if (strcmp(tok[0], "object") || nt != 6) {
+        file_error(path, lineno, "expected 'object MODEL X Y Z YAW'");
+        return -1;
+    }
+    if (n >= SCN_MAX_OBJECTS) {
+        file_error(path, lineno, "more than %u objects", (unsigned)SCN_MAX_OBJECTS);
+        return -1;
+    }
+    memset(o, 0, sizeof *o);
+    if (object_model(path, lineno, tok[1], s, names, nnames, &o->model) || object_place(path, lineno, tok + 2, o))
+        return -1;
+    return 1;
+}
+
+/* --objects FILE: 'object MODEL X Y Z YAW' lines into a malloc'd array. Returns the
+ * count, or -1 after a message naming the file and line. */
 static long read_objects(const char *path, const char *spec, const scene *s, obj_state **out)
 {
     *out = NULL;
@@ -291,82 +396,10 @@ static long read_objects(const char *path, const char *spec, const scene *s, obj
         goto done;
     }
     while ((got = getline(&line, &cap, f)) >= 0) {
-        lineno++;
-        if (strlen(line) != (size_t)got) {
-            file_error(path, lineno, "holds a NUL byte (not a text file?)");
-            goto done;
-        }
-        if (got > OBJECTS_LINE_MAX + (line[got - 1] == '\n')) {
-            file_error(path, lineno, "line longer than %u characters", OBJECTS_LINE_MAX);
-            goto done;
-        }
-        char *hash = strchr(line, '#');
-        if (hash) *hash = 0;
-        char *tok[7], *save;
-        int nt = 0;
-        for (char *t = strtok_r(line, " \t\r\n", &save); t; t = strtok_r(NULL, " \t\r\n", &save))
-            if (nt < 7) tok[nt++] = t;
-            else nt++;
-        if (nt == 0) continue;
-        if (strcmp(tok[0], "object") || nt != 6) {
-            file_error(path, lineno, "expected 'object MODEL X Y Z YAW'");
-            goto done;
-        }
-        if (n >= SCN_MAX_OBJECTS) {
-            file_error(path, lineno, "more than %u objects", (unsigned)SCN_MAX_OBJECTS);
-            goto done;
-        }
         obj_state o;
-        memset(&o, 0, sizeof o);
-        const char *m = tok[1];
-        int named = -1;
-        for (int i = 0; i < nnames; i++)
-            if (!strcmp(names[i].name, m)) named = i;
-        if (named >= 0) {
-            o.model = (uint32_t)named;
-        } else {
-            char *end;
-            errno = 0;
-            unsigned long v = strtoul(m, &end, 10);
-            if (*end || m[0] < '0' || m[0] > '9' || errno || v >= s->nmodels) {
-                if (s->nmodels == 0)
-                    file_error(path, lineno, "model '%s': the scene has no models", m);
-                else if (nnames > 0)
-                    file_error(path, lineno, "model '%s': no model of that name or number (numbers 0..%u)", m,
-                               (unsigned)s->nmodels - 1);
-                else
-                    file_error(path, lineno, "model '%s': expected a model number 0..%u (only a text scene's "
-                               "models have names)", m, (unsigned)s->nmodels - 1);
-                goto done;
-            }
-            o.model = (uint32_t)v;
-        }
-        static const char *const what[4] = {"X", "Y", "Z", "YAW"};
-        const int64_t coord_max = (int64_t)SCN_COORD_MAX << 16, height_max = (int64_t)SCN_HEIGHT_MAX << 16;
-        const int64_t limit[4] = {coord_max, coord_max, height_max, INT32_MAX};
-        int64_t v[4];
-        int k = 0;
-        for (; k < 4; k++) {
-            if (fxtext_parse64(tok[2 + k], &v[k])) {
-                file_error(path, lineno, "%s '%s' is not a number", what[k], tok[2 + k]);
-                goto done;
-            }
-            if (v[k] < -limit[k] || v[k] > limit[k]) break;
-        }
-        if (k < 2) {
-            file_error(path, lineno, "X, Y outside the world box (|coordinate| <= %d)", SCN_COORD_MAX);
-            goto done;
-        } else if (k == 2) {
-            file_error(path, lineno, "Z outside the height range (|Z| <= %d)", SCN_HEIGHT_MAX);
-            goto done;
-        } else if (k == 3) {
-            file_error(path, lineno, "YAW '%s' outside the 16.16 range", tok[5]);
-            goto done;
-        }
-        o.x = (fx_t)v[0];
-        o.y = (fx_t)v[1];
-        o.z = (fx_t)v[2];
-        o.yaw_deg = (fx_t)v[3];
+        int r = object_line(path, ++lineno, line, got, n, s, names, nnames, &o);
+        if (r < 0) goto done;
+        if (r == 0) continue;
         obj_state *grown = realloc(objs, sizeof *objs * (size_t)(n + 1));
         if (!grown) {
             fprintf(stderr, "render: out of memory\n");
@@ -591,6 +624,109 @@ static int send_link(link_sender *l, const engine *e, const uint8_t *frame, cons
     return -1;
 }
 
+/* The scene, with --objects' objects in place of its own when given: 0, or 1
+ * after a message (then nothing is left open). */
+static int open_scene(const options *o, scene_start *st, engine *e, obj_state **file_objs, long *nfile)
+{
+    char err[512];
+    *file_objs = NULL;
+    *nfile = 0;
+    hal_null_reset();
+    if (scene_start_open(st, e, o->scene, &o->bspc, NULL, 0, err, sizeof err) != 0) {
+        fprintf(stderr, "render: %s\n", err);
+        return 1;
+    }
+    if (refuse_beyond_scene(o, &e->sc)) {
+        scene_start_close(st);
+        return 1;
+    }
+    if (o->objects && (*nfile = read_objects(o->objects, o->scene, &e->sc, file_objs)) < 0) {
+        scene_start_close(st);
+        return 1;
+    }
+    world_state mine = {*file_objs, (uint32_t)*nfile, 0, 0};
+    if (scene_start_work(st, e, o->objects ? &mine : NULL, err, sizeof err) != 0) {
+        fprintf(stderr, "render: %s\n", err);
+        free(*file_objs);
+        scene_start_close(st);
+        return 1;
+    }
+    return 0;
+}
+
+/* The drawing options and the camera: --at, --angle, --look, and the eye
+ * height (the floor under the eye + CAM_EYE_HEIGHT unless --at gave Z). */
+static void set_view(const options *o, engine *e)
+{
+    e->mode = o->mode;
+    e->present = o->present;
+    e->flat = (uint8_t)o->flat;
+    if (o->have_at) {
+        e->cam.view.x = o->cam.x;
+        e->cam.view.y = o->cam.y;
+    }
+    if (o->have_angle) e->cam.view.angle_deg = o->cam.angle_deg;
+    e->cam.view.look = o->cam.look;
+    if (o->have_z) {
+        e->cam.view.z = o->cam.z;
+    } else {
+        e->cam.view.z = CAM_EYE_HEIGHT;
+        cam_follow_floor(&e->cam, &e->sc);
+    }
+}
+
+/* The world at --time with --door's ceilings and the objects asked for: 0, or
+ * -1 after a message. */
+static int set_world(const options *o, engine *e, obj_state *file_objs, long nfile)
+{
+    /* Paths are exact functions of t and a door's motion depends only on the total time,
+     * so one update from time 0 stands for every frame in between, the player at the camera. */
+    if (o->have_time) {
+        e->t_ms = o->time_ms;
+        obj_update(&e->world, &e->sc, o->time_ms, o->time_ms, e->cam.view.x, e->cam.view.y);
+    }
+    if (apply_doors(o, &e->sc, &e->world) != 0) return -1;
+    if (in_void(&e->sc, e->cam.view.x, e->cam.view.y))
+        fprintf(stderr, "render: warning: the camera is outside every sector of %s: the frame shows the void\n",
+                o->scene);
+    if (o->objects) {
+        e->world.objs = file_objs;
+        e->world.n = (uint32_t)nfile;
+    } else if (o->no_objects) {
+        e->world.n = 0;
+    }
+    return 0;
+}
+
+/* The id buffer as 4 little-endian bytes per pixel. */
+static int write_ids(const char *path, const uint32_t *ids)
+{
+    uint8_t *bytes = malloc((size_t)HAL_PAGE_BYTES * 4);
+    for (int i = 0; bytes && i < HAL_PAGE_BYTES; i++)
+        for (int k = 0; k < 4; k++) bytes[i * 4 + k] = (uint8_t)(ids[i] >> (8 * k));
+    int rc = (!bytes || write_file(path, bytes, (size_t)HAL_PAGE_BYTES * 4) != 0) ? -1 : 0;
+    int why = errno; /* for the caller's message */
+    free(bytes);
+    errno = why;
+    return rc;
+}
+
+/* The frame to every place asked (--png, --raw, --ids, --link): 1 if any failed,
+ * after a message. */
+static int write_outputs(const options *o, const engine *e, const uint8_t *frame, const uint32_t *ids,
+                         link_sender *sender, const scene_start *st)
+{
+    int failed = 0;
+    if (o->png && png_write_indexed(o->png, frame, HAL_WIDTH, HAL_HEIGHT, hal_get_palette()) != 0)
+        failed = fprintf(stderr, "render: %s: cannot write PNG: %s\n", o->png, strerror(errno));
+    if (o->raw && write_file(o->raw, frame, HAL_PAGE_BYTES) != 0)
+        failed = fprintf(stderr, "render: %s: cannot write frame: %s\n", o->raw, strerror(errno));
+    if (ids && write_ids(o->ids, ids) != 0)
+        failed = fprintf(stderr, "render: %s: cannot write id buffer: %s\n", o->ids, strerror(errno));
+    if (o->link && send_link(sender, e, frame, o->scene, st->data, st->len) != 0) failed = 1;
+    return failed != 0;
+}
+
 int main(int argc, char **argv)
 {
     options o;
@@ -606,71 +742,23 @@ int main(int argc, char **argv)
     if (rc) return rc;
 
     if (check_outputs(&o) != 0) return 1;
-    char err[512];
     /* the port first: a PORT that does not open is a bad option, found before any work */
     static link_sender sender;
+    char err[512];
     if (o.link && link_open(&sender, o.link, o.baud, err, sizeof err) != 0) {
         fprintf(stderr, "render: --link %s\n", err);
         return 2;
     }
     static engine e;
     scene_start st;
-    hal_null_reset();
-    if (scene_start_open(&st, &e, o.scene, &o.bspc, NULL, 0, err, sizeof err) != 0) {
-        fprintf(stderr, "render: %s\n", err);
-        return 1;
-    }
-    if (refuse_beyond_scene(&o, &e.sc)) {
-        scene_start_close(&st);
-        return 1;
-    }
-    obj_state *file_objs = NULL;
-    long nfile = 0;
-    if (o.objects && (nfile = read_objects(o.objects, o.scene, &e.sc, &file_objs)) < 0) {
-        scene_start_close(&st);
-        return 1;
-    }
-    world_state mine = {file_objs, (uint32_t)nfile, 0, 0};
-    if (scene_start_work(&st, &e, o.objects ? &mine : NULL, err, sizeof err) != 0) {
-        fprintf(stderr, "render: %s\n", err);
+    obj_state *file_objs;
+    long nfile;
+    if (open_scene(&o, &st, &e, &file_objs, &nfile)) return 1;
+    set_view(&o, &e);
+    if (set_world(&o, &e, file_objs, nfile) != 0) {
         free(file_objs);
         scene_start_close(&st);
         return 1;
-    }
-    e.mode = o.mode;
-    e.present = o.present;
-    e.flat = (uint8_t)o.flat;
-    if (o.have_at) {
-        e.cam.view.x = o.cam.x;
-        e.cam.view.y = o.cam.y;
-    }
-    if (o.have_angle) e.cam.view.angle_deg = o.cam.angle_deg;
-    e.cam.view.look = o.cam.look;
-    if (o.have_z) {
-        e.cam.view.z = o.cam.z;
-    } else {
-        e.cam.view.z = CAM_EYE_HEIGHT;
-        cam_follow_floor(&e.cam, &e.sc);
-    }
-    /* Paths are exact functions of t and a door's motion depends only on the total time,
-     * so one update from time 0 stands for every frame in between, the player at the camera. */
-    if (o.have_time) {
-        e.t_ms = o.time_ms;
-        obj_update(&e.world, &e.sc, o.time_ms, o.time_ms, e.cam.view.x, e.cam.view.y);
-    }
-    if (apply_doors(&o, &e.sc, &e.world) != 0) {
-        free(file_objs);
-        scene_start_close(&st);
-        return 1;
-    }
-    if (in_void(&e.sc, e.cam.view.x, e.cam.view.y))
-        fprintf(stderr, "render: warning: the camera is outside every sector of %s: the frame shows the void\n",
-                o.scene);
-    if (o.objects) {
-        e.world.objs = file_objs;
-        e.world.n = (uint32_t)nfile;
-    } else if (o.no_objects) {
-        e.world.n = 0;
     }
 
     uint32_t *ids = o.ids ? calloc(HAL_PAGE_BYTES, sizeof *ids) : NULL;
@@ -680,21 +768,7 @@ int main(int argc, char **argv)
     }
     const uint8_t *frame = hal_shown_page();
     uint32_t crc = crc_update(0, frame, HAL_PAGE_BYTES);
-
-    int failed = 0;
-    if (o.png && png_write_indexed(o.png, frame, HAL_WIDTH, HAL_HEIGHT, hal_get_palette()) != 0)
-        failed = fprintf(stderr, "render: %s: cannot write PNG: %s\n", o.png, strerror(errno));
-    if (o.raw && write_file(o.raw, frame, HAL_PAGE_BYTES) != 0)
-        failed = fprintf(stderr, "render: %s: cannot write frame: %s\n", o.raw, strerror(errno));
-    if (ids) {
-        uint8_t *bytes = malloc((size_t)HAL_PAGE_BYTES * 4);
-        for (int i = 0; bytes && i < HAL_PAGE_BYTES; i++)
-            for (int k = 0; k < 4; k++) bytes[i * 4 + k] = (uint8_t)(ids[i] >> (8 * k));
-        if (!bytes || write_file(o.ids, bytes, (size_t)HAL_PAGE_BYTES * 4) != 0)
-            failed = fprintf(stderr, "render: %s: cannot write id buffer: %s\n", o.ids, strerror(errno));
-        free(bytes);
-    }
-    if (o.link && send_link(&sender, &e, frame, o.scene, st.data, st.len) != 0) failed = 1;
+    int failed = write_outputs(&o, &e, frame, ids, &sender, &st);
     /* the counters only of a frame that went everywhere it was asked to go */
     if (!failed) print_json(&o, &e, crc, o.link ? &sender : NULL);
     if (o.link) link_close(&sender);

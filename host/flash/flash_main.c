@@ -346,10 +346,85 @@ static int run_loopback(const char *path, const uint8_t *data, size_t len, const
     return rc;
 }
 
-int main(int argc, char **argv)
+/* The command line, as parsed. */
+typedef struct {
+    const char *serial, *add_in, *out, *check;
+    uint16_t vid, pid;            /* --device (or the loopback's own ids) */
+    uint16_t svid, spid, bcd;     /* --vid, --pid, --bcd-device for --add-suffix */
+    int have_dev, have_vid, have_pid, loopback, list, verbose;
+    long unplug_after;
+    unsigned long ts, timeout, reenum;
+} flash_args;
+
+enum { O_DEVICE = 256, O_SERIAL, O_TS, O_TIMEOUT, O_REENUM, O_LOOP, O_UNPLUG, O_ADD, O_VID,
+       O_PID, O_BCD, O_CHECK, O_LIST };
+
+/* One option c with its argument arg: -1 to go on, else the exit code (0 after --help). */
+static int parse_option(int c, const char *arg, const char *given, flash_args *a)
 {
-    enum { O_DEVICE = 256, O_SERIAL, O_TS, O_TIMEOUT, O_REENUM, O_LOOP, O_UNPLUG, O_ADD, O_VID,
-           O_PID, O_BCD, O_CHECK, O_LIST };
+    unsigned long ul;
+    switch (c) {
+    case 'h': usage(stdout); return 0;
+    case 'v': a->verbose++; break;
+    case 'o': a->out = arg; break;
+    case O_DEVICE:
+        if (parse_vidpid(arg, &a->vid, &a->pid) != 0) {
+            fprintf(stderr, "flash: --device wants VID:PID in hex, like 1209:0001 (got \"%s\")\n", arg);
+            return EXIT_USAGE;
+        }
+        a->have_dev = 1;
+        break;
+    case O_SERIAL: a->serial = arg; break;
+    case O_TS:
+        if (parse_uint(arg, 65535, &a->ts) != 0 || a->ts == 0) {
+            fprintf(stderr, "flash: --transfer-size wants a number of bytes, 1..65535 (got \"%s\")\n", arg);
+            return EXIT_USAGE;
+        }
+        break;
+    case O_TIMEOUT:
+    case O_REENUM:
+        if (parse_uint(arg, 3600000, &ul) != 0 || ul == 0) {
+            fprintf(stderr, "flash: %s wants milliseconds, 1..3600000 (got \"%s\")\n",
+                    c == O_TIMEOUT ? "--timeout" : "--reenum-timeout", arg);
+            return EXIT_USAGE;
+        }
+        *(c == O_TIMEOUT ? &a->timeout : &a->reenum) = ul;
+        break;
+    case O_LOOP: a->loopback = 1; break;
+    case O_UNPLUG:
+        if (parse_uint(arg, 100000000, &ul) != 0) {
+            fprintf(stderr, "flash: --loopback-unplug-after wants a number of requests\n");
+            return EXIT_USAGE;
+        }
+        a->unplug_after = (long)ul;
+        break;
+    case O_ADD: a->add_in = arg; break;
+    case O_VID:
+    case O_PID:
+    case O_BCD: {
+        uint16_t v;
+        if (parse_hex16(arg, &v) != 0) {
+            fprintf(stderr, "flash: %s wants a 16-bit hex number like 1209 (got \"%s\")\n",
+                    c == O_VID ? "--vid" : c == O_PID ? "--pid" : "--bcd-device", arg);
+            return EXIT_USAGE;
+        }
+        if (c == O_VID) { a->svid = v; a->have_vid = 1; }
+        else if (c == O_PID) { a->spid = v; a->have_pid = 1; }
+        else a->bcd = v;
+        break;
+    }
+    case O_CHECK: a->check = arg; break;
+    case O_LIST: a->list = 1; break;
+    default:
+        fprintf(stderr, "flash: unknown or incomplete option \"%s\" (see build/flash --help)\n", given);
+        return EXIT_USAGE;
+    }
+    return -1;
+}
+
+/* The options (argv[optind..] are left for the image): -1 to go on, else the exit code. */
+static int parse_args(int argc, char **argv, flash_args *a)
+{
     static const struct option opts[] = {
         {"help", no_argument, 0, 'h'},          {"verbose", no_argument, 0, 'v'},
         {"device", required_argument, 0, O_DEVICE}, {"serial", required_argument, 0, O_SERIAL},
@@ -361,112 +436,110 @@ int main(int argc, char **argv)
         {"output", required_argument, 0, 'o'},  {"check", required_argument, 0, O_CHECK},
         {"list", no_argument, 0, O_LIST},       {0, 0, 0, 0},
     };
-    const char *serial = NULL, *add_in = NULL, *out = NULL, *check = NULL;
-    uint16_t vid = 0, pid = 0, svid = 0, spid = 0, bcd = 0xFFFF;
-    int have_dev = 0, have_vid = 0, have_pid = 0, loopback = 0, list = 0, verbose = 0;
-    long unplug_after = -1;
-    unsigned long ts = 0, timeout = 0, reenum = 0, ul;
+    memset(a, 0, sizeof *a);
+    a->bcd = 0xFFFF;
+    a->unplug_after = -1;
     int c;
     opterr = 0;
     while ((c = getopt_long(argc, argv, "hvo:", opts, NULL)) != -1) {
-        switch (c) {
-        case 'h': usage(stdout); return 0;
-        case 'v': verbose++; break;
-        case 'o': out = optarg; break;
-        case O_DEVICE:
-            if (parse_vidpid(optarg, &vid, &pid) != 0) {
-                fprintf(stderr, "flash: --device wants VID:PID in hex, like 1209:0001 (got \"%s\")\n", optarg);
-                return EXIT_USAGE;
-            }
-            have_dev = 1;
-            break;
-        case O_SERIAL: serial = optarg; break;
-        case O_TS:
-            if (parse_uint(optarg, 65535, &ts) != 0 || ts == 0) {
-                fprintf(stderr, "flash: --transfer-size wants a number of bytes, 1..65535 (got \"%s\")\n", optarg);
-                return EXIT_USAGE;
-            }
-            break;
-        case O_TIMEOUT:
-        case O_REENUM:
-            if (parse_uint(optarg, 3600000, &ul) != 0 || ul == 0) {
-                fprintf(stderr, "flash: %s wants milliseconds, 1..3600000 (got \"%s\")\n",
-                        c == O_TIMEOUT ? "--timeout" : "--reenum-timeout", optarg);
-                return EXIT_USAGE;
-            }
-            *(c == O_TIMEOUT ? &timeout : &reenum) = ul;
-            break;
-        case O_LOOP: loopback = 1; break;
-        case O_UNPLUG:
-            if (parse_uint(optarg, 100000000, &ul) != 0) {
-                fprintf(stderr, "flash: --loopback-unplug-after wants a number of requests\n");
-                return EXIT_USAGE;
-            }
-            unplug_after = (long)ul;
-            break;
-        case O_ADD: add_in = optarg; break;
-        case O_VID:
-        case O_PID:
-        case O_BCD: {
-            uint16_t v;
-            if (parse_hex16(optarg, &v) != 0) {
-                fprintf(stderr, "flash: %s wants a 16-bit hex number like 1209 (got \"%s\")\n",
-                        c == O_VID ? "--vid" : c == O_PID ? "--pid" : "--bcd-device", optarg);
-                return EXIT_USAGE;
-            }
-            if (c == O_VID) { svid = v; have_vid = 1; }
-            else if (c == O_PID) { spid = v; have_pid = 1; }
-            else bcd = v;
-            break;
-        }
-        case O_CHECK: check = optarg; break;
-        case O_LIST: list = 1; break;
-        default:
-            fprintf(stderr, "flash: unknown or incomplete option \"%s\" (see build/flash --help)\n",
-                    argv[optind - 1]);
-            return EXIT_USAGE;
-        }
+        int rc = parse_option(c, optarg, argv[optind - 1], a);
+        if (rc >= 0) return rc;
     }
-    if (add_in) {
-        if (optind < argc) {
-            fprintf(stderr, "flash: unexpected argument \"%s\" with --add-suffix\n", argv[optind]);
-            return EXIT_USAGE;
-        }
-        return add_suffix(add_in, out, have_vid, svid, have_pid, spid, bcd);
-    }
-    if (list)
-        return dfu_usb_list(stdout) ? 0 : EXIT_DEVICE;
-    const char *path = check;
+    return -1;
+}
+
+/* The image to download or --check, and that a device was named: NULL after a message. */
+static const char *image_path(const flash_args *a, int argc, char **argv)
+{
+    const char *path = a->check;
     if (!path) {
         if (optind != argc - 1) {
             fprintf(stderr, optind >= argc ? "flash: no image given (see build/flash --help)\n"
                                            : "flash: give exactly one image (see build/flash --help)\n");
-            return EXIT_USAGE;
+            return NULL;
         }
         path = argv[optind];
     }
-    if (!check && !loopback && !have_dev) {
+    if (!a->check && !a->loopback && !a->have_dev) {
         fprintf(stderr, "flash: which device? give --device VID:PID (build/flash --list shows "
                         "DFU devices), or --loopback to try without hardware\n");
-        return EXIT_USAGE;
+        return NULL;
     }
+    return path;
+}
+
+static void print_functional(uint16_t vid, uint16_t pid, const dfu_func_desc *d)
+{
+    fprintf(stderr, "flash: opened %04x:%04x: bmAttributes 0x%02x (%s%s%s%s), wTransferSize %u, "
+            "wDetachTimeOut %u ms, bcdDFU %04x\n", vid, pid, d->attributes,
+            d->attributes & DFU_ATTR_CAN_DNLOAD ? "download" : "no download",
+            d->attributes & DFU_ATTR_CAN_UPLOAD ? ", upload" : "",
+            d->attributes & DFU_ATTR_MANIFEST_TOLERANT ? ", manifestation-tolerant" : "",
+            d->attributes & DFU_ATTR_WILL_DETACH ? ", will detach" : "",
+            d->transfer_size, d->detach_timeout_ms, d->bcd_dfu);
+}
+
+/* The download to a real device through libusb: the exit code. */
+static int run_usb(const char *path, const uint8_t *data, size_t len, const flash_args *a, const dfu_host_opts *o)
+{
+    char msg[4096];
+    dfu_usb *u;
+    dfu_usb_err ue = dfu_usb_open(&u, a->vid, a->pid, a->serial, a->verbose, msg, sizeof msg);
+    if (ue != DFU_USB_OK) {
+        fprintf(stderr, "flash: %s\n", msg);
+        return EXIT_DEVICE;
+    }
+    dfu_transport t = dfu_usb_transport(u);
+    dfu_func_desc d;
+    t.functional(t.ctx, &d);
+    if (a->verbose) print_functional(a->vid, a->pid, &d);
+    dfu_host_report r;
+    dfu_host_err err = dfu_host_flash(&t, data, len, a->vid, a->pid, o, &r);
+    int rc = report_download(path, err, &r);
+    /* what the user can do about the two failures a device causes */
+    if (err == DFU_HOST_NO_DEVICE)
+        fprintf(stderr, "flash: the device disconnected; reconnect it (it stays in its "
+                        "bootloader) and run the same command again\n");
+    else if (err == DFU_HOST_TIMEOUT)
+        fprintf(stderr, "flash: the device stopped answering; a longer --timeout may help a slow "
+                        "device, otherwise reconnect it and run again\n");
+    dfu_usb_close(u);
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    flash_args a;
+    int rc = parse_args(argc, argv, &a);
+    if (rc >= 0) return rc;
+    if (a.add_in) {
+        if (optind < argc) {
+            fprintf(stderr, "flash: unexpected argument \"%s\" with --add-suffix\n", argv[optind]);
+            return EXIT_USAGE;
+        }
+        return add_suffix(a.add_in, a.out, a.have_vid, a.svid, a.have_pid, a.spid, a.bcd);
+    }
+    if (a.list)
+        return dfu_usb_list(stdout) ? 0 : EXIT_DEVICE;
+    const char *path = image_path(&a, argc, argv);
+    if (!path) return EXIT_USAGE;
 
     uint8_t *data;
     size_t len;
     if (read_file(path, &data, &len) != 0)
         return EXIT_IMAGE;
     dfu_image_t img;
-    int match = have_dev;
-    if (loopback && !have_dev) {
-        vid = LOOP_VID;   /* the simulated device's ids, checked as a real device's */
-        pid = LOOP_PID;
+    int match = a.have_dev;
+    if (a.loopback && !a.have_dev) {
+        a.vid = LOOP_VID;   /* the simulated device's ids, checked as a real device's */
+        a.pid = LOOP_PID;
         match = 1;
     }
-    if (check_image(path, data, len, match, vid, pid, &img) != 0) {
+    if (check_image(path, data, len, match, a.vid, a.pid, &img) != 0) {
         free(data);
         return EXIT_IMAGE;
     }
-    if (check) {
+    if (a.check) {
         print_suffix(stdout, path, len, &img);
         free(data);
         return 0;
@@ -475,50 +548,20 @@ int main(int argc, char **argv)
     int last_pct = -100;
     dfu_host_opts o;
     memset(&o, 0, sizeof o);
-    o.transfer_size = (uint16_t)ts;
-    o.timeout_ms = (unsigned)timeout;
-    o.reenum_timeout_ms = (unsigned)reenum;
-    o.verbose = verbose;
+    o.transfer_size = (uint16_t)a.ts;
+    o.timeout_ms = (unsigned)a.timeout;
+    o.reenum_timeout_ms = (unsigned)a.reenum;
+    o.verbose = a.verbose;
     o.log = log_line;
-    o.progress = verbose ? progress : NULL;
+    o.progress = a.verbose ? progress : NULL;
     o.user = &last_pct;
-    if (verbose)
+    if (a.verbose)
         print_suffix(stderr, path, len, &img);
 
-    int rc;
-    if (loopback) {
-        rc = run_loopback(path, data, len, &img, have_dev, vid, pid, &o, unplug_after);
-    } else {
-        char msg[4096];
-        dfu_usb *u;
-        dfu_usb_err ue = dfu_usb_open(&u, vid, pid, serial, verbose, msg, sizeof msg);
-        if (ue != DFU_USB_OK) {
-            fprintf(stderr, "flash: %s\n", msg);
-            free(data);
-            return EXIT_DEVICE;
-        }
-        dfu_transport t = dfu_usb_transport(u);
-        dfu_func_desc d;
-        t.functional(t.ctx, &d);
-        if (verbose)
-            fprintf(stderr, "flash: opened %04x:%04x: bmAttributes 0x%02x (%s%s%s%s), wTransferSize %u, "
-                    "wDetachTimeOut %u ms, bcdDFU %04x\n", vid, pid, d.attributes,
-                    d.attributes & DFU_ATTR_CAN_DNLOAD ? "download" : "no download",
-                    d.attributes & DFU_ATTR_CAN_UPLOAD ? ", upload" : "",
-                    d.attributes & DFU_ATTR_MANIFEST_TOLERANT ? ", manifestation-tolerant" : "",
-                    d.attributes & DFU_ATTR_WILL_DETACH ? ", will detach" : "",
-                    d.transfer_size, d.detach_timeout_ms, d.bcd_dfu);
-        dfu_host_report r;
-        dfu_host_err err = dfu_host_flash(&t, data, len, vid, pid, &o, &r);
-        rc = report_download(path, err, &r);
-        if (err == DFU_HOST_NO_DEVICE)
-            fprintf(stderr, "flash: the device disconnected; reconnect it (it stays in its "
-                            "bootloader) and run the same command again\n");
-        else if (err == DFU_HOST_TIMEOUT)
-            fprintf(stderr, "flash: the device stopped answering; a longer --timeout may help a slow "
-                            "device, otherwise reconnect it and run again\n");
-        dfu_usb_close(u);
-    }
+    if (a.loopback)
+        rc = run_loopback(path, data, len, &img, a.have_dev, a.vid, a.pid, &o, a.unplug_after);
+    else
+        rc = run_usb(path, data, len, &a, &o);
     free(data);
     return rc;
 }

@@ -77,17 +77,14 @@ static void child_box(const bs_tree *t, uint32_t child, int32_t (*nodebox)[4], i
     }
 }
 
-int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *len, char *err,
-                  size_t errlen)
+/* ---- pass: node boxes ---- */
+
+/* Each node's two child boxes, children before parents (nodes are numbered
+ * parent first); an empty child (no geometry below) gets an all-zero box. */
+static int blob_child_boxes(const bs_tree *t, int32_t (*childbox)[2][4])
 {
-    /* node boxes, children before parents (nodes are numbered parent first) */
     int32_t(*nodebox)[4] = malloc(sizeof *nodebox * (t->nnodes + 1));
-    int32_t(*childbox)[2][4] = malloc(sizeof *childbox * (t->nnodes + 1));
-    if (!nodebox || !childbox) {
-        free(nodebox);
-        free(childbox);
-        return bs_fail(err, errlen, "%s: out of memory", s->name);
-    }
+    if (!nodebox) return -1;
     for (uint32_t i = t->nnodes; i-- > 0;) {
         memcpy(nodebox[i], empty_box, sizeof empty_box);
         for (int c = 0; c < 2; c++) {
@@ -98,216 +95,318 @@ int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *l
                 bbox_union(nodebox[i], childbox[i][c]);
         }
     }
+    free(nodebox);
+    return 0;
+}
 
+/* ---- layout ---- */
+
+/* Every section's record count and 4-aligned offset; returns the blob's size
+ * (which may not fit in 32 bits: the caller refuses that). */
+static uint64_t blob_layout(const bs_scene *s, const bs_tree *t, uint32_t counts[SCN_SEC_COUNT],
+                            uint32_t off[SCN_SEC_COUNT])
+{
     uint32_t npv = 0;
     for (uint32_t i = 0; i < t->nleaves; i++) npv += t->leaves[i].poly.n;
     const bs_look *lk = &s->look;
     int look = lk->present;
-    uint32_t counts[SCN_SEC_COUNT] = {t->nverts, s->nsectors, s->nlines, t->nsegs,
-                                      t->nnodes, t->nleaves,  npv,       256,
-                                      s->nmodels, s->nmverts, s->nfaces, s->nfindex, s->nobjects, 1,
-                                      look ? 1u : 0u, look ? SCN_LIGHT_MAPS : 0u, look ? lk->ntex : 0u,
-                                      look ? lk->ntexels : 0u, look ? 2u * s->nlines : 0u,
-                                      look ? s->nsectors : 0u};
+    const uint32_t c[SCN_SEC_COUNT] = {t->nverts, s->nsectors, s->nlines, t->nsegs,
+                                       t->nnodes, t->nleaves,  npv,       256,
+                                       s->nmodels, s->nmverts, s->nfaces, s->nfindex, s->nobjects, 1,
+                                       look ? 1u : 0u, look ? SCN_LIGHT_MAPS : 0u, look ? lk->ntex : 0u,
+                                       look ? lk->ntexels : 0u, look ? 2u * s->nlines : 0u,
+                                       look ? s->nsectors : 0u};
     static const uint32_t recsz[SCN_SEC_COUNT] = {8, 12 + 4, 24, 16, 56, 20, 8, 3, 28, 12, 8, 4, 40,
                                                   sizeof(scn_needs), 8, 256, 12, 1, 24, 4};
-    uint32_t off[SCN_SEC_COUNT];
     uint64_t at = sizeof(scn_header);
     for (int k = 0; k < SCN_SEC_COUNT; k++) {
         at = (at + 3) & ~(uint64_t)3;
+        counts[k] = c[k];
         off[k] = (uint32_t)at;
-        at += (uint64_t)counts[k] * recsz[k];
+        at += (uint64_t)c[k] * recsz[k];
     }
-    at = (at + 3) & ~(uint64_t)3;
-    if (at > UINT32_MAX) {
-        free(nodebox);
-        free(childbox);
-        return bs_fail(err, errlen, "%s: compiled scene larger than 4 GiB", s->name);
-    }
-    uint8_t *p = calloc((size_t)at, 1);
-    if (!p) {
-        free(nodebox);
-        free(childbox);
-        return bs_fail(err, errlen, "%s: out of memory", s->name);
-    }
-    wr w = {p, 0};
+    return (at + 3) & ~(uint64_t)3;
+}
 
-    /* header */
-    w32(&w, SCN_MAGIC);
-    w16(&w, SCN_VERSION);
-    w16(&w, (uint16_t)sizeof(scn_header));
-    w32(&w, (uint32_t)at);
-    w32(&w, 0); /* crc, below */
-    w32(&w, 0); /* flags */
-    wi32(&w, s->player_x);
-    wi32(&w, s->player_y);
-    wi32(&w, s->player_angle);
-    w32(&w, s->player_sector);
-    w32(&w, t->root);
-    w32(&w, t->max_depth);
+/* ---- section writers ---- */
+
+/* What the section writers read: the scene, its tree and the node boxes. */
+typedef struct {
+    const bs_scene *s;
+    const bs_tree *t;
+    int32_t (*childbox)[2][4];
+} blob_src;
+
+static void put_header(wr *w, const blob_src *b, uint32_t size, const uint32_t counts[SCN_SEC_COUNT],
+                       const uint32_t off[SCN_SEC_COUNT])
+{
+    w32(w, SCN_MAGIC);
+    w16(w, SCN_VERSION);
+    w16(w, (uint16_t)sizeof(scn_header));
+    w32(w, size);
+    w32(w, 0); /* crc, at the end */
+    w32(w, 0); /* flags */
+    wi32(w, b->s->player_x);
+    wi32(w, b->s->player_y);
+    wi32(w, b->s->player_angle);
+    w32(w, b->s->player_sector);
+    w32(w, b->t->root);
+    w32(w, b->t->max_depth);
     for (int k = 0; k < SCN_SEC_COUNT; k++) {
-        w32(&w, off[k]);
-        w32(&w, counts[k]);
+        w32(w, off[k]);
+        w32(w, counts[k]);
     }
+}
 
-    w.at = off[SCN_SEC_VERTICES];
-    for (uint32_t i = 0; i < t->nverts; i++) {
-        wi32(&w, t->vx[i]);
-        wi32(&w, t->vy[i]);
+static void put_vertices(wr *w, const blob_src *b)
+{
+    for (uint32_t i = 0; i < b->t->nverts; i++) {
+        wi32(w, b->t->vx[i]);
+        wi32(w, b->t->vy[i]);
     }
-    w.at = off[SCN_SEC_SECTORS];
-    for (uint32_t i = 0; i < s->nsectors; i++) {
-        const bs_sector *c = &s->sectors[i];
-        wi32(&w, c->floor_h);
-        wi32(&w, c->ceil_h);
-        w8(&w, c->floor_color);
-        w8(&w, c->ceil_color);
-        w8(&w, c->light);
-        w8(&w, c->flags);
-        wi32(&w, (c->flags & SCN_SECTOR_DOOR) ? c->open_h : c->ceil_h);
+}
+
+static void put_sectors(wr *w, const blob_src *b)
+{
+    for (uint32_t i = 0; i < b->s->nsectors; i++) {
+        const bs_sector *c = &b->s->sectors[i];
+        wi32(w, c->floor_h);
+        wi32(w, c->ceil_h);
+        w8(w, c->floor_color);
+        w8(w, c->ceil_color);
+        w8(w, c->light);
+        w8(w, c->flags);
+        wi32(w, (c->flags & SCN_SECTOR_DOOR) ? c->open_h : c->ceil_h);
     }
-    w.at = off[SCN_SEC_LINES];
-    for (uint32_t i = 0; i < s->nlines; i++) {
-        const bs_line *l = &s->lines[i];
-        w32(&w, t->line_v[2 * i]);
-        w32(&w, t->line_v[2 * i + 1]);
-        w32(&w, l->sector[0]);
-        w32(&w, l->sector[1]);
+}
+
+static void put_lines(wr *w, const blob_src *b)
+{
+    for (uint32_t i = 0; i < b->s->nlines; i++) {
+        const bs_line *l = &b->s->lines[i];
+        w32(w, b->t->line_v[2 * i]);
+        w32(w, b->t->line_v[2 * i + 1]);
+        w32(w, l->sector[0]);
+        w32(w, l->sector[1]);
         for (int sd = 0; sd < 2; sd++)
-            for (int part = 0; part < 3; part++) w8(&w, l->color[sd][part]);
-        w16(&w, 0);
+            for (int part = 0; part < 3; part++) w8(w, l->color[sd][part]);
+        w16(w, 0);
     }
-    w.at = off[SCN_SEC_SEGS];
+}
+
+/* segs grouped by leaf, in leaf order: put_leaves numbers them the same way */
+static void put_segs(wr *w, const blob_src *b)
+{
+    const bs_tree *t = b->t;
     for (uint32_t i = 0; i < t->nleaves; i++) {
         const bs_leaf *L = &t->leaves[i];
         for (uint32_t k = 0; k < L->nsegs; k++) {
             const bs_seg *g = &t->segs[L->segs[k]];
-            w32(&w, g->v1);
-            w32(&w, g->v2);
-            w32(&w, g->line);
-            w32(&w, g->side);
+            w32(w, g->v1);
+            w32(w, g->v2);
+            w32(w, g->line);
+            w32(w, g->side);
         }
     }
-    w.at = off[SCN_SEC_NODES];
+}
+
+static void put_nodes(wr *w, const blob_src *b)
+{
+    const bs_tree *t = b->t;
     for (uint32_t i = 0; i < t->nnodes; i++) {
         const bs_node *N = &t->nodes[i];
         const bs_pline *P = &t->plines[N->pline];
-        wi32(&w, P->x);
-        wi32(&w, P->y);
-        wi32(&w, N->rev ? -P->dx : P->dx);
-        wi32(&w, N->rev ? -P->dy : P->dy);
+        wi32(w, P->x);
+        wi32(w, P->y);
+        wi32(w, N->rev ? -P->dx : P->dx);
+        wi32(w, N->rev ? -P->dy : P->dy);
         for (int c = 0; c < 2; c++)
-            for (int k = 0; k < 4; k++) wi32(&w, childbox[i][c][k]);
-        w32(&w, N->child[0]);
-        w32(&w, N->child[1]);
+            for (int k = 0; k < 4; k++) wi32(w, b->childbox[i][c][k]);
+        w32(w, N->child[0]);
+        w32(w, N->child[1]);
     }
-    w.at = off[SCN_SEC_LEAVES];
+}
+
+static void put_leaves(wr *w, const blob_src *b)
+{
     uint32_t fs = 0, fp = 0;
-    for (uint32_t i = 0; i < t->nleaves; i++) {
-        const bs_leaf *L = &t->leaves[i];
-        w32(&w, fs);
-        w32(&w, L->nsegs);
-        w32(&w, L->sector);
-        w32(&w, fp);
-        w32(&w, L->poly.n);
+    for (uint32_t i = 0; i < b->t->nleaves; i++) {
+        const bs_leaf *L = &b->t->leaves[i];
+        w32(w, fs);
+        w32(w, L->nsegs);
+        w32(w, L->sector);
+        w32(w, fp);
+        w32(w, L->poly.n);
         fs += L->nsegs;
         fp += L->poly.n;
     }
-    w.at = off[SCN_SEC_PVERTS];
+}
+
+static void put_pverts(wr *w, const blob_src *b)
+{
+    const bs_tree *t = b->t;
     for (uint32_t i = 0; i < t->nleaves; i++)
         for (uint32_t k = 0; k < t->leaves[i].poly.n; k++) {
-            wi32(&w, t->leaves[i].poly.v[k].x);
-            wi32(&w, t->leaves[i].poly.v[k].y);
+            wi32(w, t->leaves[i].poly.v[k].x);
+            wi32(w, t->leaves[i].poly.v[k].y);
         }
-    w.at = off[SCN_SEC_PALETTE];
-    if (lk->doom_palette)
-        memcpy(p + w.at, lk->palette, 768);
+}
+
+/* the WAD's PLAYPAL when it has one, else the built-in palette */
+static void put_palette(wr *w, const blob_src *b)
+{
+    if (b->s->look.doom_palette)
+        memcpy(w->p + w->at, b->s->look.palette, 768);
     else
-        bs_palette(p + w.at);
-    w.at = off[SCN_SEC_MODELS];
-    for (uint32_t i = 0; i < s->nmodels; i++) {
-        const bs_model *m = &s->models[i];
-        w32(&w, m->first_vert);
-        w32(&w, m->num_verts);
-        w32(&w, m->first_face);
-        w32(&w, m->num_faces);
-        wi32(&w, m->radius);
-        wi32(&w, m->zmin);
-        wi32(&w, m->zmax);
-    }
-    w.at = off[SCN_SEC_MVERTS];
-    for (uint32_t i = 0; i < s->nmverts; i++) {
-        wi32(&w, s->mverts[i].x);
-        wi32(&w, s->mverts[i].y);
-        wi32(&w, s->mverts[i].z);
-    }
-    w.at = off[SCN_SEC_FACES];
-    for (uint32_t i = 0; i < s->nfaces; i++) {
-        const bs_face *f = &s->faces[i];
-        w32(&w, f->first_index);
-        w16(&w, f->num_index);
-        w8(&w, f->colour);
-        w8(&w, f->part);
-    }
-    w.at = off[SCN_SEC_FINDEX];
-    for (uint32_t i = 0; i < s->nfindex; i++) w32(&w, s->findex[i]);
-    w.at = off[SCN_SEC_OBJECTS];
-    for (uint32_t i = 0; i < s->nobjects; i++) {
-        const bs_object *o = &s->objects[i];
-        w32(&w, o->model);
-        wi32(&w, o->x);
-        wi32(&w, o->y);
-        wi32(&w, o->z);
-        wi32(&w, o->yaw);
-        w32(&w, o->path);
-        wi32(&w, o->pa);
-        wi32(&w, o->pb);
-        w32(&w, o->period_ms);
-        wi32(&w, o->spin);
-    }
+        bs_palette(w->p + w->at);
+}
 
-    if (look) {
-        w.at = off[SCN_SEC_LOOK];
-        w32(&w, lk->sky_tex);
-        w32(&w, 0);
-        memcpy(p + off[SCN_SEC_LIGHTS], lk->lights, 256 * SCN_LIGHT_MAPS);
-        w.at = off[SCN_SEC_TEXTURES];
-        for (uint32_t i = 0; i < lk->ntex; i++) {
-            w32(&w, lk->tex[i].first);
-            w8(&w, lk->tex[i].wbits);
-            w8(&w, lk->tex[i].hbits);
-            w8(&w, lk->tex[i].colour);
-            w8(&w, 0);
-            w16(&w, lk->tex[i].height);
-            w16(&w, 0);
-        }
-        memcpy(p + off[SCN_SEC_TEXELS], lk->texels, lk->ntexels);
-        w.at = off[SCN_SEC_SIDES];
-        for (uint32_t i = 0; i < 2 * s->nlines; i++) {
-            const scn_side *d = &lk->sides[i];
-            wi32(&w, d->ux);
-            wi32(&w, d->uy);
-            wi32(&w, d->u0);
-            wi32(&w, d->row_off);
-            for (int k = 0; k < 3; k++) w16(&w, d->tex[k]);
-            w8(&w, d->flags);
-            w8(&w, (uint8_t)d->light_adj);
-        }
-        w.at = off[SCN_SEC_PLANES];
-        for (uint32_t i = 0; i < s->nsectors; i++) {
-            w16(&w, lk->planes[i].floor_tex);
-            w16(&w, lk->planes[i].ceil_tex);
-        }
+static void put_models(wr *w, const blob_src *b)
+{
+    for (uint32_t i = 0; i < b->s->nmodels; i++) {
+        const bs_model *m = &b->s->models[i];
+        w32(w, m->first_vert);
+        w32(w, m->num_verts);
+        w32(w, m->first_face);
+        w32(w, m->num_faces);
+        wi32(w, m->radius);
+        wi32(w, m->zmin);
+        wi32(w, m->zmax);
     }
+}
 
-    /* the needs record (SCN_SEC_NEEDS) stays zero here: bspc.c fills it in from
-     * the analysis of this very blob and recomputes the CRC */
-    uint32_t crc = crc_update(0, p + 16, (size_t)at - 16);
+static void put_mverts(wr *w, const blob_src *b)
+{
+    for (uint32_t i = 0; i < b->s->nmverts; i++) {
+        wi32(w, b->s->mverts[i].x);
+        wi32(w, b->s->mverts[i].y);
+        wi32(w, b->s->mverts[i].z);
+    }
+}
+
+static void put_faces(wr *w, const blob_src *b)
+{
+    for (uint32_t i = 0; i < b->s->nfaces; i++) {
+        const bs_face *f = &b->s->faces[i];
+        w32(w, f->first_index);
+        w16(w, f->num_index);
+        w8(w, f->colour);
+        w8(w, f->part);
+    }
+}
+
+static void put_findex(wr *w, const blob_src *b)
+{
+    for (uint32_t i = 0; i < b->s->nfindex; i++) w32(w, b->s->findex[i]);
+}
+
+static void put_objects(wr *w, const blob_src *b)
+{
+    for (uint32_t i = 0; i < b->s->nobjects; i++) {
+        const bs_object *o = &b->s->objects[i];
+        w32(w, o->model);
+        wi32(w, o->x);
+        wi32(w, o->y);
+        wi32(w, o->z);
+        wi32(w, o->yaw);
+        w32(w, o->path);
+        wi32(w, o->pa);
+        wi32(w, o->pb);
+        w32(w, o->period_ms);
+        wi32(w, o->spin);
+    }
+}
+
+static void put_look(wr *w, const blob_src *b)
+{
+    w32(w, b->s->look.sky_tex);
+    w32(w, 0);
+}
+
+static void put_lights(wr *w, const blob_src *b) { memcpy(w->p + w->at, b->s->look.lights, 256 * SCN_LIGHT_MAPS); }
+
+static void put_textures(wr *w, const blob_src *b)
+{
+    const bs_look *lk = &b->s->look;
+    for (uint32_t i = 0; i < lk->ntex; i++) {
+        w32(w, lk->tex[i].first);
+        w8(w, lk->tex[i].wbits);
+        w8(w, lk->tex[i].hbits);
+        w8(w, lk->tex[i].colour);
+        w8(w, 0);
+        w16(w, lk->tex[i].height);
+        w16(w, 0);
+    }
+}
+
+static void put_texels(wr *w, const blob_src *b) { memcpy(w->p + w->at, b->s->look.texels, b->s->look.ntexels); }
+
+static void put_sides(wr *w, const blob_src *b)
+{
+    for (uint32_t i = 0; i < 2 * b->s->nlines; i++) {
+        const scn_side *d = &b->s->look.sides[i];
+        wi32(w, d->ux);
+        wi32(w, d->uy);
+        wi32(w, d->u0);
+        wi32(w, d->row_off);
+        for (int k = 0; k < 3; k++) w16(w, d->tex[k]);
+        w8(w, d->flags);
+        w8(w, (uint8_t)d->light_adj);
+    }
+}
+
+static void put_planes(wr *w, const blob_src *b)
+{
+    for (uint32_t i = 0; i < b->s->nsectors; i++) {
+        w16(w, b->s->look.planes[i].floor_tex);
+        w16(w, b->s->look.planes[i].ceil_tex);
+    }
+}
+
+/* One writer per section, in enum order. The needs record (SCN_SEC_NEEDS) has
+ * none: it stays zero here, and bspc.c fills it in from the analysis of this
+ * very blob and recomputes the CRC. */
+static void (*const put_section[SCN_SEC_COUNT])(wr *, const blob_src *) = {
+    [SCN_SEC_VERTICES] = put_vertices, [SCN_SEC_SECTORS] = put_sectors, [SCN_SEC_LINES] = put_lines,
+    [SCN_SEC_SEGS] = put_segs,         [SCN_SEC_NODES] = put_nodes,     [SCN_SEC_LEAVES] = put_leaves,
+    [SCN_SEC_PVERTS] = put_pverts,     [SCN_SEC_PALETTE] = put_palette, [SCN_SEC_MODELS] = put_models,
+    [SCN_SEC_MVERTS] = put_mverts,     [SCN_SEC_FACES] = put_faces,     [SCN_SEC_FINDEX] = put_findex,
+    [SCN_SEC_OBJECTS] = put_objects,   [SCN_SEC_LOOK] = put_look,       [SCN_SEC_LIGHTS] = put_lights,
+    [SCN_SEC_TEXTURES] = put_textures, [SCN_SEC_TEXELS] = put_texels,   [SCN_SEC_SIDES] = put_sides,
+    [SCN_SEC_PLANES] = put_planes,
+};
+
+int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *len, char *err,
+                  size_t errlen)
+{
+    int32_t(*childbox)[2][4] = malloc(sizeof *childbox * (t->nnodes + 1));
+    if (!childbox || blob_child_boxes(t, childbox)) {
+        free(childbox);
+        return bs_fail(err, errlen, "%s: out of memory", s->name);
+    }
+    uint32_t counts[SCN_SEC_COUNT], off[SCN_SEC_COUNT];
+    uint64_t size = blob_layout(s, t, counts, off);
+    uint8_t *p = size > UINT32_MAX ? NULL : calloc((size_t)size, 1);
+    if (!p) {
+        free(childbox);
+        if (size > UINT32_MAX) return bs_fail(err, errlen, "%s: compiled scene larger than 4 GiB", s->name);
+        return bs_fail(err, errlen, "%s: out of memory", s->name);
+    }
+    blob_src b = {s, t, childbox};
+    wr w = {p, 0};
+    put_header(&w, &b, (uint32_t)size, counts, off);
+    /* a section without records is not written: the look's sections have
+     * none when the scene has no look (their sources are then empty) */
+    for (int k = 0; k < SCN_SEC_COUNT; k++)
+        if (put_section[k] && counts[k]) {
+            w.at = off[k];
+            put_section[k](&w, &b);
+        }
+    uint32_t crc = crc_update(0, p + 16, (size_t)size - 16);
     w.at = 12;
     w32(&w, crc);
-    free(nodebox);
     free(childbox);
     *blob = p;
-    *len = (size_t)at;
+    *len = (size_t)size;
     return 0;
 }

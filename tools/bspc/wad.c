@@ -274,140 +274,131 @@ static int find_doors(bs_scene *s, const uint8_t *lines, uint32_t nl, const uint
     return 0;
 }
 
-int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_scene *s,
-                const bspc_options *opt, char *err, size_t errlen)
+/* ---- the map's lumps ---- */
+
+enum { L_THINGS, L_LINEDEFS, L_SIDEDEFS, L_VERTEXES, L_SECTORS, L_N };
+static const char *const need[L_N] = {"THINGS", "LINEDEFS", "SIDEDEFS", "VERTEXES", "SECTORS"};
+
+/* One map being read: the open WAD, its directory and the lumps read so far,
+ * shared by the per-lump readers below (as Doom's P_Load* share the level). */
+typedef struct {
+    FILE *f;
+    size_t len;          /* file size */
+    const char *wadpath, *display;
+    const bspc_options *opt;
+    char *err;
+    size_t errlen;
+    lump *dir;
+    uint8_t *dirbuf;
+    uint32_t nlumps;
+    char want[9];        /* the map marker's name, upper case */
+    uint8_t *ld[L_N];    /* the lumps this reader uses, NULL until found */
+    uint32_t cnt[L_N];   /* their record counts */
+    uint8_t *vused;      /* [nverts]: the vertex ends a kept linedef */
+    bs_wadlook *look;    /* textures and light tables; NULL with --flat */
+} wad_map;
+
+/* The 12-byte header and the lump directory. */
+static int wad_read_dir(wad_map *m)
 {
-    snprintf(s->name, sizeof s->name, "%s", display);
-    s->is_text = 0;
-    s->player_sector = SCN_NONE;
-    FILE *f = fopen(wadpath, "rb");
-    if (!f) return bs_fail(err, errlen, "%s: cannot open %s: %s", display, wadpath, strerror(errno));
-    int rc = -1;
-    lump *dir = NULL;
-    uint8_t *vused = NULL, *dirbuf = NULL;
-    bs_wadlook *look = NULL;
-    enum { L_THINGS, L_LINEDEFS, L_SIDEDEFS, L_VERTEXES, L_SECTORS, L_N };
-    uint8_t *ld[L_N] = {0};
     uint8_t hdr[12];
     long flen = -1;
-    if (fseek(f, 0, SEEK_END) == 0) flen = ftell(f);
-    if (flen < 12 || read_at(f, 0, 12, hdr)) {
-        bs_fail(err, errlen, "%s: %s is not a WAD file (%ld bytes, shorter than the 12-byte header)", display,
-                wadpath, flen < 0 ? 0L : flen);
-        goto out;
-    }
+    if (fseek(m->f, 0, SEEK_END) == 0) flen = ftell(m->f);
+    if (flen < 12 || read_at(m->f, 0, 12, hdr))
+        return bs_fail(m->err, m->errlen, "%s: %s is not a WAD file (%ld bytes, shorter than the 12-byte header)",
+                       m->display, m->wadpath, flen < 0 ? 0L : flen);
     if (memcmp(hdr, "IWAD", 4) != 0 && memcmp(hdr, "PWAD", 4) != 0) {
         char magic[5];
         for (int i = 0; i < 4; i++) magic[i] = isprint(hdr[i]) ? (char)hdr[i] : '?';
         magic[4] = 0;
-        bs_fail(err, errlen, "%s: %s is not a WAD file (header magic '%s', not IWAD or PWAD)", display, wadpath,
-                magic);
-        goto out;
+        return bs_fail(m->err, m->errlen, "%s: %s is not a WAD file (header magic '%s', not IWAD or PWAD)",
+                       m->display, m->wadpath, magic);
     }
-    size_t len = (size_t)flen;
+    m->len = (size_t)flen;
     uint32_t nlumps = rd32(hdr + 4), dirofs = rd32(hdr + 8);
-    if (dirofs > len || nlumps > (len - dirofs) / 16) {
-        bs_fail(err, errlen, "%s: %s: lump directory (%u lumps at offset %u) runs past the end of "
-                "the file (%zu bytes)", display, wadpath, nlumps, dirofs, len);
-        goto out;
-    }
-    dir = calloc(nlumps + 1, sizeof *dir);
-    dirbuf = malloc((size_t)nlumps * 16 + 1);
-    if (!dir || !dirbuf) {
-        bs_fail(err, errlen, "%s: out of memory", display);
-        goto out;
-    }
-    if (read_at(f, dirofs, nlumps * 16, dirbuf)) {
-        bs_fail(err, errlen, "%s: %s: cannot read the lump directory", display, wadpath);
-        goto out;
-    }
+    if (dirofs > m->len || nlumps > (m->len - dirofs) / 16)
+        return bs_fail(m->err, m->errlen, "%s: %s: lump directory (%u lumps at offset %u) runs past the end of "
+                       "the file (%zu bytes)", m->display, m->wadpath, nlumps, dirofs, m->len);
+    m->nlumps = nlumps;
+    m->dir = calloc(nlumps + 1, sizeof *m->dir);
+    m->dirbuf = malloc((size_t)nlumps * 16 + 1);
+    if (!m->dir || !m->dirbuf) return bs_fail(m->err, m->errlen, "%s: out of memory", m->display);
+    if (read_at(m->f, dirofs, nlumps * 16, m->dirbuf))
+        return bs_fail(m->err, m->errlen, "%s: %s: cannot read the lump directory", m->display, m->wadpath);
     for (uint32_t i = 0; i < nlumps; i++) {
-        const uint8_t *e = dirbuf + 16 * i;
-        dir[i].pos = rd32(e);
-        dir[i].size = rd32(e + 4);
-        name8(dir[i].name, e + 8);
+        const uint8_t *e = m->dirbuf + 16 * i;
+        m->dir[i].pos = rd32(e);
+        m->dir[i].size = rd32(e + 4);
+        name8(m->dir[i].name, e + 8);
     }
-    char want[9];
+    return 0;
+}
+
+/* The index of the map's marker lump, or -1 with a message naming the maps
+ * the WAD has. */
+static int64_t wad_find_marker(wad_map *m, const char *map)
+{
     size_t ml = strlen(map);
-    if (ml > 8) {
-        bs_fail(err, errlen, "%s: map name '%s' is longer than 8 characters", display, map);
-        goto out;
-    }
-    memset(want, 0, sizeof want);
-    for (size_t i = 0; i < ml; i++) want[i] = (char)toupper((unsigned char)map[i]);
-    uint32_t marker = nlumps;
-    for (uint32_t i = nlumps; i-- > 0;) /* the last one wins, as in the engine */
-        if (strcmp(dir[i].name, want) == 0) {
-            marker = i;
-            break;
-        }
-    if (marker == nlumps) {
-        char maps[200];
-        if (bspc_list_maps(wadpath, maps, sizeof maps, err, errlen) >= 0)
-            bs_fail(err, errlen, "%s: no map %s in %s (its maps: %s)", display, want, wadpath, *maps ? maps : "none");
-        goto out;
-    }
-    static const char *need[L_N] = {"THINGS", "LINEDEFS", "SIDEDEFS", "VERTEXES", "SECTORS"};
+    if (ml > 8) return bs_fail(m->err, m->errlen, "%s: map name '%s' is longer than 8 characters", m->display, map);
+    memset(m->want, 0, sizeof m->want);
+    for (size_t i = 0; i < ml; i++) m->want[i] = (char)toupper((unsigned char)map[i]);
+    for (uint32_t i = m->nlumps; i-- > 0;) /* the last one wins, as in the engine */
+        if (strcmp(m->dir[i].name, m->want) == 0) return i;
+    char maps[200];
+    if (bspc_list_maps(m->wadpath, maps, sizeof maps, m->err, m->errlen) >= 0)
+        bs_fail(m->err, m->errlen, "%s: no map %s in %s (its maps: %s)", m->display, m->want, m->wadpath,
+                *maps ? maps : "none");
+    return -1;
+}
+
+/* Read lump i as lump kind k, checking it lies in the file and holds whole records. */
+static int wad_read_lump(wad_map *m, uint32_t i, int k)
+{
     static const uint32_t recsz[L_N] = {10, 14, 30, 4, 26};
-    uint32_t cnt[L_N] = {0};
-    for (uint32_t i = marker + 1; i < nlumps && is_map_lump(dir[i].name); i++) {
-        if (strcmp(dir[i].name, "BEHAVIOR") == 0) {
-            bs_fail(err, errlen, "%s: Hexen-format map (has a BEHAVIOR lump): only Doom-format maps "
-                    "are supported", display);
-            goto out;
-        }
-        for (int k = 0; k < L_N; k++) {
-            if (strcmp(dir[i].name, need[k]) != 0 || ld[k]) continue;
-            if (dir[i].pos > len || dir[i].size > len - dir[i].pos) {
-                bs_fail(err, errlen, "%s: %s lump runs past the end of the file", display, need[k]);
-                goto out;
-            }
-            if (dir[i].size % recsz[k] != 0) {
-                bs_fail(err, errlen, "%s: %s lump size %u is not a multiple of %u bytes", display,
-                        need[k], dir[i].size, recsz[k]);
-                goto out;
-            }
-            ld[k] = malloc(dir[i].size + 1);
-            if (!ld[k]) {
-                bs_fail(err, errlen, "%s: out of memory", display);
-                goto out;
-            }
-            if (read_at(f, dir[i].pos, dir[i].size, ld[k])) {
-                bs_fail(err, errlen, "%s: cannot read the %s lump", display, need[k]);
-                goto out;
-            }
-            cnt[k] = dir[i].size / recsz[k];
-        }
+    const lump *d = &m->dir[i];
+    if (d->pos > m->len || d->size > m->len - d->pos)
+        return bs_fail(m->err, m->errlen, "%s: %s lump runs past the end of the file", m->display, need[k]);
+    if (d->size % recsz[k] != 0)
+        return bs_fail(m->err, m->errlen, "%s: %s lump size %u is not a multiple of %u bytes", m->display,
+                       need[k], d->size, recsz[k]);
+    m->ld[k] = malloc(d->size + 1);
+    if (!m->ld[k]) return bs_fail(m->err, m->errlen, "%s: out of memory", m->display);
+    if (read_at(m->f, d->pos, d->size, m->ld[k]))
+        return bs_fail(m->err, m->errlen, "%s: cannot read the %s lump", m->display, need[k]);
+    m->cnt[k] = d->size / recsz[k];
+    return 0;
+}
+
+/* The lumps after the marker, up to the first one that is not a map lump:
+ * the first of each kind this reader uses is read; all must be there. */
+static int wad_read_map_lumps(wad_map *m, uint32_t marker)
+{
+    for (uint32_t i = marker + 1; i < m->nlumps && is_map_lump(m->dir[i].name); i++) {
+        if (strcmp(m->dir[i].name, "BEHAVIOR") == 0)
+            return bs_fail(m->err, m->errlen, "%s: Hexen-format map (has a BEHAVIOR lump): only Doom-format maps "
+                           "are supported", m->display);
+        for (int k = 0; k < L_N; k++)
+            if (strcmp(m->dir[i].name, need[k]) == 0 && !m->ld[k] && wad_read_lump(m, i, k)) return -1;
     }
     for (int k = 0; k < L_N; k++)
-        if (!ld[k]) {
-            bs_fail(err, errlen, "%s: map has no %s lump", display, need[k]);
-            goto out;
-        }
+        if (!m->ld[k]) return bs_fail(m->err, m->errlen, "%s: map has no %s lump", m->display, need[k]);
+    return 0;
+}
 
-    /* sectors */
-    if (cnt[L_SECTORS] == 0) {
-        bs_fail(err, errlen, "%s: map has no sectors", display);
-        goto out;
-    }
-    if (bs_look_open(f, len, dir, nlumps, want, s, cnt[L_SECTORS], cnt[L_LINEDEFS], opt, &look, err, errlen))
-        goto out;
-    s->sectors = calloc(cnt[L_SECTORS], sizeof *s->sectors);
-    if (!s->sectors) {
-        bs_fail(err, errlen, "%s: out of memory", display);
-        goto out;
-    }
-    s->scap = s->nsectors = cnt[L_SECTORS];
-    for (uint32_t i = 0; i < cnt[L_SECTORS]; i++) {
-        const uint8_t *r = ld[L_SECTORS] + 26 * i;
+/* Sectors: heights, light, flat colours and the sky (P_LoadSectors). */
+static int wad_load_sectors(wad_map *m, bs_scene *s)
+{
+    uint32_t n = m->cnt[L_SECTORS];
+    s->sectors = calloc(n, sizeof *s->sectors);
+    if (!s->sectors) return bs_fail(m->err, m->errlen, "%s: out of memory", m->display);
+    s->scap = s->nsectors = n;
+    for (uint32_t i = 0; i < n; i++) {
+        const uint8_t *r = m->ld[L_SECTORS] + 26 * i;
         bs_sector *c = &s->sectors[i];
         int fh = rds16(r), ch = rds16(r + 2);
-        if (fh > SCN_HEIGHT_MAX || fh < -SCN_HEIGHT_MAX || ch > SCN_HEIGHT_MAX ||
-            ch < -SCN_HEIGHT_MAX) {
-            bs_fail(err, errlen, "%s: sector %u: floor %d / ceiling %d out of range (|height| <= %d)",
-                    display, i, fh, ch, SCN_HEIGHT_MAX);
-            goto out;
-        }
+        if (fh > SCN_HEIGHT_MAX || fh < -SCN_HEIGHT_MAX || ch > SCN_HEIGHT_MAX || ch < -SCN_HEIGHT_MAX)
+            return bs_fail(m->err, m->errlen, "%s: sector %u: floor %d / ceiling %d out of range (|height| <= %d)",
+                           m->display, i, fh, ch, SCN_HEIGHT_MAX);
         c->floor_h = fh * 65536;
         c->ceil_h = ch * 65536;
         int light = rds16(r + 20);
@@ -424,113 +415,127 @@ int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_sc
         } else {
             c->ceil_color = bs_flat_color(cflat, light, 1);
         }
-        if (look && bs_look_sector(look, i, r, err, errlen)) goto out;
+        if (m->look && bs_look_sector(m->look, i, r, m->err, m->errlen)) return -1;
     }
+    return 0;
+}
 
-    /* vertices: all of them, in lump order (unused ones are dropped by the build) */
-    uint32_t nv = cnt[L_VERTEXES];
+/* Vertices: all of them, in lump order (unused ones are dropped by the build;
+ * only the used ones are range-checked, by wad_check_vertexes). */
+static int wad_load_vertexes(wad_map *m, bs_scene *s)
+{
+    uint32_t nv = m->cnt[L_VERTEXES];
     s->vx = malloc(sizeof(int32_t) * (nv + 1));
     s->vy = malloc(sizeof(int32_t) * (nv + 1));
-    vused = calloc(nv + 1, 1);
-    if (!s->vx || !s->vy || !vused) {
-        bs_fail(err, errlen, "%s: out of memory", display);
-        goto out;
-    }
+    m->vused = calloc(nv + 1, 1);
+    if (!s->vx || !s->vy || !m->vused) return bs_fail(m->err, m->errlen, "%s: out of memory", m->display);
     s->vcap = s->nverts = nv;
     for (uint32_t i = 0; i < nv; i++) {
-        s->vx[i] = rds16(ld[L_VERTEXES] + 4 * i) * 65536;
-        s->vy[i] = rds16(ld[L_VERTEXES] + 4 * i + 2) * 65536;
+        s->vx[i] = rds16(m->ld[L_VERTEXES] + 4 * i) * 65536;
+        s->vy[i] = rds16(m->ld[L_VERTEXES] + 4 * i + 2) * 65536;
     }
+    return 0;
+}
 
-    /* linedefs */
-    uint32_t nl = cnt[L_LINEDEFS], nsd = cnt[L_SIDEDEFS];
-    s->lines = calloc(nl + 1, sizeof *s->lines);
-    if (!s->lines) {
-        bs_fail(err, errlen, "%s: out of memory", display);
-        goto out;
+/* One side of linedef i (scene line l): its sector and wall colours
+ * (P_LoadSideDefs); sd was range-checked by the caller. */
+static int wad_load_side(wad_map *m, bs_scene *s, bs_line *l, uint32_t i, int k, uint32_t sd, int contrast,
+                         unsigned line_flags)
+{
+    const uint8_t *sr = m->ld[L_SIDEDEFS] + 30 * sd;
+    uint32_t sec = rd16(sr + 28);
+    if (sec >= s->nsectors)
+        return bs_fail(m->err, m->errlen, "%s: linedef %u: sidedef %u: sector %u out of range (have %u)",
+                       m->display, i, sd, sec, s->nsectors);
+    l->sector[k] = sec;
+    int light = s->sectors[sec].light;
+    char up[9], lo[9], mid[9];
+    name8(up, sr + 4);
+    name8(lo, sr + 12);
+    name8(mid, sr + 20);
+    int has_mid = mid[0] && strcmp(mid, "-") != 0;
+    uint8_t cm = has_mid ? bs_wall_color(mid, light, contrast) : bs_neutral_color(light);
+    l->color[k][SCN_PART_MIDDLE] = cm;
+    l->color[k][SCN_PART_UPPER] = (up[0] && strcmp(up, "-") != 0) ? bs_wall_color(up, light, contrast) : cm;
+    l->color[k][SCN_PART_LOWER] = (lo[0] && strcmp(lo, "-") != 0) ? bs_wall_color(lo, light, contrast) : cm;
+    if (m->look && bs_look_side(m->look, s->nlines, k, sr, line_flags, m->err, m->errlen)) return -1;
+    return 0;
+}
+
+/* Linedef i becomes the next scene line unless it has zero length (then 1 is
+ * returned); its vertex and sidedef indices are checked first (P_LoadLineDefs). */
+static int wad_load_linedef(wad_map *m, bs_scene *s, uint32_t i)
+{
+    const uint8_t *r = m->ld[L_LINEDEFS] + 14 * i;
+    uint32_t nv = s->nverts, nsd = m->cnt[L_SIDEDEFS];
+    uint32_t v1 = rd16(r), v2 = rd16(r + 2);
+    uint32_t sd[2] = {rd16(r + 10), rd16(r + 12)};
+    if (v1 >= nv || v2 >= nv)
+        return bs_fail(m->err, m->errlen, "%s: linedef %u: vertex %u out of range (have %u)", m->display, i,
+                       v1 >= nv ? v1 : v2, nv);
+    if (sd[0] == 0xFFFF) return bs_fail(m->err, m->errlen, "%s: linedef %u: no front sidedef", m->display, i);
+    for (int k = 0; k < 2; k++)
+        if (sd[k] != 0xFFFF && sd[k] >= nsd)
+            return bs_fail(m->err, m->errlen, "%s: linedef %u: sidedef %u out of range (have %u)", m->display, i,
+                           sd[k], nsd);
+    if (s->vx[v1] == s->vx[v2] && s->vy[v1] == s->vy[v2]) {
+        bs_warn(m->opt, "%s: linedef %u: zero length, skipped", m->display, i);
+        return 1;
     }
+    bs_line *l = &s->lines[s->nlines];
+    l->v1 = v1;
+    l->v2 = v2;
+    l->src_line = (int)i;
+    l->sector[0] = l->sector[1] = SCN_NONE;
+    int64_t dx = ((int64_t)s->vx[v2] - s->vx[v1]) / 65536, dy = ((int64_t)s->vy[v2] - s->vy[v1]) / 65536;
+    /* fake contrast as in Doom: walls running east-west a shade lighter,
+     * north-south a shade darker */
+    int contrast = (dy == 0) ? 1 : (dx == 0) ? -1 : 0;
+    for (int k = 0; k < 2; k++)
+        if (sd[k] != 0xFFFF && wad_load_side(m, s, l, i, k, sd[k], contrast, rd16(r + 4))) return -1;
+    m->vused[v1] = m->vused[v2] = 1;
+    s->nlines++;
+    return 0;
+}
+
+/* Linedefs with their sidedefs; zero-length ones are left out with a note. */
+static int wad_load_linedefs(wad_map *m, bs_scene *s)
+{
+    uint32_t nl = m->cnt[L_LINEDEFS];
+    s->lines = calloc(nl + 1, sizeof *s->lines);
+    if (!s->lines) return bs_fail(m->err, m->errlen, "%s: out of memory", m->display);
     s->lcap = nl + 1;
     uint32_t skipped = 0;
     for (uint32_t i = 0; i < nl; i++) {
-        const uint8_t *r = ld[L_LINEDEFS] + 14 * i;
-        uint32_t v1 = rd16(r), v2 = rd16(r + 2);
-        uint32_t sd[2] = {rd16(r + 10), rd16(r + 12)};
-        if (v1 >= nv || v2 >= nv) {
-            bs_fail(err, errlen, "%s: linedef %u: vertex %u out of range (have %u)", display, i,
-                    v1 >= nv ? v1 : v2, nv);
-            goto out;
-        }
-        if (sd[0] == 0xFFFF) {
-            bs_fail(err, errlen, "%s: linedef %u: no front sidedef", display, i);
-            goto out;
-        }
-        for (int k = 0; k < 2; k++)
-            if (sd[k] != 0xFFFF && sd[k] >= nsd) {
-                bs_fail(err, errlen, "%s: linedef %u: sidedef %u out of range (have %u)", display, i,
-                        sd[k], nsd);
-                goto out;
-            }
-        if (s->vx[v1] == s->vx[v2] && s->vy[v1] == s->vy[v2]) {
-            bs_warn(opt, "%s: linedef %u: zero length, skipped", display, i);
-            skipped++;
-            continue;
-        }
-        bs_line *l = &s->lines[s->nlines];
-        l->v1 = v1;
-        l->v2 = v2;
-        l->src_line = (int)i;
-        l->sector[0] = l->sector[1] = SCN_NONE;
-        int64_t dx = ((int64_t)s->vx[v2] - s->vx[v1]) / 65536, dy = ((int64_t)s->vy[v2] - s->vy[v1]) / 65536;
-        /* fake contrast as in Doom: walls running east-west a shade lighter,
-         * north-south a shade darker */
-        int contrast = (dy == 0) ? 1 : (dx == 0) ? -1 : 0;
-        for (int k = 0; k < 2; k++) {
-            if (sd[k] == 0xFFFF) continue;
-            const uint8_t *sr = ld[L_SIDEDEFS] + 30 * sd[k];
-            uint32_t sec = rd16(sr + 28);
-            if (sec >= s->nsectors) {
-                bs_fail(err, errlen, "%s: linedef %u: sidedef %u: sector %u out of range (have %u)",
-                        display, i, sd[k], sec, s->nsectors);
-                goto out;
-            }
-            l->sector[k] = sec;
-            int light = s->sectors[sec].light;
-            char up[9], lo[9], mid[9];
-            name8(up, sr + 4);
-            name8(lo, sr + 12);
-            name8(mid, sr + 20);
-            int has_mid = mid[0] && strcmp(mid, "-") != 0;
-            uint8_t cm = has_mid ? bs_wall_color(mid, light, contrast) : bs_neutral_color(light);
-            l->color[k][SCN_PART_MIDDLE] = cm;
-            l->color[k][SCN_PART_UPPER] =
-                (up[0] && strcmp(up, "-") != 0) ? bs_wall_color(up, light, contrast) : cm;
-            l->color[k][SCN_PART_LOWER] =
-                (lo[0] && strcmp(lo, "-") != 0) ? bs_wall_color(lo, light, contrast) : cm;
-            if (look && bs_look_side(look, s->nlines, k, sr, rd16(r + 4), err, errlen)) goto out;
-        }
-        vused[v1] = vused[v2] = 1;
-        s->nlines++;
+        int r = wad_load_linedef(m, s, i);
+        if (r < 0) return -1;
+        skipped += (uint32_t)r;
     }
-    if (skipped) bs_note(opt, "%s: skipped %u zero-length linedef(s)", display, skipped);
-    if (s->nlines == 0) {
-        bs_fail(err, errlen, "%s: map has no linedefs", display);
-        goto out;
-    }
-    for (uint32_t i = 0; i < nv; i++)
-        if (vused[i] && s->vx[i] == -32768 * 65536) {
-            bs_fail(err, errlen, "%s: vertex %u: x = -32768 out of range (|coordinate| <= %d)",
-                    display, i, SCN_COORD_MAX);
-            goto out;
-        } else if (vused[i] && s->vy[i] == -32768 * 65536) {
-            bs_fail(err, errlen, "%s: vertex %u: y = -32768 out of range (|coordinate| <= %d)",
-                    display, i, SCN_COORD_MAX);
-            goto out;
-        }
+    if (skipped) bs_note(m->opt, "%s: skipped %u zero-length linedef(s)", m->display, skipped);
+    if (s->nlines == 0) return bs_fail(m->err, m->errlen, "%s: map has no linedefs", m->display);
+    return 0;
+}
 
-    /* player 1 start: the last one, as in Doom (each spawns the player; the
-     * earlier ones are left behind as "voodoo dolls") */
-    for (uint32_t i = cnt[L_THINGS]; i-- > 0;) {
-        const uint8_t *r = ld[L_THINGS] + 10 * i;
+/* -32768 has no negation in 16 bits, so a used vertex may not sit there
+ * (|coordinate| <= SCN_COORD_MAX). */
+static int wad_check_vertexes(wad_map *m, const bs_scene *s)
+{
+    for (uint32_t i = 0; i < s->nverts; i++)
+        if (m->vused[i] && s->vx[i] == -32768 * 65536)
+            return bs_fail(m->err, m->errlen, "%s: vertex %u: x = -32768 out of range (|coordinate| <= %d)",
+                           m->display, i, SCN_COORD_MAX);
+        else if (m->vused[i] && s->vy[i] == -32768 * 65536)
+            return bs_fail(m->err, m->errlen, "%s: vertex %u: y = -32768 out of range (|coordinate| <= %d)",
+                           m->display, i, SCN_COORD_MAX);
+    return 0;
+}
+
+/* Player 1 start: the last one, as in Doom (each spawns the player; the
+ * earlier ones are left behind as "voodoo dolls"). */
+static int wad_load_player(wad_map *m, bs_scene *s)
+{
+    for (uint32_t i = m->cnt[L_THINGS]; i-- > 0;) {
+        const uint8_t *r = m->ld[L_THINGS] + 10 * i;
         if (rd16(r + 6) != 1) continue;
         int x = rds16(r), y = rds16(r + 2), a = rds16(r + 4);
         s->player_x = x * 65536;
@@ -540,26 +545,50 @@ int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_sc
         s->player_angle = a * 65536;
         s->has_player = 1;
         s->player_line = (int)i;
-        if (x == -32768 || y == -32768) {
-            bs_fail(err, errlen, "%s: thing %u (player start): coordinate out of range", display, i);
-            goto out;
-        }
-        break;
+        if (x == -32768 || y == -32768)
+            return bs_fail(m->err, m->errlen, "%s: thing %u (player start): coordinate out of range", m->display, i);
+        return 0;
     }
-    if (!s->has_player) {
-        bs_fail(err, errlen, "%s: no player start (no thing of type 1)", display);
-        goto out;
-    }
-    /* every sidedef and sector index was checked by the linedef loop above */
-    if (find_doors(s, ld[L_LINEDEFS], nl, ld[L_SIDEDEFS], ld[L_SECTORS], display, err, errlen)) goto out;
-    if (read_things(s, look, ld[L_THINGS], cnt[L_THINGS], display, opt, err, errlen)) goto out;
-    rc = 0;
-out:
-    bs_look_close(look);
-    for (int k = 0; k < L_N; k++) free(ld[k]);
-    free(vused);
-    free(dir);
-    free(dirbuf);
-    fclose(f);
+    return bs_fail(m->err, m->errlen, "%s: no player start (no thing of type 1)", m->display);
+}
+
+/* The map's lumps, read in P_SetupLevel's spirit: sectors first (the sides
+ * refer to them), then vertices, linedefs with their sides, the player, the
+ * doors and the things. */
+static int wad_load_map(wad_map *m, const char *map, bs_scene *s)
+{
+    if (wad_read_dir(m)) return -1;
+    int64_t marker = wad_find_marker(m, map);
+    if (marker < 0 || wad_read_map_lumps(m, (uint32_t)marker)) return -1;
+    if (m->cnt[L_SECTORS] == 0) return bs_fail(m->err, m->errlen, "%s: map has no sectors", m->display);
+    if (bs_look_open(m->f, m->len, m->dir, m->nlumps, m->want, s, m->cnt[L_SECTORS], m->cnt[L_LINEDEFS], m->opt,
+                     &m->look, m->err, m->errlen))
+        return -1;
+    if (wad_load_sectors(m, s) || wad_load_vertexes(m, s) || wad_load_linedefs(m, s) || wad_check_vertexes(m, s) ||
+        wad_load_player(m, s))
+        return -1;
+    /* every sidedef and sector index was checked by wad_load_linedefs */
+    if (find_doors(s, m->ld[L_LINEDEFS], m->cnt[L_LINEDEFS], m->ld[L_SIDEDEFS], m->ld[L_SECTORS], m->display,
+                   m->err, m->errlen))
+        return -1;
+    return read_things(s, m->look, m->ld[L_THINGS], m->cnt[L_THINGS], m->display, m->opt, m->err, m->errlen);
+}
+
+int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_scene *s,
+                const bspc_options *opt, char *err, size_t errlen)
+{
+    snprintf(s->name, sizeof s->name, "%s", display);
+    s->is_text = 0;
+    s->player_sector = SCN_NONE;
+    wad_map m = {.wadpath = wadpath, .display = display, .opt = opt, .err = err, .errlen = errlen};
+    m.f = fopen(wadpath, "rb");
+    if (!m.f) return bs_fail(err, errlen, "%s: cannot open %s: %s", display, wadpath, strerror(errno));
+    int rc = wad_load_map(&m, map, s) ? -1 : 0;
+    bs_look_close(m.look);
+    for (int k = 0; k < L_N; k++) free(m.ld[k]);
+    free(m.vused);
+    free(m.dir);
+    free(m.dirbuf);
+    fclose(m.f);
     return rc;
 }
