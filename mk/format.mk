@@ -10,18 +10,19 @@
 # Formatting differs between clang-format releases; the config is written for clang-format 14
 # (Debian bookworm's clang-format, installed by make deps).
 CLANG_FORMAT ?= clang-format
+FORMAT_STYLE := $(CURDIR)/.clang-format
 FORMAT_DIRS := firmware firmware/dfu hal hal/bare hal/board hal/mps2 hal/null hal/pcvga hal/sdl hal/serial \
                host host/flash tools tools/bspc tools/flbench_m3 tools/qemu_plugin tests/unit tests/fuzz
 FORMAT_SRC := $(sort $(foreach d,$(FORMAT_DIRS),$(wildcard $(d)/*.c $(d)/*.h)))
 
 .PHONY: format format-check
 format:
-	@$(CLANG_FORMAT) -i --style=file $(FORMAT_SRC)
+	@$(CLANG_FORMAT) -i --style=file:$(FORMAT_STYLE) $(FORMAT_SRC)
 	@echo "format: $(words $(FORMAT_SRC)) files"
 
 format-check:
 	@command -v $(CLANG_FORMAT) >/dev/null || { echo "format-check: $(CLANG_FORMAT) not found (make deps)"; exit 1; }
-	@bad=$$(for f in $(FORMAT_SRC); do $(CLANG_FORMAT) --style=file "$$f" | cmp -s - "$$f" || echo "$$f"; done); \
+	@bad=$$(for f in $(FORMAT_SRC); do $(CLANG_FORMAT) --style=file:$(FORMAT_STYLE) "$$f" | cmp -s - "$$f" || echo "$$f"; done); \
 	if [ -n "$$bad" ]; then \
 	  echo "format-check: these files differ from .clang-format (make format rewrites them):"; \
 	  echo "$$bad" | sed 's/^/  /'; exit 1; \
