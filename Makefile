@@ -159,6 +159,8 @@ help:
 	@echo "make report     error against the reference vs instructions per frame, per render mode and"
 	@echo "                precision-knob configuration (mk/report.mk) -> build/report/report.md and plots;"
 	@echo "                REPORT_CONFIGS=\"default subpix0\" for a few, REPORT_ARGS=\"--views 4\", V=1 shows the compiles"
+	@echo "make format     rewrite the project's C files with clang-format (.clang-format, HACKING.md);"
+	@echo "                make format-check (first step of make test) lists the files that differ"
 	@echo "make clean      remove build/"
 
 deps:
@@ -194,6 +196,7 @@ pytest: $(PROGRAMS) $(SAN_PROGS)
 	$(PY) -m pytest -q tests
 
 test: deps
+	@$(MAKE) --no-print-directory format-check
 	@$(MAKE) --no-print-directory all unit fuzz-smoke
 	@$(MAKE) --no-print-directory pytest
 

@@ -23,6 +23,7 @@ PACKAGES=(
   zdbsp glbsp                 # other BSP compilers, for make bench-bsp
   valgrind                    # instruction counts
   clang libclang-rt-14-dev    # libFuzzer harnesses with ASan and UBSan (make fuzz, tests/fuzz)
+  clang-format                # make format, make format-check (.clang-format is written for version 14)
   xvfb xauth                  # a display for SDL tests on headless machines
   python3 python3-venv        # tests and tools
 )
