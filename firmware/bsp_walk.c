@@ -20,7 +20,7 @@ static void frustum_planes(const view_xform *v, walk_plane p[3])
     /* view z = dx*cos + dy*sin, view x = dx*sin - dy*cos (view.h) */
     p[0] = (walk_plane){(int64_t)v->cos + v->sin, (int64_t)v->sin - v->cos, CLIP_LEFT};  /* z + x >= 0 */
     p[1] = (walk_plane){(int64_t)v->cos - v->sin, (int64_t)v->sin + v->cos, CLIP_RIGHT}; /* z - x >= 0 */
-    p[2] = (walk_plane){v->cos, v->sin, CLIP_NEAR};                                        /* z >= 0 */
+    p[2] = (walk_plane){v->cos, v->sin, CLIP_NEAR};                                      /* z >= 0 */
 }
 
 /* Returns -1 if the box is outside some plane, else the mask with the planes

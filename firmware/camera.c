@@ -6,12 +6,12 @@
 #include "collide.h"
 #include "hal.h"
 
-#define WALK_SPEED 256     /* units per second */
-#define TURN_SPEED 120     /* degrees per second */
-#define FLY_SPEED 128      /* units per second */
-#define LOOK_SPEED 120     /* pixels per second */
+#define WALK_SPEED 256          /* units per second */
+#define TURN_SPEED 120          /* degrees per second */
+#define FLY_SPEED 128           /* units per second */
+#define LOOK_SPEED 120          /* pixels per second */
 #define EASE_SNAP (FX_ONE / 16) /* nearer than this, the eye is put on its floor */
-#define EASE_DT_MAX 1000u  /* longer frames ease as one second (keeps products small) */
+#define EASE_DT_MAX 1000u       /* longer frames ease as one second (keeps products small) */
 #define CEIL_GAP (4 * FX_ONE)   /* the eased eye stays this far under the ceiling */
 
 static void set_eye(cam_state *c)

@@ -9,16 +9,16 @@
 #include "scene.h"
 #include "view.h"
 
-#define CAM_EYE_HEIGHT (41 * FX_ONE) /* above the floor of the eye's sector */
-#define CAM_EASE_MS 60               /* time constant of the eye's easing over steps */
+#define CAM_EYE_HEIGHT (41 * FX_ONE)              /* above the floor of the eye's sector */
+#define CAM_EASE_MS 60                            /* time constant of the eye's easing over steps */
 #define CAM_FLY_MAX (2 * SCN_HEIGHT_MAX * FX_ONE) /* highest fly offset */
 
 typedef struct {
-    camera view;      /* what the renderer uses */
-    fx_t fly;         /* height above floor + CAM_EYE_HEIGHT, changed by fly keys, 0..CAM_FLY_MAX */
-    fx_t eye_floor;   /* the floor the eye is at (eased toward the floor under the eye) */
-    fx_t feet;        /* the floor the player stands on (collide.h: highest under its circle) */
-    int noclip;       /* nonzero: walk through walls (free movement); 0 after cam_start */
+    camera view;    /* what the renderer uses */
+    fx_t fly;       /* height above floor + CAM_EYE_HEIGHT, changed by fly keys, 0..CAM_FLY_MAX */
+    fx_t eye_floor; /* the floor the eye is at (eased toward the floor under the eye) */
+    fx_t feet;      /* the floor the player stands on (collide.h: highest under its circle) */
+    int noclip;     /* nonzero: walk through walls (free movement); 0 after cam_start */
 } cam_state;
 
 /* The player start of the scene, eye at floor + 41. */

@@ -24,12 +24,12 @@
 typedef struct {
     const scene *s;
     const world_state *w; /* the ceilings now (doors) */
-    int64_t r, r2;       /* radius on the grid (2^12 .. 2^22) and its square */
-    int64_t rraw;        /* radius, 16.16 */
+    int64_t r, r2;        /* radius on the grid (2^12 .. 2^22) and its square */
+    int64_t rraw;         /* radius, 16.16 */
     int64_t height, step;
-    query_box box;            /* the candidates cover this box */
+    query_box box;              /* the candidates cover this box */
     int64_t gx0, gy0, gx1, gy1; /* the same on the grid */
-    int overflow;        /* more segs than CAND_MAX: checks walk the tree themselves */
+    int overflow;               /* more segs than CAND_MAX: checks walk the tree themselves */
     uint32_t n;
     uint32_t cand[CAND_MAX];
 } mover;
@@ -124,11 +124,11 @@ static int wall_blocks(const mover *m, const scn_line *ln, int64_t z)
 
 typedef struct {
     const mover *m;
-    grid_pt p, q;        /* the path */
-    int64_t z;       /* floor stood on at the start of the sub-step */
-    int blocked;     /* some wall blocks the path */
-    int stuck;       /* a blocking wall that p already overlaps holds the move */
-    int touched;     /* fmax, cmin hold something */
+    grid_pt p, q;       /* the path */
+    int64_t z;          /* floor stood on at the start of the sub-step */
+    int blocked;        /* some wall blocks the path */
+    int stuck;          /* a blocking wall that p already overlaps holds the move */
+    int touched;        /* fmax, cmin hold something */
     int64_t fmax, cmin; /* over the sectors touched at q */
 } path_check;
 
@@ -176,8 +176,8 @@ static void check_seg(void *ctx, uint32_t si)
 /* Is the path p -> q (16.16) clear for a body that stood on floor z at the start
  * of the sub-step and stands as *at at p? Fills *out with where it would stand at
  * q. at == NULL: only compute *out (no end rules). */
-static int try_path(const mover *m, int64_t px, int64_t py, int64_t qx, int64_t qy, int64_t z,
-                    const footing *at, footing *out, int *stuck)
+static int try_path(const mover *m, int64_t px, int64_t py, int64_t qx, int64_t qy, int64_t z, const footing *at,
+                    footing *out, int *stuck)
 {
     path_check c;
     c.m = m;
@@ -209,11 +209,11 @@ static int try_path(const mover *m, int64_t px, int64_t py, int64_t qx, int64_t 
 
 typedef struct {
     const mover *m;
-    grid_pt l, h;        /* last clear point, first blocked point */
+    grid_pt l, h; /* last clear point, first blocked point */
     int64_t z;
     int found;
-    int64_t best;    /* distance from l to the nearest blocking seg */
-    grid_pt a, b;        /* that seg */
+    int64_t best; /* distance from l to the nearest blocking seg */
+    grid_pt a, b; /* that seg */
 } contact_check;
 
 static void contact_seg(void *ctx, uint32_t si)
@@ -239,8 +239,8 @@ static void contact_seg(void *ctx, uint32_t si)
 }
 
 /* The unit normal (2.30) of the wall met between l and h, pointing back at l. */
-static int contact_normal(const mover *m, int64_t z, int64_t lx, int64_t ly, int64_t hx, int64_t hy,
-                          int32_t *nx, int32_t *ny)
+static int contact_normal(const mover *m, int64_t z, int64_t lx, int64_t ly, int64_t hx, int64_t hy, int32_t *nx,
+                          int32_t *ny)
 {
     contact_check c;
     c.m = m;

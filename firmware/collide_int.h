@@ -33,11 +33,26 @@ typedef struct {
 
 /* inline: called per candidate seg in every check, and kept inlined as they
  * were when all of this was one file */
-static inline int64_t min64(int64_t a, int64_t b) { return a < b ? a : b; }
-static inline int64_t max64(int64_t a, int64_t b) { return a > b ? a : b; }
-static inline int64_t clamp64(int64_t v, int64_t lo, int64_t hi) { return v < lo ? lo : (v > hi ? hi : v); }
-static inline int64_t clampw(int64_t v) { return clamp64(v, -WORLD_RAW, WORLD_RAW); }
-static inline int sgn64(int64_t v) { return (v > 0) - (v < 0); }
+static inline int64_t min64(int64_t a, int64_t b)
+{
+    return a < b ? a : b;
+}
+static inline int64_t max64(int64_t a, int64_t b)
+{
+    return a > b ? a : b;
+}
+static inline int64_t clamp64(int64_t v, int64_t lo, int64_t hi)
+{
+    return v < lo ? lo : (v > hi ? hi : v);
+}
+static inline int64_t clampw(int64_t v)
+{
+    return clamp64(v, -WORLD_RAW, WORLD_RAW);
+}
+static inline int sgn64(int64_t v)
+{
+    return (v > 0) - (v < 0);
+}
 
 static inline grid_pt to_grid(int64_t x, int64_t y)
 {

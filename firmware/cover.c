@@ -78,9 +78,9 @@ static inline void close_words(cov_mask *m, int y, uint32_t full)
 }
 
 /* cov_fill's work, inlined into it and into cov_fill_rows' loop. */
-static inline __attribute__((always_inline)) uint32_t fill_row(cov_mask *m, const rast_target *t, int y, int x0,
-                                                                int x1, const uint32_t *keep, const tex_paint *paint,
-                                                                int textured, uint32_t id)
+static inline __attribute__((always_inline)) uint32_t fill_row(cov_mask *m, const rast_target *t, int y, int x0, int x1,
+                                                               const uint32_t *keep, const tex_paint *paint,
+                                                               int textured, uint32_t id)
 {
     x0 = clamp_w(x0);
     x1 = clamp_w(x1);
@@ -89,7 +89,7 @@ static inline __attribute__((always_inline)) uint32_t fill_row(cov_mask *m, cons
     int w0 = x0 >> 5, w1 = (x1 - 1) >> 5;
     uint32_t first = 0xFFFFFFFFu << (x0 & 31), last = 0xFFFFFFFFu >> (31 - ((x1 - 1) & 31));
     uint32_t full = 0; /* words this fill completes */
-    if (!keep) { /* the common case first: nothing of [x0, x1) set yet, one span */
+    if (!keep) {       /* the common case first: nothing of [x0, x1) set yet, one span */
         uint32_t taken = w0 == w1 ? line[w0] & first & last : (line[w0] & first) | (line[w1] & last);
         for (int w = w0 + 1; w < w1 && !taken; w++) taken |= line[w];
         if (!taken) {
@@ -144,8 +144,8 @@ static inline __attribute__((always_inline)) uint32_t fill_row(cov_mask *m, cons
     return drawn;
 }
 
-uint32_t cov_fill(cov_mask *m, const rast_target *t, int y, int x0, int x1, const uint32_t *keep, const tex_paint *paint,
-                  uint32_t id)
+uint32_t cov_fill(cov_mask *m, const rast_target *t, int y, int x0, int x1, const uint32_t *keep,
+                  const tex_paint *paint, uint32_t id)
 {
     if (rast_textured_paint(t, paint)) return fill_row(m, t, y, x0, x1, keep, paint, 1, id);
     return fill_row(m, t, y, x0, x1, keep, paint, 0, id);

@@ -18,8 +18,8 @@ _Static_assert(VIEW_W % 32 == 0 && COV_WORDS <= 16, "a row is whole words, at mo
 
 typedef struct {
     uint32_t bits[VIEW_H][COV_WORDS];
-    uint16_t open[VIEW_H];      /* bit i: word i of the row has a clear bit */
-    uint16_t full_rows;         /* rows with every pixel set */
+    uint16_t open[VIEW_H]; /* bit i: word i of the row has a clear bit */
+    uint16_t full_rows;    /* rows with every pixel set */
 } cov_mask;
 
 void cov_clear(cov_mask *m);
@@ -91,8 +91,8 @@ int cov_box_covered(const cov_mask *m, int y0, int y1, int x0, int x1);
  * row mask of pixels to leave alone, or NULL) in its paint with id, one span per
  * run (a free word at a time where it can), and set them. Returns the pixels
  * written. */
-uint32_t cov_fill(cov_mask *m, const rast_target *t, int y, int x0, int x1, const uint32_t *keep, const tex_paint *paint,
-                  uint32_t id);
+uint32_t cov_fill(cov_mask *m, const rast_target *t, int y, int x0, int x1, const uint32_t *keep,
+                  const tex_paint *paint, uint32_t id);
 
 /* cov_fill for rows [top, bottom) of a polygon, row y from lo[y] to hi[y]. */
 uint32_t cov_fill_rows(cov_mask *m, const rast_target *t, int top, int bottom, const int16_t *lo, const int16_t *hi,

@@ -35,12 +35,12 @@ typedef struct {
 } dr_face;
 
 typedef struct {
-    int32_t left;            /* west edge of its box, whole units (the list is sorted by it) */
-    uint16_t index;          /* the object (its id; SCN_MAX_OBJECTS fits) */
-    uint16_t x0, x1;         /* screen box of its faces: pixels [x0, x1) x [y0, y1) */
+    int32_t left;    /* west edge of its box, whole units (the list is sorted by it) */
+    uint16_t index;  /* the object (its id; SCN_MAX_OBJECTS fits) */
+    uint16_t x0, x1; /* screen box of its faces: pixels [x0, x1) x [y0, y1) */
     uint8_t y0, y1;
-    uint16_t first_face;     /* stored: its faces in the pool */
-    uint8_t nfaces;          /* faces facing the eye and on screen (SCN_MAX_MODEL_FACES fits) */
+    uint16_t first_face; /* stored: its faces in the pool */
+    uint8_t nfaces;      /* faces facing the eye and on screen (SCN_MAX_MODEL_FACES fits) */
     uint8_t active : 1, stored : 1, drew : 1;
 } dr_obj;
 
@@ -59,7 +59,7 @@ typedef struct {
     dr_obj *objs;     /* objects in view, by the west edge of their boxes */
     uint16_t *active; /* the ones the walk has met that show faces, as indices into objs */
     uint32_t nobjs, nactive, nfaces, nedges;
-    int32_t reach;    /* the widest box in view, whole units */
+    int32_t reach; /* the widest box in view, whole units */
     dr_face *faces;
     dr_edge *edges;
     dr_face scratch_face; /* a face of an object the pools could not hold */
@@ -114,8 +114,10 @@ static int face_row(const dr_face *f, const dr_edge *edges, int y, int *a, int *
         if (y < e->e.row || y >= e->e.end_row) continue;
         int col = rast_first_sample(edge_x(&e->e, y));
         col = col < 0 ? 0 : (col > VIEW_W ? VIEW_W : col);
-        if (e->leading) lo = col;
-        else hi = col;
+        if (e->leading)
+            lo = col;
+        else
+            hi = col;
     }
     *a = lo;
     *b = hi;
@@ -124,8 +126,8 @@ static int face_row(const dr_face *f, const dr_edge *edges, int y, int *a, int *
 
 /* Face fi of the object's model, if it faces the eye and shows: its plane, rows
  * and edges (into edges[], at most FACE_EDGES). */
-static int face_build(const dr_state *S, const dr_obj *o, const view_pt *verts, uint32_t fi, dr_face *f,
-                      dr_edge *edges, screen_pt box[2])
+static int face_build(const dr_state *S, const dr_obj *o, const view_pt *verts, uint32_t fi, dr_face *f, dr_edge *edges,
+                      screen_pt box[2])
 {
     const scene *sc = S->sc;
     const scn_model *m = &sc->models[S->w->objs[o->index].model];
@@ -304,8 +306,10 @@ static uint32_t first_at_or_east(const dr_state *S, int32_t x)
     uint32_t lo = 0, hi = S->nobjs;
     while (lo < hi) {
         uint32_t mid = lo + (hi - lo) / 2;
-        if (S->objs[mid].left < x) lo = mid + 1;
-        else hi = mid;
+        if (S->objs[mid].left < x)
+            lo = mid + 1;
+        else
+            hi = mid;
     }
     return lo;
 }
@@ -348,11 +352,15 @@ static void mark_in_front(uint32_t *keep, const objd_plane *s, int sn, const obj
     int lo = a, hi = b - 1; /* in front at lo differs from at hi */
     while (hi - lo > 1) {
         int mid = lo + (hi - lo) / 2;
-        if (objd_front(s, sn, p, pn, look, mid, y) == fa) lo = mid;
-        else hi = mid;
+        if (objd_front(s, sn, p, pn, look, mid, y) == fa)
+            lo = mid;
+        else
+            hi = mid;
     }
-    if (fa) cov_line_set(keep, a, hi);
-    else cov_line_set(keep, hi, b);
+    if (fa)
+        cov_line_set(keep, a, hi);
+    else
+        cov_line_set(keep, hi, b);
 }
 
 /* ---- drawing the objects' faces ---------------------------------------------------------- */
@@ -374,8 +382,11 @@ static void keep_nearer_face(dr_state *S, dr_obj *o, const dr_face *g, const dr_
     if (a < k->x0) a = k->x0;
     if (b > k->x1) b = k->x1;
     if (a >= b || g->zmin > k->self->zmax + DEPTH_APART) return; /* g lies wholly behind */
-    if (g->zmax + DEPTH_APART < k->self->zmin) cov_line_set(k->keep, a, b); /* wholly in front */
-    else mark_in_front(k->keep, &g->pl, 1 + (int)g->obj, &k->self->pl, 1 + (int)k->self->obj, VIEW_LOOK(S->v), k->y, a, b);
+    if (g->zmax + DEPTH_APART < k->self->zmin)
+        cov_line_set(k->keep, a, b); /* wholly in front */
+    else
+        mark_in_front(k->keep, &g->pl, 1 + (int)g->obj, &k->self->pl, 1 + (int)k->self->obj, VIEW_LOOK(S->v), k->y, a,
+                      b);
 }
 
 /* Fill [a, b) of row y with face (a copy: looking at the other faces may rebuild
@@ -434,10 +445,12 @@ static void draw_face_over_world(dr_state *S, dr_obj *o, const dr_face *f, const
     if (a < k->x0) a = k->x0;
     if (b > k->x1) b = k->x1;
     if (a >= b || cov_all(&S->cov, k->y, a, b)) return; /* nothing of it left to decide */
-    if (k->zmax + DEPTH_APART < f->zmin) return; /* the world surface is nearer all over */
+    if (k->zmax + DEPTH_APART < f->zmin) return;        /* the world surface is nearer all over */
     uint32_t mine[COV_WORDS] = {0};
-    if (k->zmin > f->zmax + DEPTH_APART) cov_line_set(mine, a, b); /* the face is nearer all over */
-    else mark_in_front(mine, &f->pl, 1 + (int)f->obj, k->world, 0, VIEW_LOOK(S->v), k->y, a, b);
+    if (k->zmin > f->zmax + DEPTH_APART)
+        cov_line_set(mine, a, b); /* the face is nearer all over */
+    else
+        mark_in_front(mine, &f->pl, 1 + (int)f->obj, k->world, 0, VIEW_LOOK(S->v), k->y, a, b);
     uint32_t any = 0;
     for (int w = 0; w < COV_WORDS; w++) any |= mine[w];
     if (!any) return;
@@ -507,8 +520,10 @@ static void add_polygon(void *ctx, const screen_pt *pts, int n, const tex_paint 
     } else {
         drawn = cov_fill_rows(&S->cov, S->t, top, bottom, lo, hi, paint, id);
     }
-    if (drawn) S->st->surfaces_drawn++;
-    else S->st->occluded++;
+    if (drawn)
+        S->st->surfaces_drawn++;
+    else
+        S->st->occluded++;
 }
 
 /* The sink's question before clipping: is the points' box already drawn? */
@@ -573,8 +588,8 @@ static void list_objects_in_view(dr_state *S)
     sort_by_west_edge(S->objs, S->nobjs);
 }
 
-void direct_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t,
-                   render_stats *st, void *work, uint32_t work_bytes)
+void direct_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t, render_stats *st,
+                   void *work, uint32_t work_bytes)
 {
     uint32_t need = direct_work_bytes(sc, w);
     if (!work || need == 0 || work_bytes < need) {

@@ -38,7 +38,7 @@
 /* Bytes of work memory direct_render needs with w's objects (w NULL: none). */
 uint32_t direct_work_bytes(const scene *s, const world_state *w);
 
-void direct_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t,
-                   render_stats *st, void *work, uint32_t work_bytes);
+void direct_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t, render_stats *st,
+                   void *work, uint32_t work_bytes);
 
 #endif

@@ -16,13 +16,13 @@ typedef struct {
     cam_state cam;
     render_mode mode;
     hal_present_mode present;
-    uint8_t flat;           /* 1: a textured scene is drawn in its flat colours */
-    uint32_t frame;         /* frames rendered since eng_init */
-    render_stats stats;     /* of the last frame */
+    uint8_t flat;              /* 1: a textured scene is drawn in its flat colours */
+    uint32_t frame;            /* frames rendered since eng_init */
+    render_stats stats;        /* of the last frame */
     render_work work;          /* given by the target: eng_set_work */
     render_work renderer_work; /* the renderer's part of it (after the world state) */
-    world_state world;      /* objects and doors now, in the work area; unset (NULL arrays) before eng_set_work */
-    uint32_t t_ms;          /* time since eng_init: the sum of eng_step's dt */
+    world_state world;         /* objects and doors now, in the work area; unset (NULL arrays) before eng_set_work */
+    uint32_t t_ms;             /* time since eng_init: the sum of eng_step's dt */
 } engine;
 
 /* 1 if frames are drawn textured: the scene has a look, the build has the

@@ -29,7 +29,10 @@
 /* The same in the units of the cross products below (offsets shifted by 3). */
 #define EYE_MARGIN_X (EYE_MARGIN >> 3)
 
-static int64_t abs64(int64_t v) { return v < 0 ? -v : v; }
+static int64_t abs64(int64_t v)
+{
+    return v < 0 ? -v : v;
+}
 
 /* Side of the eye (x, y) relative to the line through (px, py) along (dx_raw,
  * dy_raw), within a band of `band` (EYE_MARGIN_X units) either side.

@@ -56,8 +56,7 @@ void objd_plane_flat(const view_xform *v, int32_t h, objd_plane *p)
 {
     /* view_point's height arithmetic; |y| < 2^29.05, so d < 2^58.05 */
     int32_t y = (int32_t)fx_asr64((int64_t)h - v->cz, 16 - VIEW_SHIFT);
-    *p = (objd_plane){0, y < 0 ? -(int32_t)NORM_LO : (int32_t)NORM_LO, 0, 0, 0, 0,
-                      (int64_t)(y < 0 ? -y : y) * NORM_LO};
+    *p = (objd_plane){0, y < 0 ? -(int32_t)NORM_LO : (int32_t)NORM_LO, 0, 0, 0, 0, (int64_t)(y < 0 ? -y : y) * NORM_LO};
 }
 
 void objd_plane_wall(const view_xform *v, const scn_vertex *a, const scn_vertex *b, objd_plane *p)

@@ -33,12 +33,12 @@ typedef struct {
 _Static_assert(OBJ_DOOR_WAIT_MS <= 0xFFFFu, "obj_door.wait_ms");
 
 typedef struct {
-    obj_state *objs;   /* n objects, drawn with ids RAST_ID(RAST_KIND_OBJECT, i) */
+    obj_state *objs; /* n objects, drawn with ids RAST_ID(RAST_KIND_OBJECT, i) */
     uint32_t n;
-    fx_t *ceil;        /* current ceiling of every sector (nsectors entries), or NULL: as compiled */
-    obj_door *doors;   /* motion of each door sector, in sector order (ndoors entries),
+    fx_t *ceil;      /* current ceiling of every sector (nsectors entries), or NULL: as compiled */
+    obj_door *doors; /* motion of each door sector, in sector order (ndoors entries),
                         * or NULL: obj_update leaves the ceilings alone */
-    uint32_t *near;    /* obj_update's scratch: one bit per sector, "triggered now" */
+    uint32_t *near;  /* obj_update's scratch: one bit per sector, "triggered now" */
     uint32_t ndoors;
 } world_state;
 

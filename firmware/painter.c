@@ -35,11 +35,11 @@ typedef struct {
     const rast_target *t;
     render_stats *st;
     surf_sink sink;
-    pt_order *objs;       /* objects in view; the first walk finds their leaves, the second draws them in order */
+    pt_order *objs; /* objects in view; the first walk finds their leaves, the second draws them in order */
     uint32_t nobjs, at;
-    uint32_t visits;      /* first walk: leaves visited so far */
-    uint32_t unplaced;    /* first walk: objects whose leaf is not found yet */
-    int32_t reach;        /* first walk: the widest box, whole units */
+    uint32_t visits;   /* first walk: leaves visited so far */
+    uint32_t unplaced; /* first walk: objects whose leaf is not found yet */
+    int32_t reach;     /* first walk: the widest box, whole units */
 } painter;
 
 uint32_t painter_work_bytes(const scene *s, const world_state *w)
@@ -79,8 +79,10 @@ static int place_objects(void *ctx, uint32_t leaf, unsigned clip_mask)
     uint32_t lo = 0, hi = p->nobjs;
     while (lo < hi) { /* the first object whose west edge is at or east of west */
         uint32_t mid = lo + (hi - lo) / 2;
-        if (p->objs[mid].left < west) lo = mid + 1;
-        else hi = mid;
+        if (p->objs[mid].left < west)
+            lo = mid + 1;
+        else
+            hi = mid;
     }
     for (uint32_t k = lo; k < p->nobjs && p->objs[k].left <= east; k++) {
         pt_order *o = &p->objs[k];
@@ -166,8 +168,8 @@ static void draw_object(const scene *sc, uint32_t i, const obj_state *o, const v
     }
 }
 
-void painter_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t,
-                    render_stats *st, void *work, uint32_t work_bytes)
+void painter_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t, render_stats *st,
+                    void *work, uint32_t work_bytes)
 {
     painter p = {sc, w, v, t, st, {fill_polygon, 0}, 0, 0, 0, 0, 0};
     walk_stats ws;

@@ -19,7 +19,7 @@ uint32_t painter_work_bytes(const scene *s, const world_state *w);
 /* Draw the back-to-front frame; each object right after the nearest visited
  * leaf its box touches. A frame with objects and less work memory than
  * painter_work_bytes is the background only, and st->refused. */
-void painter_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t,
-                    render_stats *st, void *work, uint32_t work_bytes);
+void painter_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t, render_stats *st,
+                    void *work, uint32_t work_bytes);
 
 #endif

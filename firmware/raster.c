@@ -97,8 +97,10 @@ void rast_textured(const rast_target *t, int y, int x0, int x1, const tex_paint 
     uint32_t row[VIEW_W / 4]; /* indexed by screen column, aligned as the surface's rows */
     uint8_t *px = (uint8_t *)row;
     tex_span(paint, y, x0, x1, px);
-    if (t->tally) hal_put_linear(t->surf, y, x0, x1 - x0, px, t->tally);
-    else hal_put_span(t->surf, y, x0, x1 - x0, px);
+    if (t->tally)
+        hal_put_linear(t->surf, y, x0, x1 - x0, px, t->tally);
+    else
+        hal_put_span(t->surf, y, x0, x1 - x0, px);
 }
 #endif
 
@@ -121,8 +123,10 @@ uint32_t rast_convex(const rast_target *t, const screen_pt *pts, int n, const te
     }
     for (int i = 0; i < n; i++) {
         screen_pt a = pts[i], b = pts[(i + 1 == n) ? 0 : i + 1];
-        if (a.y < b.y) walk_edge(right, a.x, a.y, b.x, b.y);      /* going down: right side */
-        else if (a.y > b.y) walk_edge(left, b.x, b.y, a.x, a.y);  /* going up: left side */
+        if (a.y < b.y)
+            walk_edge(right, a.x, a.y, b.x, b.y); /* going down: right side */
+        else if (a.y > b.y)
+            walk_edge(left, b.x, b.y, a.x, a.y); /* going up: left side */
     }
     uint32_t drawn = 0;
     for (int32_t y = top; y < bottom; y++) {

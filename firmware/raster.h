@@ -19,7 +19,7 @@ typedef struct {
 } rast_target;
 
 /* Surface ids (DESIGN.md): kind << 24 | index. */
-#define RAST_ID(kind, index) (((uint32_t)(kind) << 24) | ((uint32_t)(index) & 0xFFFFFFu))
+#define RAST_ID(kind, index) (((uint32_t)(kind) << 24) | ((uint32_t)(index)&0xFFFFFFu))
 enum { RAST_KIND_NONE, RAST_KIND_WALL, RAST_KIND_FLOOR, RAST_KIND_CEILING, RAST_KIND_OBJECT };
 
 /* Pixel index of the first sample at or right of (or below) a 16.16 coordinate:
@@ -122,22 +122,25 @@ static inline int rast_textured_paint(const rast_target *t, const tex_paint *pai
  * the fill loops whole (left to itself the compiler keeps an out-of-line part
  * and pays a call a span). */
 static inline __attribute__((always_inline)) void rast_span_as(const rast_target *t, int y, int x0, int x1,
-                                                             const tex_paint *paint, uint32_t id, int textured)
+                                                               const tex_paint *paint, uint32_t id, int textured)
 {
     if (x1 <= x0) return;
 #if CFG_TEXTURES
-    if (textured) rast_textured(t, y, x0, x1, paint);
+    if (textured)
+        rast_textured(t, y, x0, x1, paint);
     else
 #else
     (void)textured;
 #endif
-    if (t->tally) hal_fill_linear(t->surf, y, x0, x1 - x0, paint->colour, t->tally);
-    else hal_fill_span(t->surf, y, x0, x1 - x0, paint->colour);
+        if (t->tally)
+        hal_fill_linear(t->surf, y, x0, x1 - x0, paint->colour, t->tally);
+    else
+        hal_fill_span(t->surf, y, x0, x1 - x0, paint->colour);
     if (t->ids) rast_ids(t, y, x0, x1, id);
 }
 
 static inline __attribute__((always_inline)) void rast_span(const rast_target *t, int y, int x0, int x1,
-                                                          const tex_paint *paint, uint32_t id)
+                                                            const tex_paint *paint, uint32_t id)
 {
     rast_span_as(t, y, x0, x1, paint, id, rast_textured_paint(t, paint));
 }

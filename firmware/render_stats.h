@@ -7,18 +7,18 @@
 #include <stdint.h>
 
 typedef struct {
-    uint32_t nodes;     /* nodes visited */
-    uint32_t leaves;    /* leaves visited */
-    uint32_t segs;      /* wall pieces considered */
-    uint32_t culled;    /* wall pieces rejected as back-facing */
-    uint32_t polygons;  /* polygons that reached the rasteriser */
-    uint32_t clipped_away; /* polygons entirely outside the frustum */
-    uint32_t boxes_culled; /* subtrees rejected by their bounding box */
-    uint32_t occluded;     /* polygons wholly behind nearer ones (spans: no edges added) */
-    uint32_t edges;        /* edges entered into the scan (spans) */
-    uint32_t spans;        /* spans emitted (spans) */
-    uint32_t surfaces_drawn; /* spans: surface batches filled; direct: polygons that wrote a pixel */
-    uint32_t refused;      /* 1: the work memory given was smaller than the scene needs */
+    uint32_t nodes;           /* nodes visited */
+    uint32_t leaves;          /* leaves visited */
+    uint32_t segs;            /* wall pieces considered */
+    uint32_t culled;          /* wall pieces rejected as back-facing */
+    uint32_t polygons;        /* polygons that reached the rasteriser */
+    uint32_t clipped_away;    /* polygons entirely outside the frustum */
+    uint32_t boxes_culled;    /* subtrees rejected by their bounding box */
+    uint32_t occluded;        /* polygons wholly behind nearer ones (spans: no edges added) */
+    uint32_t edges;           /* edges entered into the scan (spans) */
+    uint32_t spans;           /* spans emitted (spans) */
+    uint32_t surfaces_drawn;  /* spans: surface batches filled; direct: polygons that wrote a pixel */
+    uint32_t refused;         /* 1: the work memory given was smaller than the scene needs */
     uint32_t objects_visible; /* objects drawn: in view (spans: and in a leaf the walk visited;
                                * direct: and writing at least one pixel) */
     uint32_t object_faces;    /* object faces that reached the rasteriser */

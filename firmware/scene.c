@@ -7,19 +7,34 @@
 #include "fixed.h"
 
 static const uint32_t record_bytes[SCN_SEC_COUNT] = {
-    sizeof(scn_vertex), sizeof(scn_sector), sizeof(scn_line), sizeof(scn_seg),
-    sizeof(scn_node), sizeof(scn_leaf), sizeof(scn_vertex), 3,
-    sizeof(scn_model), sizeof(scn_mvert), sizeof(scn_face), sizeof(uint32_t), sizeof(scn_object),
-    sizeof(scn_needs), sizeof(scn_look), 256, sizeof(scn_texture), 1, sizeof(scn_side), sizeof(scn_plane),
+    sizeof(scn_vertex),  sizeof(scn_sector),
+    sizeof(scn_line),    sizeof(scn_seg),
+    sizeof(scn_node),    sizeof(scn_leaf),
+    sizeof(scn_vertex),  3,
+    sizeof(scn_model),   sizeof(scn_mvert),
+    sizeof(scn_face),    sizeof(uint32_t),
+    sizeof(scn_object),  sizeof(scn_needs),
+    sizeof(scn_look),    256,
+    sizeof(scn_texture), 1,
+    sizeof(scn_side),    sizeof(scn_plane),
 };
 
 const char *scene_status_text(scene_status st)
 {
     static const char *const text[SCENE_ERR_COUNT] = {
-        "ok", "truncated", "not 4-byte aligned in memory", "wrong magic (not a compiled scene)",
-        "unsupported version", "inconsistent header", "bad CRC-32", "section outside the blob",
-        "index out of range", "value outside the proven-safe range", "node graph is not a tree or is too deep",
-        "needs record does not match the scene", "needs more than this build provides",
+        "ok",
+        "truncated",
+        "not 4-byte aligned in memory",
+        "wrong magic (not a compiled scene)",
+        "unsupported version",
+        "inconsistent header",
+        "bad CRC-32",
+        "section outside the blob",
+        "index out of range",
+        "value outside the proven-safe range",
+        "node graph is not a tree or is too deep",
+        "needs record does not match the scene",
+        "needs more than this build provides",
     };
     return ((unsigned)st < SCENE_ERR_COUNT) ? text[st] : "unknown error";
 }
@@ -27,9 +42,9 @@ const char *scene_status_text(scene_status st)
 const char *scene_section_name(int section)
 {
     static const char *const names[SCN_SEC_COUNT] = {
-        "vertices", "sectors", "lines", "segs", "nodes", "leaves", "leaf polygon vertices", "palette",
-        "models", "model vertices", "faces", "face indices", "objects", "needs",
-        "look", "light tables", "textures", "texels", "sides", "planes",
+        "vertices", "sectors",      "lines",          "segs",   "nodes",        "leaves",  "leaf polygon vertices",
+        "palette",  "models",       "model vertices", "faces",  "face indices", "objects", "needs",
+        "look",     "light tables", "textures",       "texels", "sides",        "planes",
     };
     return (section >= 0 && section < SCN_SEC_COUNT) ? names[section] : "header";
 }
@@ -56,10 +71,13 @@ static scene_status refuse(scene_error *err, uint32_t item, uint32_t need, uint3
 const char *scene_item_name(uint32_t item)
 {
     static const char *const names[SCENE_ITEM_COUNT] = {
-        "objects", "doors", "two-sided walls", "height changes", "sky steps", "look up/down", "y-clipping",
-        "textures",
-        "edges per frame", "surfaces per frame", "tree depth", "leaf polygon vertices", "model vertices",
-        "face vertices",
+        "objects",         "doors",
+        "two-sided walls", "height changes",
+        "sky steps",       "look up/down",
+        "y-clipping",      "textures",
+        "edges per frame", "surfaces per frame",
+        "tree depth",      "leaf polygon vertices",
+        "model vertices",  "face vertices",
     };
     return item < SCENE_ITEM_COUNT ? names[item] : "?";
 }
@@ -105,8 +123,7 @@ static scene_status check_sections(scene *s, const uint8_t *base, const scn_head
     for (int i = 0; i < SCN_SEC_COUNT; i++) {
         uint64_t off = h->sec[i].offset;
         uint64_t end = off + (uint64_t)h->sec[i].count * record_bytes[i];
-        if ((off & 3u) || off < h->header_bytes || end > h->total_bytes)
-            return fail(err, SCENE_ERR_SECTION, i, 0);
+        if ((off & 3u) || off < h->header_bytes || end > h->total_bytes) return fail(err, SCENE_ERR_SECTION, i, 0);
     }
     if (h->sec[SCN_SEC_PALETTE].count != 256) return fail(err, SCENE_ERR_SECTION, SCN_SEC_PALETTE, 0);
     if (h->sec[SCN_SEC_NEEDS].count != 1) return fail(err, SCENE_ERR_SECTION, SCN_SEC_NEEDS, 0);
@@ -171,23 +188,21 @@ static scene_status check_geometry(const scene *s, scene_error *err)
     }
     for (uint32_t i = 0; i < s->nleaves; i++) {
         const scn_leaf *f = &s->leaves[i];
-        if ((uint64_t)f->first_seg + f->num_segs > s->nsegs ||
-            (uint64_t)f->first_pvert + f->num_pverts > s->npverts || f->num_pverts > SCN_MAX_LEAF_VERTS ||
-            (f->sector != SCN_NONE && f->sector >= s->nsectors))
+        if ((uint64_t)f->first_seg + f->num_segs > s->nsegs || (uint64_t)f->first_pvert + f->num_pverts > s->npverts ||
+            f->num_pverts > SCN_MAX_LEAF_VERTS || (f->sector != SCN_NONE && f->sector >= s->nsectors))
             return fail(err, SCENE_ERR_INDEX, SCN_SEC_LEAVES, i);
     }
     for (uint32_t i = 0; i < s->nnodes; i++) {
         const scn_node *n = &s->nodes[i];
-        if (!coord_ok(n->x, SCN_COORD_MAX) || !coord_ok(n->y, SCN_COORD_MAX) ||
-            (n->dx == 0 && n->dy == 0) || n->dx == INT32_MIN || n->dy == INT32_MIN)
+        if (!coord_ok(n->x, SCN_COORD_MAX) || !coord_ok(n->y, SCN_COORD_MAX) || (n->dx == 0 && n->dy == 0) ||
+            n->dx == INT32_MIN || n->dy == INT32_MIN)
             return fail(err, SCENE_ERR_RANGE, SCN_SEC_NODES, i);
         for (int c = 0; c < 2; c++) {
             uint32_t ch = n->child[c];
             if ((ch & SCN_LEAF_BIT) ? (ch & ~SCN_LEAF_BIT) >= s->nleaves : ch >= s->nnodes)
                 return fail(err, SCENE_ERR_INDEX, SCN_SEC_NODES, i);
             for (int k = 0; k < 4; k++)
-                if (!coord_ok(n->bbox[c][k], SCN_COORD_MAX))
-                    return fail(err, SCENE_ERR_RANGE, SCN_SEC_NODES, i);
+                if (!coord_ok(n->bbox[c][k], SCN_COORD_MAX)) return fail(err, SCENE_ERR_RANGE, SCN_SEC_NODES, i);
         }
     }
     return SCENE_OK;
@@ -214,8 +229,7 @@ static scene_status check_objects(const scene *s, scene_error *err)
 {
     for (uint32_t i = 0; i < s->nmverts; i++) {
         const scn_mvert *v = &s->mverts[i];
-        if (!coord_ok(v->x, SCN_MODEL_MAX) || !coord_ok(v->y, SCN_MODEL_MAX) ||
-            !coord_ok(v->z, SCN_MODEL_MAX))
+        if (!coord_ok(v->x, SCN_MODEL_MAX) || !coord_ok(v->y, SCN_MODEL_MAX) || !coord_ok(v->z, SCN_MODEL_MAX))
             return fail(err, SCENE_ERR_RANGE, SCN_SEC_MVERTS, i);
     }
     for (uint32_t i = 0; i < s->nfaces; i++) {
@@ -233,8 +247,7 @@ static scene_status check_objects(const scene *s, scene_error *err)
         for (uint32_t k = 0; k < m->num_faces; k++) {
             const scn_face *f = &s->faces[m->first_face + k];
             for (uint32_t j = 0; j < f->num_index; j++)
-                if (s->findex[f->first_index + j] >= m->num_verts)
-                    return fail(err, SCENE_ERR_INDEX, SCN_SEC_MODELS, i);
+                if (s->findex[f->first_index + j] >= m->num_verts) return fail(err, SCENE_ERR_INDEX, SCN_SEC_MODELS, i);
         }
         uint64_t d2 = 0;
         int32_t zmin = INT32_MAX, zmax = INT32_MIN;
@@ -256,8 +269,7 @@ static scene_status check_objects(const scene *s, scene_error *err)
         if (o->path > SCN_PATH_LINE) return fail(err, SCENE_ERR_INDEX, SCN_SEC_OBJECTS, i);
         /* the extent of the whole path, which for no path is the origin */
         int64_t lo[2] = {o->x, o->y}, hi[2] = {o->x, o->y};
-        int ok = coord_ok(o->z, SCN_HEIGHT_MAX) && o->spin >= -(OBJ_SPIN_MAX << 16) &&
-                 o->spin <= (OBJ_SPIN_MAX << 16);
+        int ok = coord_ok(o->z, SCN_HEIGHT_MAX) && o->spin >= -(OBJ_SPIN_MAX << 16) && o->spin <= (OBJ_SPIN_MAX << 16);
         if (o->path == SCN_PATH_NONE) {
             ok = ok && o->pa == 0 && o->pb == 0 && o->period_ms == 0;
         } else {
@@ -272,8 +284,10 @@ static scene_status check_objects(const scene *s, scene_error *err)
                 int64_t d[2] = {o->pa, o->pb};
                 ok = ok && (o->pa != 0 || o->pb != 0);
                 for (int k = 0; k < 2; k++) {
-                    if (d[k] < 0) lo[k] += d[k];
-                    else hi[k] += d[k];
+                    if (d[k] < 0)
+                        lo[k] += d[k];
+                    else
+                        hi[k] += d[k];
                 }
             }
         }
@@ -489,13 +503,11 @@ static scene_status check_build(const scene *s, scene_error *err)
     uint32_t missing = n->features & ~((uint32_t)CFG_FEATURES | SCN_NEED_TEXTURES);
     for (uint32_t bit = 0; missing; bit++)
         if (missing & (1u << bit)) return refuse(err, bit, 1, 0);
-    if (s->hdr->max_depth > CFG_MAX_DEPTH)
-        return refuse(err, SCENE_ITEM_DEPTH, s->hdr->max_depth, CFG_MAX_DEPTH);
+    if (s->hdr->max_depth > CFG_MAX_DEPTH) return refuse(err, SCENE_ITEM_DEPTH, s->hdr->max_depth, CFG_MAX_DEPTH);
     if (n->edges > CFG_MAX_EDGES) return refuse(err, SCENE_ITEM_EDGES, n->edges, CFG_MAX_EDGES);
     if (n->surfaces > CFG_MAX_SURFACES) return refuse(err, SCENE_ITEM_SURFACES, n->surfaces, CFG_MAX_SURFACES);
     if (n->leaf_verts > CFG_LEAF_VERTS) return refuse(err, SCENE_ITEM_LEAF_VERTS, n->leaf_verts, CFG_LEAF_VERTS);
-    if (n->model_verts > CFG_MODEL_VERTS)
-        return refuse(err, SCENE_ITEM_MODEL_VERTS, n->model_verts, CFG_MODEL_VERTS);
+    if (n->model_verts > CFG_MODEL_VERTS) return refuse(err, SCENE_ITEM_MODEL_VERTS, n->model_verts, CFG_MODEL_VERTS);
     if (n->face_verts > CFG_FACE_VERTS) return refuse(err, SCENE_ITEM_FACE_VERTS, n->face_verts, CFG_FACE_VERTS);
     return SCENE_OK;
 }

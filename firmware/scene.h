@@ -42,40 +42,53 @@ typedef struct {
 
 typedef enum {
     SCENE_OK = 0,
-    SCENE_ERR_SHORT,     /* fewer bytes than the header or than total_bytes says */
-    SCENE_ERR_ALIGN,     /* blob not 4-byte aligned in memory */
+    SCENE_ERR_SHORT, /* fewer bytes than the header or than total_bytes says */
+    SCENE_ERR_ALIGN, /* blob not 4-byte aligned in memory */
     SCENE_ERR_MAGIC,
     SCENE_ERR_VERSION,
-    SCENE_ERR_HEADER,    /* header_bytes or total_bytes inconsistent */
+    SCENE_ERR_HEADER, /* header_bytes or total_bytes inconsistent */
     SCENE_ERR_CRC,
-    SCENE_ERR_SECTION,   /* a section is misaligned or lies outside the blob */
-    SCENE_ERR_INDEX,     /* a record refers to something that does not exist */
-    SCENE_ERR_RANGE,     /* a coordinate or height outside the proven-safe range */
-    SCENE_ERR_TREE,      /* the node graph is not a tree, or is deeper than supported */
-    SCENE_ERR_NEEDS,     /* the needs record does not match the scene */
-    SCENE_ERR_BUILD,     /* the scene needs more than this build provides (need, have) */
+    SCENE_ERR_SECTION, /* a section is misaligned or lies outside the blob */
+    SCENE_ERR_INDEX,   /* a record refers to something that does not exist */
+    SCENE_ERR_RANGE,   /* a coordinate or height outside the proven-safe range */
+    SCENE_ERR_TREE,    /* the node graph is not a tree, or is deeper than supported */
+    SCENE_ERR_NEEDS,   /* the needs record does not match the scene */
+    SCENE_ERR_BUILD,   /* the scene needs more than this build provides (need, have) */
     SCENE_ERR_COUNT
 } scene_status;
 
 typedef struct {
     scene_status status;
-    int section;     /* SCN_SEC_* of the offending record, or -1 */
-    uint32_t index;  /* its index; section -1: the SCENE_FIELD_*; SCENE_ERR_BUILD: the SCENE_ITEM_* that does not fit */
+    int section;    /* SCN_SEC_* of the offending record, or -1 */
+    uint32_t index; /* its index; section -1: the SCENE_FIELD_*; SCENE_ERR_BUILD: the SCENE_ITEM_* that does not fit */
     uint32_t need, have; /* SCENE_ERR_BUILD: what the scene needs, what the build provides */
 } scene_error;
 
 /* A refusal of the header itself (section -1): which field, as scene_error.index. */
 enum {
-    SCENE_FIELD_NONE, SCENE_FIELD_MAGIC, SCENE_FIELD_VERSION, SCENE_FIELD_HEADER_BYTES, SCENE_FIELD_TOTAL_BYTES,
-    SCENE_FIELD_CRC, SCENE_FIELD_FLAGS, SCENE_FIELD_MAX_DEPTH, SCENE_FIELD_PLAYER_SECTOR, SCENE_FIELD_PLAYER_START,
+    SCENE_FIELD_NONE,
+    SCENE_FIELD_MAGIC,
+    SCENE_FIELD_VERSION,
+    SCENE_FIELD_HEADER_BYTES,
+    SCENE_FIELD_TOTAL_BYTES,
+    SCENE_FIELD_CRC,
+    SCENE_FIELD_FLAGS,
+    SCENE_FIELD_MAX_DEPTH,
+    SCENE_FIELD_PLAYER_SECTOR,
+    SCENE_FIELD_PLAYER_START,
     SCENE_FIELD_ROOT
 };
 
 /* What a build provides, item by item (SCENE_ERR_BUILD's index): the features
  * SCN_NEED_* by bit number, then the sizes. */
 enum {
-    SCENE_ITEM_EDGES = 8, SCENE_ITEM_SURFACES, SCENE_ITEM_DEPTH, SCENE_ITEM_LEAF_VERTS, SCENE_ITEM_MODEL_VERTS,
-    SCENE_ITEM_FACE_VERTS, SCENE_ITEM_COUNT
+    SCENE_ITEM_EDGES = 8,
+    SCENE_ITEM_SURFACES,
+    SCENE_ITEM_DEPTH,
+    SCENE_ITEM_LEAF_VERTS,
+    SCENE_ITEM_MODEL_VERTS,
+    SCENE_ITEM_FACE_VERTS,
+    SCENE_ITEM_COUNT
 };
 
 /* Validate blob[0..len) and fill s: scene_parse, then the needs record checked

@@ -31,16 +31,16 @@
 #define SCN_LEAF_BIT 0x80000000u /* child index refers to a leaf */
 
 /* Proven-safe ranges (see docs/ranges.md); bspc rejects scenes outside them. */
-#define SCN_COORD_MAX 32767 /* |x|, |y| of every vertex, whole units */
-#define SCN_HEIGHT_MAX 16383 /* |floor|, |ceiling| heights, whole units */
-#define SCN_MAX_DEPTH 255    /* deepest node path the walk stack supports */
+#define SCN_COORD_MAX 32767   /* |x|, |y| of every vertex, whole units */
+#define SCN_HEIGHT_MAX 16383  /* |floor|, |ceiling| heights, whole units */
+#define SCN_MAX_DEPTH 255     /* deepest node path the walk stack supports */
 #define SCN_MAX_LEAF_VERTS 64 /* most vertices of a leaf floor polygon (clip.h has room for 5 more) */
 /* Objects (docs/objects.md) */
-#define SCN_MODEL_MAX 1024       /* |x|, |y|, |z| of a model vertex, whole units */
-#define SCN_MAX_MODEL_VERTS 64   /* vertices of one model */
-#define SCN_MAX_MODEL_FACES 64   /* faces of one model */
-#define SCN_MAX_FACE_VERTS 16    /* vertices of one face (clip.h has room for 5 more) */
-#define SCN_MAX_OBJECTS 4096     /* objects of one scene */
+#define SCN_MODEL_MAX 1024     /* |x|, |y|, |z| of a model vertex, whole units */
+#define SCN_MAX_MODEL_VERTS 64 /* vertices of one model */
+#define SCN_MAX_MODEL_FACES 64 /* faces of one model */
+#define SCN_MAX_FACE_VERTS 16  /* vertices of one face (clip.h has room for 5 more) */
+#define SCN_MAX_OBJECTS 4096   /* objects of one scene */
 
 enum scn_section_id {
     SCN_SEC_VERTICES, /* scn_vertex[]: original vertices first, then split points */
@@ -54,9 +54,9 @@ enum scn_section_id {
     SCN_SEC_MODELS,   /* scn_model[] (docs/objects.md) */
     SCN_SEC_MVERTS,   /* scn_mvert[]: model vertices, model by model */
     SCN_SEC_FACES,    /* scn_face[]: model faces, model by model */
-    SCN_SEC_FINDEX,   /* uint32_t[]: face vertex numbers, relative to the model's first vertex [index: the model's vertices] */
-    SCN_SEC_OBJECTS,  /* scn_object[]: placed objects */
-    SCN_SEC_NEEDS,    /* scn_needs[1]: what the scene needs (docs/needs.md) */
+    SCN_SEC_FINDEX, /* uint32_t[]: face vertex numbers, relative to the model's first vertex [index: the model's vertices] */
+    SCN_SEC_OBJECTS, /* scn_object[]: placed objects */
+    SCN_SEC_NEEDS,   /* scn_needs[1]: what the scene needs (docs/needs.md) */
     /* A textured scene's look (docs/textures.md); every count is 0 in a flat-shaded scene. */
     SCN_SEC_LOOK,     /* scn_look[1] */
     SCN_SEC_LIGHTS,   /* light tables: records of 256 bytes (palette index -> palette index), brightest first */
@@ -73,12 +73,12 @@ typedef struct {
 } scn_section;
 
 typedef struct {
-    uint32_t magic;        /* SCN_MAGIC */
-    uint16_t version;      /* SCN_VERSION */
-    uint16_t header_bytes; /* sizeof(scn_header) */
-    uint32_t total_bytes;  /* whole blob */
-    uint32_t crc32;        /* CRC-32 (IEEE, as zlib) of bytes [16, total_bytes) */
-    uint32_t flags;        /* reserved, 0 */
+    uint32_t magic;             /* SCN_MAGIC */
+    uint16_t version;           /* SCN_VERSION */
+    uint16_t header_bytes;      /* sizeof(scn_header) */
+    uint32_t total_bytes;       /* whole blob */
+    uint32_t crc32;             /* CRC-32 (IEEE, as zlib) of bytes [16, total_bytes) */
+    uint32_t flags;             /* reserved, 0 */
     int32_t player_x, player_y; /* 16.16 */
     int32_t player_angle;       /* degrees, 16.16, 0 = east, counter-clockwise */
     uint32_t player_sector;     /* sector of the player start, or SCN_NONE [index: SECTORS or SCN_NONE] */
@@ -97,16 +97,16 @@ typedef struct {
 typedef struct {
     int32_t floor_h, ceil_h; /* 16.16; ceil_h is a door's closed ceiling */
     uint8_t floor_color, ceil_color, light, flags;
-    int32_t open_h;          /* 16.16: a door's open ceiling (>= ceil_h); ceil_h for other sectors */
+    int32_t open_h; /* 16.16: a door's open ceiling (>= ceil_h); ceil_h for other sectors */
 } scn_sector;
 
 enum { SCN_PART_UPPER, SCN_PART_MIDDLE, SCN_PART_LOWER };
 
 typedef struct {
-    uint32_t v1, v2;      /* vertex indices; the front side is on the right going v1 -> v2 [index: VERTICES] */
-    uint32_t sector[2];   /* front, back (SCN_NONE: one-sided) [index: SECTORS or SCN_NONE] */
-    uint8_t color[2][3];  /* [side][SCN_PART_*] */
-    uint16_t flags;       /* reserved, 0 */
+    uint32_t v1, v2;     /* vertex indices; the front side is on the right going v1 -> v2 [index: VERTICES] */
+    uint32_t sector[2];  /* front, back (SCN_NONE: one-sided) [index: SECTORS or SCN_NONE] */
+    uint8_t color[2][3]; /* [side][SCN_PART_*] */
+    uint16_t flags;      /* reserved, 0 */
 } scn_line;
 
 typedef struct {
@@ -120,14 +120,14 @@ typedef struct {
 enum { BOX_TOP, BOX_BOTTOM, BOX_LEFT, BOX_RIGHT, BOX_SIDES };
 
 typedef struct {
-    int32_t x, y, dx, dy;  /* partition line through (x,y) along (dx,dy), 16.16; front = right side */
+    int32_t x, y, dx, dy;       /* partition line through (x,y) along (dx,dy), 16.16; front = right side */
     int32_t bbox[2][BOX_SIDES]; /* [child][BOX_*]: ymax, ymin, xmin, xmax, 16.16 */
-    uint32_t child[2];     /* 0 front (right), 1 back; SCN_LEAF_BIT marks a leaf [child] */
+    uint32_t child[2];          /* 0 front (right), 1 back; SCN_LEAF_BIT marks a leaf [child] */
 } scn_node;
 
 typedef struct {
-    uint32_t first_seg, num_segs; /* segs[first_seg .. first_seg + num_segs) [range: SEGS] */
-    uint32_t sector;              /* the leaf's sector (SCN_NONE if it has none) [index: SECTORS or SCN_NONE] */
+    uint32_t first_seg, num_segs;     /* segs[first_seg .. first_seg + num_segs) [range: SEGS] */
+    uint32_t sector;                  /* the leaf's sector (SCN_NONE if it has none) [index: SECTORS or SCN_NONE] */
     uint32_t first_pvert, num_pverts; /* floor polygon in pverts[] (0 pverts if degenerate) [range: PVERTS] */
 } scn_leaf;
 
@@ -145,10 +145,11 @@ typedef struct {
 } scn_mvert;
 
 typedef struct {
-    uint32_t first_index; /* findex[first_index .. + num_index): vertex numbers within the model [range: FINDEX, num_index] */
-    uint16_t num_index;   /* 3 .. SCN_MAX_FACE_VERTS, counter-clockwise seen from outside [count of first_index] */
+    uint32_t
+        first_index; /* findex[first_index .. + num_index): vertex numbers within the model [range: FINDEX, num_index] */
+    uint16_t num_index; /* 3 .. SCN_MAX_FACE_VERTS, counter-clockwise seen from outside [count of first_index] */
     uint8_t colour;
-    uint8_t part;         /* convex part of the model it belongs to */
+    uint8_t part; /* convex part of the model it belongs to */
 } scn_face;
 
 enum { SCN_PATH_NONE, SCN_PATH_CIRCLE, SCN_PATH_LINE };
@@ -165,13 +166,13 @@ typedef struct {
 
 /* ---- Textures and light (docs/textures.md) ---- */
 
-#define SCN_TEX_NONE 0xFFFFu   /* no texture: the part or plane keeps its flat colour */
-#define SCN_LIGHT_MAPS 32      /* light tables of a textured scene (Doom's COLORMAP 0..31) */
-#define SCN_TEX_MAX_BITS 10    /* a texture is at most 1024 x 1024 texels */
+#define SCN_TEX_NONE 0xFFFFu /* no texture: the part or plane keeps its flat colour */
+#define SCN_LIGHT_MAPS 32    /* light tables of a textured scene (Doom's COLORMAP 0..31) */
+#define SCN_TEX_MAX_BITS 10  /* a texture is at most 1024 x 1024 texels */
 
 typedef struct {
-    uint32_t sky_tex;   /* scn_texture index of the sky, or SCN_TEX_NONE [index: TEXTURES or SCN_TEX_NONE] */
-    uint32_t flags;     /* reserved, 0 */
+    uint32_t sky_tex; /* scn_texture index of the sky, or SCN_TEX_NONE [index: TEXTURES or SCN_TEX_NONE] */
+    uint32_t flags;   /* reserved, 0 */
 } scn_look;
 
 /* A texture of 2^wbits columns of 2^hbits texels, column-major: texel (u, v)
@@ -182,12 +183,12 @@ typedef struct {
  * that is not a power of two is padded to the next one by repeating rows from
  * the top. A flat is 64 x 64 with u = map x, v = -map y (Doom's alignment). */
 typedef struct {
-    uint32_t first;          /* first texel in SCN_SEC_TEXELS [range: TEXELS, 1 << (wbits + hbits)] */
-    uint8_t wbits, hbits;    /* 0 .. SCN_TEX_MAX_BITS */
-    uint8_t colour;          /* palette index nearest the texture's mean colour [index: PALETTE] */
-    uint8_t reserved;        /* 0 */
-    uint16_t height;         /* rows as the WAD gives them (<= 2^hbits): Doom's pegging counts these */
-    uint16_t reserved2;      /* 0 */
+    uint32_t first;       /* first texel in SCN_SEC_TEXELS [range: TEXELS, 1 << (wbits + hbits)] */
+    uint8_t wbits, hbits; /* 0 .. SCN_TEX_MAX_BITS */
+    uint8_t colour;       /* palette index nearest the texture's mean colour [index: PALETTE] */
+    uint8_t reserved;     /* 0 */
+    uint16_t height;      /* rows as the WAD gives them (<= 2^hbits): Doom's pegging counts these */
+    uint16_t reserved2;   /* 0 */
 } scn_texture;
 
 #define SCN_SIDE_UNPEG_TOP 1u    /* Doom's linedef flag 8: upper texture hangs from the front ceiling */
@@ -198,16 +199,17 @@ typedef struct {
  * vector along the side (from the line's v1 for side 0, from v2 for side 1),
  * u0 folds in where that runs from and the side's x offset. */
 typedef struct {
-    int32_t ux, uy;     /* 2.30 */
-    int32_t u0;         /* 16.16 */
-    int32_t row_off;    /* 16.16: the side's y offset (added to every part's texture row) */
-    uint16_t tex[3];    /* [SCN_PART_*]: scn_texture index, or SCN_TEX_NONE [index: TEXTURES or SCN_TEX_NONE] */
-    uint8_t flags;      /* SCN_SIDE_* */
-    int8_t light_adj;   /* Doom's fake contrast in light levels: -1 along x (east-west), +1 along y, else 0 */
+    int32_t ux, uy;   /* 2.30 */
+    int32_t u0;       /* 16.16 */
+    int32_t row_off;  /* 16.16: the side's y offset (added to every part's texture row) */
+    uint16_t tex[3];  /* [SCN_PART_*]: scn_texture index, or SCN_TEX_NONE [index: TEXTURES or SCN_TEX_NONE] */
+    uint8_t flags;    /* SCN_SIDE_* */
+    int8_t light_adj; /* Doom's fake contrast in light levels: -1 along x (east-west), +1 along y, else 0 */
 } scn_side;
 
 typedef struct {
-    uint16_t floor_tex, ceil_tex; /* scn_texture index, or SCN_TEX_NONE (a sky ceiling: the sky) [index: TEXTURES or SCN_TEX_NONE] */
+    uint16_t floor_tex,
+        ceil_tex; /* scn_texture index, or SCN_TEX_NONE (a sky ceiling: the sky) [index: TEXTURES or SCN_TEX_NONE] */
 } scn_plane;
 
 /* What a scene needs of a renderer, written by the compiler's analysis
@@ -217,25 +219,25 @@ typedef struct {
  * The bounds hold for every camera the renderer accepts (any position in the
  * coordinate box, any height, any angle and look) and every door state. */
 /* Macros, not an enum: builds test them in #if (build_config.h's CFG_TEXTURES). */
-#define SCN_NEED_OBJECTS (1u << 0) /* models (objects are placed from them) */
-#define SCN_NEED_DOORS (1u << 1) /* a sector whose ceiling moves */
+#define SCN_NEED_OBJECTS (1u << 0)   /* models (objects are placed from them) */
+#define SCN_NEED_DOORS (1u << 1)     /* a sector whose ceiling moves */
 #define SCN_NEED_TWO_SIDED (1u << 2) /* a line with a sector on both sides */
-#define SCN_NEED_HEIGHTS (1u << 3) /* floors or ceilings at more than one height */
-#define SCN_NEED_SKY (1u << 4) /* two sky ceilings meet at a step (Doom's sky rule) */
-#define SCN_NEED_LOOK (1u << 5) /* the camera may look up and down */
-#define SCN_NEED_YCLIP (1u << 6) /* a polygon can cross the top or bottom screen edge */
-#define SCN_NEED_TEXTURES (1u << 7) /* textures, light tables and a sky (docs/textures.md) */
+#define SCN_NEED_HEIGHTS (1u << 3)   /* floors or ceilings at more than one height */
+#define SCN_NEED_SKY (1u << 4)       /* two sky ceilings meet at a step (Doom's sky rule) */
+#define SCN_NEED_LOOK (1u << 5)      /* the camera may look up and down */
+#define SCN_NEED_YCLIP (1u << 6)     /* a polygon can cross the top or bottom screen edge */
+#define SCN_NEED_TEXTURES (1u << 7)  /* textures, light tables and a sky (docs/textures.md) */
 #define SCN_NEED_ALL ((1u << 8) - 1u)
 
 typedef struct {
-    uint32_t features;      /* SCN_NEED_* */
-    uint32_t edges;         /* most world edges on the edge lists in one frame (mode spans) */
-    uint32_t surfaces;      /* most world surfaces in one frame */
-    uint32_t leaf_verts;    /* most vertices of a leaf floor polygon */
-    uint32_t object_faces;  /* faces of the scene's own objects */
-    uint32_t object_edges;  /* their edges after clipping, at most */
-    uint32_t model_verts;   /* most vertices of one model */
-    uint32_t face_verts;    /* most vertices of one model face */
+    uint32_t features;     /* SCN_NEED_* */
+    uint32_t edges;        /* most world edges on the edge lists in one frame (mode spans) */
+    uint32_t surfaces;     /* most world surfaces in one frame */
+    uint32_t leaf_verts;   /* most vertices of a leaf floor polygon */
+    uint32_t object_faces; /* faces of the scene's own objects */
+    uint32_t object_edges; /* their edges after clipping, at most */
+    uint32_t model_verts;  /* most vertices of one model */
+    uint32_t face_verts;   /* most vertices of one model face */
 } scn_needs;
 
 #endif

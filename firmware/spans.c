@@ -8,31 +8,31 @@
 #include "obj_draw.h"
 #include "surfaces.h"
 
-#define SPAN_BUFFER 2048       /* spans collected before they are filled */
+#define SPAN_BUFFER 2048 /* spans collected before they are filled */
 #define BACKGROUND_COLOUR 0
 #define POLY_EDGES (CFG_POLY_VERTS + 5) /* the most edges one clipped polygon can have */
 
 typedef struct sp_edge {
-    rast_edge d;               /* the DDA the fill rule is defined by (raster.h) */
-    uint8_t leading;           /* left edge of its polygon: the surface starts here */
+    rast_edge d;     /* the DDA the fill rule is defined by (raster.h) */
+    uint8_t leading; /* left edge of its polygon: the surface starts here */
     struct sp_surf *surf;
     struct sp_edge *next;
 } sp_edge;
 
 typedef struct sp_surf {
-    uint32_t key;              /* BSP order of its leaf: smaller is nearer (an object's face: kmin) */
+    uint32_t key; /* BSP order of its leaf: smaller is nearer (an object's face: kmin) */
     uint32_t id;
-    uint32_t kmax;             /* an object's face: its key range is [key, kmax] */
-    int32_t plane;             /* its 1/z plane in planes[], or -1 (a world surface's, until needed) */
-    uint32_t seg;              /* a world surface's plane: a wall of this seg, or (SCN_NONE) the
+    uint32_t kmax;  /* an object's face: its key range is [key, kmax] */
+    int32_t plane;  /* its 1/z plane in planes[], or -1 (a world surface's, until needed) */
+    uint32_t seg;   /* a world surface's plane: a wall of this seg, or (SCN_NONE) the
                                 * floor or ceiling its id names */
-    uint8_t object;            /* 1: an object's face */
-    uint8_t silent;            /* 1: owns its pixels but fills nothing (see spans_render) */
-    int32_t state;             /* leading minus trailing edges seen on this line */
+    uint8_t object; /* 1: an object's face */
+    uint8_t silent; /* 1: owns its pixels but fills nothing (see spans_render) */
+    int32_t state;  /* leading minus trailing edges seen on this line */
     tex_paint paint;
-    struct sp_surf *below;     /* next surface down the stack */
+    struct sp_surf *below; /* next surface down the stack */
     struct sp_surf *above;
-    int32_t span_head;         /* this batch's spans, linked through sp_span.next */
+    int32_t span_head; /* this batch's spans, linked through sp_span.next */
     struct sp_surf *next_drawn;
 } sp_surf;
 
@@ -43,9 +43,9 @@ typedef struct {
 
 /* An object in the view frustum, and the first visited leaf its box touches. */
 typedef struct {
-    int32_t x0, x1, y0, y1;    /* its box (16.16), clamped to 32 bits */
-    uint32_t index;            /* in w->objs */
-    uint32_t kmin;             /* the key of that leaf, 0 while none */
+    int32_t x0, x1, y0, y1; /* its box (16.16), clamped to 32 bits */
+    uint32_t index;         /* in w->objs */
+    uint32_t kmin;          /* the key of that leaf, 0 while none */
 } sp_obj;
 
 typedef struct {
@@ -60,25 +60,25 @@ typedef struct {
     sp_surf *surfs;
     uint32_t nsurfs, max_surfs;
     uint32_t cap_edges, cap_surfs; /* the pools: world's part plus every face of every object */
-    objd_plane *planes;        /* with objects: 1/z planes of object faces and of world surfaces */
+    objd_plane *planes;            /* with objects: 1/z planes of object faces and of world surfaces */
     uint32_t nplanes;
-    uint32_t object_faces;     /* object faces on the edge lists */
-    sp_obj *objs;              /* with objects: those in the frustum, by x0 */
-    uint32_t nobjs, pending;   /* pending: not yet found in a visited leaf */
-    int32_t obj_span;          /* the widest object box (x1 - x0) */
-    int world_planes;          /* world surfaces keep what finds their plane */
-    int final;                 /* the batch being drawn is the frame's last */
-    int flushed;               /* a batch was drawn before this one */
+    uint32_t object_faces;   /* object faces on the edge lists */
+    sp_obj *objs;            /* with objects: those in the frustum, by x0 */
+    uint32_t nobjs, pending; /* pending: not yet found in a visited leaf */
+    int32_t obj_span;        /* the widest object box (x1 - x0) */
+    int world_planes;        /* world surfaces keep what finds their plane */
+    int final;               /* the batch being drawn is the frame's last */
+    int flushed;             /* a batch was drawn before this one */
     uint32_t edges_total;
     sp_edge *new_edges[VIEW_H];
-    cov_mask claimed;          /* pixels some polygon on the lists (any batch) covers */
-    cov_mask drawn;            /* pixels filled by an earlier batch */
+    cov_mask claimed; /* pixels some polygon on the lists (any batch) covers */
+    cov_mask drawn;   /* pixels filled by an earlier batch */
     occ_columns occ;
     int use_occ;
     uint32_t key;
     sp_span spans[SPAN_BUFFER];
     int nspans;
-    sp_surf *drawn_list;       /* surfaces with spans in the span buffer */
+    sp_surf *drawn_list; /* surfaces with spans in the span buffer */
     sp_surf background;
 } span_state;
 
@@ -110,9 +110,9 @@ static uint64_t min_u64(uint64_t a, uint64_t b)
 }
 
 typedef struct {
-    uint64_t world_edges, world_surfs;     /* one batch's world polygons */
-    uint64_t edges, surfs, planes, objs;   /* pool sizes; planes and objs 0 without objects */
-    uint64_t total;                        /* bytes */
+    uint64_t world_edges, world_surfs;   /* one batch's world polygons */
+    uint64_t edges, surfs, planes, objs; /* pool sizes; planes and objs 0 without objects */
+    uint64_t total;                      /* bytes */
 } span_layout;
 
 static void layout(const scene *s, const world_state *w, span_layout *L)
@@ -260,8 +260,12 @@ static uint32_t collect_objects(span_state *S)
         const obj_state *o = &w->objs[i];
         if (o->model >= sc->nmodels || !objd_in_view(sc, o, S->v)) continue;
         int64_t r = sc->models[o->model].radius;
-        sp_obj b = {clamp32((int64_t)o->x - r), clamp32((int64_t)o->x + r), clamp32((int64_t)o->y - r),
-                    clamp32((int64_t)o->y + r), i, 0};
+        sp_obj b = {clamp32((int64_t)o->x - r),
+                    clamp32((int64_t)o->x + r),
+                    clamp32((int64_t)o->y - r),
+                    clamp32((int64_t)o->y + r),
+                    i,
+                    0};
         if (b.x1 - b.x0 > S->obj_span) S->obj_span = b.x1 - b.x0;
         uint32_t k = n++;
         for (; k > 0 && S->objs[k - 1].x0 > b.x0; k--) S->objs[k] = S->objs[k - 1];
@@ -298,8 +302,10 @@ static void find_objects(span_state *S, uint32_t leaf)
     uint32_t lo = 0, hi = S->nobjs;
     while (lo < hi) {
         uint32_t mid = lo + (hi - lo) / 2;
-        if (S->objs[mid].x0 < from) lo = mid + 1;
-        else hi = mid;
+        if (S->objs[mid].x0 < from)
+            lo = mid + 1;
+        else
+            hi = mid;
     }
     for (uint32_t i = lo; i < S->nobjs && S->objs[i].x0 <= box[BOX_RIGHT]; i++) {
         sp_obj *o = &S->objs[i];
@@ -454,8 +460,10 @@ static void emit_span(span_state *S, sp_surf *s, int y, int x0, int x1)
     }
     for (int x = cov_next_clear(&S->drawn, y, x0, x1); x < x1;) {
         int end = cov_next_set(&S->drawn, y, x, x1);
-        if (S->final) push_span(S, s, y, x, end);
-        else push_marked(S, s, y, x, end);
+        if (S->final)
+            push_span(S, s, y, x, end);
+        else
+            push_marked(S, s, y, x, end);
         x = cov_next_clear(&S->drawn, y, end, x1);
     }
 }
@@ -475,7 +483,7 @@ static void emit_span(span_state *S, sp_surf *s, int y, int x0, int x1)
 #define OVERTAKES_MAX 32 /* at one pixel: only orders that are no depth could need more */
 
 typedef struct {
-    int x;      /* first pixel where s is in front of the top, VIEW_W: none */
+    int x; /* first pixel where s is in front of the top, VIEW_W: none */
     sp_surf *s;
 } sp_next;
 
@@ -505,8 +513,10 @@ static int overtakes_at(span_state *S, sp_surf *top, sp_surf *p, int x, int y)
     int lo = x - 1, hi = VIEW_W - 1; /* in front at hi; lo is before the range */
     while (hi - lo > 1) {
         int mid = lo + (hi - lo) / 2;
-        if (mixed_front(S, p, top, mid, y)) hi = mid;
-        else lo = mid;
+        if (mixed_front(S, p, top, mid, y))
+            hi = mid;
+        else
+            lo = mid;
     }
     return hi;
 }
@@ -559,8 +569,8 @@ static inline __attribute__((always_inline)) void scan_line(span_state *S, sp_ed
 {
     sp_surf *top = &S->background;
     int cur = 0;
-    int nobj = 0, mixed = 0;        /* object faces on the stack; any on this line so far */
-    sp_next next = {VIEW_W, 0};     /* with objects: the next overtaking of the top */
+    int nobj = 0, mixed = 0;    /* object faces on the stack; any on this line so far */
+    sp_next next = {VIEW_W, 0}; /* with objects: the next overtaking of the top */
     for (sp_edge *e = active; e; e = e->next) {
         int col = rast_first_sample(e->d.x);
         if (col < 0) col = 0;
@@ -578,7 +588,7 @@ static inline __attribute__((always_inline)) void scan_line(span_state *S, sp_ed
                 top->above = s;
                 top = s;
                 if (objects && nobj) next = next_overtake(S, top, col, y);
-            } else {                            /* slot it in below */
+            } else { /* slot it in below */
                 sp_surf *p = top;
                 while (!in_front(S, s, p->below, col, y, objects)) p = p->below;
                 s->below = p->below;
@@ -590,14 +600,14 @@ static inline __attribute__((always_inline)) void scan_line(span_state *S, sp_ed
         } else {
             if (--s->state != 0) continue;
             if (objects && s->object) nobj--;
-            if (s == top) {                     /* the top ends: the next one shows */
+            if (s == top) { /* the top ends: the next one shows */
                 emit_span(S, s, y, cur, col);
                 cur = col;
                 top = s->below;
                 top->above = 0;
                 if (objects && mixed) top = nearest(S, top, col, y);
                 if (objects) next = nobj ? next_overtake(S, top, col, y) : (sp_next){VIEW_W, 0};
-            } else if (s->below || s->above) {  /* leaves from inside the stack */
+            } else if (s->below || s->above) { /* leaves from inside the stack */
                 s->above->below = s->below;
                 s->below->above = s->above;
                 if (objects && s == next.s) next = nobj ? next_overtake(S, top, col, y) : (sp_next){VIEW_W, 0};
@@ -734,8 +744,12 @@ void spans_render(const scene *sc, const world_state *w, const view_xform *v, co
     S->key = 0;
     S->nspans = 0;
     S->drawn_list = 0;
-    S->background = (sp_surf){.key = 0xFFFFFFFFu, .id = RAST_ID(RAST_KIND_NONE, 0), .plane = -1, .seg = SCN_NONE,
-                              .paint = {.kind = TEX_FLAT, .colour = BACKGROUND_COLOUR}, .span_head = -1};
+    S->background = (sp_surf){.key = 0xFFFFFFFFu,
+                              .id = RAST_ID(RAST_KIND_NONE, 0),
+                              .plane = -1,
+                              .seg = SCN_NONE,
+                              .paint = {.kind = TEX_FLAT, .colour = BACKGROUND_COLOUR},
+                              .span_head = -1};
     for (int y = 0; y < VIEW_H; y++) S->new_edges[y] = 0;
     cov_clear(&S->claimed); /* S->drawn: cleared before the first batch that is not the last */
     walk_stats ws;

@@ -28,14 +28,14 @@ static int project_unclipped(const view_xform *v, const clip_poly *p, screen_pt 
 enum { LOOK_FLAT, LOOK_PART, LOOK_PLANE, LOOK_SKY };
 
 typedef struct {
-    uint8_t kind;   /* LOOK_* */
-    uint8_t part;   /* LOOK_PART: SCN_PART_* */
-    uint8_t colour; /* the flat colour */
-    uint8_t light;  /* the sector's light level */
-    const scn_seg *g;             /* LOOK_PART */
-    int32_t ff, fc, bf, bc;       /* LOOK_PART: front floor and ceiling, back floor and ceiling, now */
-    uint32_t tex;                 /* LOOK_PLANE */
-    int32_t h;                    /* LOOK_PLANE: its height */
+    uint8_t kind;           /* LOOK_* */
+    uint8_t part;           /* LOOK_PART: SCN_PART_* */
+    uint8_t colour;         /* the flat colour */
+    uint8_t light;          /* the sector's light level */
+    const scn_seg *g;       /* LOOK_PART */
+    int32_t ff, fc, bf, bc; /* LOOK_PART: front floor and ceiling, back floor and ceiling, now */
+    uint32_t tex;           /* LOOK_PLANE */
+    int32_t h;              /* LOOK_PLANE: its height */
 } surf_look;
 
 /* A wall part's paint: its texture, hung by Doom's pegging from the heights
@@ -156,8 +156,7 @@ static void seg_parts(const scene *sc, const fx_t *ceil, const view_xform *v, ui
     view_pt pa = view_point(v, a->x, a->y, 0), pb = view_point(v, b->x, b->y, 0); /* once for every part */
     int c0 = 0, c1 = VIEW_W;
     if (occ) {
-        if (!occ_seg_columns(pa, pb, &c0, &c1) ||
-            occ_hidden(occ, c0 > 0 ? c0 - 1 : 0, c1 < VIEW_W ? c1 + 1 : VIEW_W)) {
+        if (!occ_seg_columns(pa, pb, &c0, &c1) || occ_hidden(occ, c0 > 0 ? c0 - 1 : 0, c1 < VIEW_W ? c1 + 1 : VIEW_W)) {
             st->occluded++;
             return;
         }
@@ -168,8 +167,17 @@ static void seg_parts(const scene *sc, const fx_t *ceil, const view_xform *v, ui
     int32_t front_ceil = ceil_now(sc, ceil, front_index);
     uint32_t id = RAST_ID(RAST_KIND_WALL, g->line * 2u + g->side);
     const uint8_t *colour = l->color[g->side];
-    surf_look k = {LOOK_PART, SCN_PART_MIDDLE, colour[SCN_PART_MIDDLE], front->light, g,
-                   front->floor_h, front_ceil, front->floor_h, front_ceil, 0, 0};
+    surf_look k = {LOOK_PART,
+                   SCN_PART_MIDDLE,
+                   colour[SCN_PART_MIDDLE],
+                   front->light,
+                   g,
+                   front->floor_h,
+                   front_ceil,
+                   front->floor_h,
+                   front_ceil,
+                   0,
+                   0};
     if (!CFG_TWO_SIDED || back_index == SCN_NONE) {
         wall_part(sc, v, pa, pb, front->floor_h, front_ceil, mask, sink, &k, id, gi, st);
         if (occ) close_columns(v, a, b, pa, pb, mask, occ);
@@ -210,10 +218,12 @@ static void seg_parts(const scene *sc, const fx_t *ceil, const view_xform *v, ui
 static surf_look plane_look(const scene *sc, uint32_t sector, int ceiling, int32_t h)
 {
     const scn_sector *sec = &sc->sectors[sector];
-    surf_look k = {LOOK_PLANE, 0, ceiling ? sec->ceil_color : sec->floor_color, sec->light, 0, 0, 0, 0, 0,
+    surf_look k = {LOOK_PLANE,   0, ceiling ? sec->ceil_color : sec->floor_color, sec->light, 0, 0, 0, 0, 0,
                    SCN_TEX_NONE, h};
-    if (ceiling && CFG_SKY && (sec->flags & SCN_SECTOR_SKY)) k.kind = LOOK_SKY;
-    else if (CFG_TEXTURES && sc->look) k.tex = ceiling ? sc->planes[sector].ceil_tex : sc->planes[sector].floor_tex;
+    if (ceiling && CFG_SKY && (sec->flags & SCN_SECTOR_SKY))
+        k.kind = LOOK_SKY;
+    else if (CFG_TEXTURES && sc->look)
+        k.tex = ceiling ? sc->planes[sector].ceil_tex : sc->planes[sector].floor_tex;
     return k;
 }
 
@@ -241,7 +251,8 @@ void surf_leaf(const scene *sc, const world_state *w, const view_xform *v, uint3
         int floor = v->cz > sec->floor_h, ceiling = v->cz < top; /* edge-on or from behind: no plane work */
         st->planes_skipped += (uint32_t)!floor + (uint32_t)!ceiling;
         uint32_t n = f->num_pverts;
-        if (n < 3 || n > CLIP_MAX_VERTS - 5) floor = ceiling = 0; /* degenerate; the loader refuses more than the build's */
+        if (n < 3 || n > CLIP_MAX_VERTS - 5)
+            floor = ceiling = 0; /* degenerate; the loader refuses more than the build's */
         view_pt pts[CLIP_MAX_VERTS];
         if (floor || ceiling) /* the leaf polygon rotated once for both */
             for (uint32_t i = 0; i < n; i++) {

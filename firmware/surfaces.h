@@ -20,8 +20,8 @@ typedef struct {
      * part of, or SCN_NONE for the floor or ceiling its id names (a sky step has
      * a ceiling's id but is a wall: its seg tells). zmin, zmax: the view depths
      * of its clipped vertices (view units), the range it spans. */
-    void (*polygon)(void *ctx, const screen_pt *pts, int n, const tex_paint *paint, uint32_t id, uint32_t seg, int32_t zmin,
-                    int32_t zmax);
+    void (*polygon)(void *ctx, const screen_pt *pts, int n, const tex_paint *paint, uint32_t id, uint32_t seg,
+                    int32_t zmin, int32_t zmax);
     /* May be NULL. Asked before clipping, with the polygon's vertices projected
      * unclipped (clamped to the screen; asked only when every vertex is in
      * front of the near plane): 1 if the screen box of those points (widened

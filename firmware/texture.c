@@ -164,7 +164,7 @@ static inline uint8_t texel(tex_addr a, uint32_t u, uint32_t v)
 /* n texels along a straight line through the texture, each through its
  * light table: the inner loop of every wall piece and plane span. */
 static inline __attribute__((always_inline)) void run_of(uint8_t *out, int n, const uint8_t *light, tex_addr a,
-                                                        uint32_t u, uint32_t v, uint32_t du, uint32_t dv)
+                                                         uint32_t u, uint32_t v, uint32_t du, uint32_t dv)
 {
 #pragma GCC unroll 4
     for (int i = 0; i < n; i++) {
@@ -206,7 +206,7 @@ static inline const uint8_t *wall_light(const tex_paint *p, uint32_t z)
  * wall: den and slope are the paint's a + sx b and c + sx d for the pixel's
  * column (2.30, stepped along the span), vk its row's sy 2^22 / 320. */
 static inline __attribute__((always_inline)) wall_sample wall_at(const tex_paint *p, int64_t den, int64_t slope,
-                                                                int32_t vk)
+                                                                 int32_t vk)
 {
     int64_t d14 = den >> 16; /* 2.14, < 2^15 */
     uint32_t z = d14 > 0 ? depth_div((uint64_t)p->dist, (uint32_t)d14) : TEX_ZMAX;
@@ -222,8 +222,8 @@ static inline __attribute__((always_inline)) wall_sample wall_at(const tex_paint
  * its row was cut into spans: every render mode and pool size draws the same
  * texels. Past a wall's vanishing point (a sample the ray of which misses the
  * line) the span's own end is sampled instead. */
-static inline __attribute__((always_inline)) void wall_span_as(const tex_paint *p, int y, int x0, int x1,
-                                                                uint8_t *row, tex_addr a)
+static inline __attribute__((always_inline)) void wall_span_as(const tex_paint *p, int y, int x0, int x1, uint8_t *row,
+                                                               tex_addr a)
 {
     int32_t sy = 2 * (VIEW_CY + p->look) - 2 * y - 1;
     int32_t vk = sy * 13107; /* sy 2^22 / 320, |sy| < 600 */
@@ -263,8 +263,10 @@ static inline __attribute__((always_inline)) void wall_span_as(const tex_paint *
 static void wall_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
 {
     tex_addr a = addr_of(p);
-    if (a.rmask == 127u) wall_span_as(p, y, x0, x1, row, (tex_addr){a.texels, a.cmask, 127u, 9u});
-    else wall_span_as(p, y, x0, x1, row, a);
+    if (a.rmask == 127u)
+        wall_span_as(p, y, x0, x1, row, (tex_addr){a.texels, a.cmask, 127u, 9u});
+    else
+        wall_span_as(p, y, x0, x1, row, a);
 }
 
 /* ---- floors and ceilings: one depth a row (Doom's trick) ---- */
@@ -303,9 +305,12 @@ static void sky_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
 
 void tex_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
 {
-    if (p->kind == TEX_WALL) wall_span(p, y, x0, x1, row);
-    else if (p->kind == TEX_PLANE) plane_span(p, y, x0, x1, row);
-    else if (p->kind == TEX_SKY) sky_span(p, y, x0, x1, row);
+    if (p->kind == TEX_WALL)
+        wall_span(p, y, x0, x1, row);
+    else if (p->kind == TEX_PLANE)
+        plane_span(p, y, x0, x1, row);
+    else if (p->kind == TEX_SKY)
+        sky_span(p, y, x0, x1, row);
     else
         for (int x = x0; x < x1; x++) row[x] = p->colour;
 }

@@ -49,18 +49,18 @@ typedef struct {
     uint8_t kind;   /* TEX_* */
     uint8_t colour; /* TEX_FLAT's colour; for the others, the flat colour a flat-shaded target draws */
 #if CFG_TEXTURES
-    uint8_t hbits;  /* rows 2^hbits; texel (u, v) = texels[(u & wmask) << hbits | (v & hmask)] */
-    int8_t start;   /* the brightest light table the surface's light level allows */
+    uint8_t hbits; /* rows 2^hbits; texel (u, v) = texels[(u & wmask) << hbits | (v & hmask)] */
+    int8_t start;  /* the brightest light table the surface's light level allows */
     uint32_t wmask, hmask;
     const uint8_t *texels;
     const uint8_t *lights; /* the scene's light tables */
-    int64_t dist;   /* walls: the eye's distance from the wall's line, 16.16, times 2^14 */
-    int64_t dh;     /* planes: the plane's height above the eye, 16.16 */
-    int32_t a, b;   /* walls: depth denominator a + sx * b; planes: cos, sin of the view; 2.30 */
-    int32_t c, d;   /* walls: texture column slope c + sx * d (2.30); planes: sin, cos divided by 320 */
-    uint32_t u0;    /* walls: texture column at the eye, 16.16; sky: the view angle */
-    uint32_t v0;    /* walls: texture row at the eye's height, 16.16; planes: the eye's x, 16.16 */
-    uint32_t w0;    /* planes: minus the eye's y, 16.16 */
+    int64_t dist;          /* walls: the eye's distance from the wall's line, 16.16, times 2^14 */
+    int64_t dh;            /* planes: the plane's height above the eye, 16.16 */
+    int32_t a, b;          /* walls: depth denominator a + sx * b; planes: cos, sin of the view; 2.30 */
+    int32_t c, d;          /* walls: texture column slope c + sx * d (2.30); planes: sin, cos divided by 320 */
+    uint32_t u0;           /* walls: texture column at the eye, 16.16; sky: the view angle */
+    uint32_t v0;           /* walls: texture row at the eye's height, 16.16; planes: the eye's x, 16.16 */
+    uint32_t w0;           /* planes: minus the eye's y, 16.16 */
     int32_t look;
 #endif
 } tex_paint;

@@ -13,7 +13,9 @@ void view_setup(view_xform *v, const camera *cam)
     v->angle = a;
     v->sin = fx_sin(a);
     v->cos = fx_cos(a);
-    v->look = !CFG_LOOK ? 0 : cam->look < -VIEW_LOOK_MAX ? -VIEW_LOOK_MAX : (cam->look > VIEW_LOOK_MAX ? VIEW_LOOK_MAX : cam->look);
+    v->look = !CFG_LOOK                    ? 0
+              : cam->look < -VIEW_LOOK_MAX ? -VIEW_LOOK_MAX
+                                           : (cam->look > VIEW_LOOK_MAX ? VIEW_LOOK_MAX : cam->look);
 }
 
 static int32_t clamp32(int64_t v, int32_t hi)

@@ -65,34 +65,34 @@
 /* The near plane at 1/1024 unit (16 raw by default); with fewer than 10 view
  * bits, at one raw unit, the nearest plane they can express. */
 #define VIEW_ZNEAR (VIEW_SHIFT >= 10 ? 1 << (VIEW_SHIFT - 10) : 1)
-#define VIEW_FOCAL 160           /* pixels */
+#define VIEW_FOCAL 160 /* pixels */
 #define VIEW_CX 160
 #define VIEW_CY 100
-#define VIEW_LOOK_MAX 100        /* |look| in pixels: the horizon stays on screen */
+#define VIEW_LOOK_MAX 100 /* |look| in pixels: the horizon stays on screen */
 #define VIEW_W 320
 #define VIEW_H 200
 #define VIEW_W_FX (VIEW_W << 16)
 #define VIEW_H_FX (VIEW_H << 16)
 
 typedef struct {
-    fx_t x, y, z;      /* eye position, 16.16 map units (z absolute) */
-    fx_t angle_deg;    /* view angle in degrees, 16.16; 0 = east, counter-clockwise */
-    int32_t look;      /* vertical shear in pixels: positive looks up */
+    fx_t x, y, z;   /* eye position, 16.16 map units (z absolute) */
+    fx_t angle_deg; /* view angle in degrees, 16.16; 0 = east, counter-clockwise */
+    int32_t look;   /* vertical shear in pixels: positive looks up */
 } camera;
 
 typedef struct {
-    int64_t cx, cy, cz;  /* eye, 16.16 */
-    int32_t sin, cos;    /* of the view angle, 2.30 */
-    int32_t look;        /* clamped shear, pixels */
-    fx_ang_t angle;      /* the view angle */
+    int64_t cx, cy, cz; /* eye, 16.16 */
+    int32_t sin, cos;   /* of the view angle, 2.30 */
+    int32_t look;       /* clamped shear, pixels */
+    fx_ang_t angle;     /* the view angle */
 } view_xform;
 
 typedef struct {
-    int32_t x, y, z;     /* view space, VIEW_SHIFT fraction bits */
+    int32_t x, y, z; /* view space, VIEW_SHIFT fraction bits */
 } view_pt;
 
 typedef struct {
-    int32_t x, y;        /* screen, 16.16 */
+    int32_t x, y; /* screen, 16.16 */
 } screen_pt;
 
 /* The vertical shear in use: always 0 in a build without look up/down. */

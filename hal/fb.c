@@ -24,8 +24,7 @@ static const char *const present_names[HAL_PRESENT_COUNT] = {
 
 const char *hal_present_name(hal_present_mode m)
 {
-    if ((unsigned)m >= (unsigned)HAL_PRESENT_COUNT)
-        return "unknown";
+    if ((unsigned)m >= (unsigned)HAL_PRESENT_COUNT) return "unknown";
     return present_names[m];
 }
 
@@ -40,11 +39,9 @@ static int str_eq(const char *a, const char *b)
 
 int hal_present_parse(const char *name)
 {
-    if (name == NULL)
-        return -1;
+    if (name == NULL) return -1;
     for (int m = 0; m < HAL_PRESENT_COUNT; m++)
-        if (str_eq(name, present_names[m]))
-            return m;
+        if (str_eq(name, present_names[m])) return m;
     return -1;
 }
 
@@ -68,7 +65,7 @@ static uint8_t *copy_buffer(void)
 
 hal_surface hal_begin_frame(hal_present_mode m)
 {
-    hal_surface s = { NULL, 0, 0 };
+    hal_surface s = {NULL, 0, 0};
     if (m == HAL_PRESENT_FLIP) {
         s.pixels = hal_target_vram(1 - shown_index());
         s.in_vram = 1;
@@ -87,7 +84,7 @@ hal_surface hal_begin_frame(hal_present_mode m)
  * linear path save and restore registers on every span. */
 static __attribute__((noinline)) void fill_planar(uint8_t *row, uint32_t x, uint32_t len, uint8_t colour)
 {
-    uint32_t w[3] = { 0, 0, 0 }; /* transactions of 1, 2 and 4 bytes */
+    uint32_t w[3] = {0, 0, 0};                      /* transactions of 1, 2 and 4 bytes */
     uint32_t g0 = x >> 2, g1 = (x + len - 1u) >> 2; /* first and last group, inclusive */
     unsigned first = (0xFu << (x & 3u)) & 0xFu;
     unsigned last = 0xFu >> (3u - ((x + len - 1u) & 3u));
@@ -118,24 +115,20 @@ static __attribute__((noinline)) void fill_planar(uint8_t *row, uint32_t x, uint
 
 void hal_fill_span(const hal_surface *s, int y, int x, int len, uint8_t colour)
 {
-    if (s == NULL || s->pixels == NULL)
-        return;
-    if (y < 0 || y >= HAL_HEIGHT || len <= 0 || x >= HAL_WIDTH)
-        return;
+    if (s == NULL || s->pixels == NULL) return;
+    if (y < 0 || y >= HAL_HEIGHT || len <= 0 || x >= HAL_WIDTH) return;
     if (x < 0) {
         len += x; /* len > 0 and x < 0: cannot overflow */
         x = 0;
-        if (len <= 0)
-            return;
+        if (len <= 0) return;
     }
-    if (len > HAL_WIDTH - x)
-        len = HAL_WIDTH - x;
+    if (len > HAL_WIDTH - x) len = HAL_WIDTH - x;
 
     if (s->planar) { /* planar pages are VRAM */
         fill_planar(s->pixels + (uint32_t)y * (HAL_WIDTH / 4), (uint32_t)x, (uint32_t)len, colour);
         return;
     }
-    uint32_t w[3] = { 0, 0, 0 }; /* transactions of 1, 2 and 4 bytes */
+    uint32_t w[3] = {0, 0, 0}; /* transactions of 1, 2 and 4 bytes */
     hal_fill_run(s->pixels + (uint32_t)y * HAL_WIDTH + (uint32_t)x, (uint32_t)len, colour, w);
     hal_perf_add_span(s->in_vram ? HAL_DEST_VRAM : HAL_DEST_SYSMEM, w[0], w[1], w[2], (uint32_t)len, (uint32_t)len);
 }
@@ -147,8 +140,7 @@ static __attribute__((noinline)) void put_planar(uint8_t *prow, uint32_t x, uint
     uint32_t writes = 0;
     for (uint32_t plane = 0; plane < 4u; plane++) {
         uint32_t first = x + ((plane - x) & 3u); /* the span's first pixel in this plane */
-        if (first >= x + len)
-            continue;
+        if (first >= x + len) continue;
         hal_target_plane_mask(1u << plane);
         for (uint32_t px = first; px < x + len; px += 4u) {
             *(volatile uint8_t *)(prow + (px >> 2)) = row[px];
@@ -160,15 +152,13 @@ static __attribute__((noinline)) void put_planar(uint8_t *prow, uint32_t x, uint
 
 void hal_put_span(const hal_surface *s, int y, int x, int len, const uint8_t *row)
 {
-    if (s == NULL || s->pixels == NULL || row == NULL)
-        return;
-    if (y < 0 || y >= HAL_HEIGHT || len <= 0 || x < 0 || x >= HAL_WIDTH || len > HAL_WIDTH - x)
-        return;
+    if (s == NULL || s->pixels == NULL || row == NULL) return;
+    if (y < 0 || y >= HAL_HEIGHT || len <= 0 || x < 0 || x >= HAL_WIDTH || len > HAL_WIDTH - x) return;
     if (s->planar) {
         put_planar(s->pixels + (uint32_t)y * (HAL_WIDTH / 4), (uint32_t)x, (uint32_t)len, row);
         return;
     }
-    uint32_t w[3] = { 0, 0, 0 };
+    uint32_t w[3] = {0, 0, 0};
     hal_copy_run(s->pixels + (uint32_t)y * HAL_WIDTH + (uint32_t)x, row, (uint32_t)x, (uint32_t)len, w);
     hal_perf_add_span(s->in_vram ? HAL_DEST_VRAM : HAL_DEST_SYSMEM, w[0], w[1], w[2], (uint32_t)len, (uint32_t)len);
 }
@@ -176,8 +166,9 @@ void hal_put_span(const hal_surface *s, int y, int x, int len, const uint8_t *ro
 void hal_add_tally(const hal_surface *s, hal_tally *t)
 {
     if (t->pixels)
-        hal_perf_add_span(s->in_vram ? HAL_DEST_VRAM : HAL_DEST_SYSMEM, t->w[0], t->w[1], t->w[2], t->pixels, t->pixels);
-    *t = (hal_tally){ { 0, 0, 0 }, 0 };
+        hal_perf_add_span(s->in_vram ? HAL_DEST_VRAM : HAL_DEST_SYSMEM, t->w[0], t->w[1], t->w[2], t->pixels,
+                          t->pixels);
+    *t = (hal_tally){{0, 0, 0}, 0};
 }
 
 /* The copies: the system-memory buffer and the pages are 4-aligned and
@@ -185,8 +176,7 @@ void hal_add_tally(const hal_surface *s, hal_tally *t)
 static void copy8(uint8_t *dst, const uint8_t *src)
 {
     volatile uint8_t *d = dst;
-    for (uint32_t i = 0; i < HAL_PAGE_BYTES; i++)
-        d[i] = src[i];
+    for (uint32_t i = 0; i < HAL_PAGE_BYTES; i++) d[i] = src[i];
     hal_perf_add_writes(1, HAL_DEST_VRAM, HAL_PAGE_BYTES, 1);
 }
 
@@ -194,8 +184,7 @@ static void copy16(uint8_t *dst, const uint8_t *src)
 {
     volatile uint16_t *d = (volatile uint16_t *)(void *)dst;
     const uint16_t *s = (const uint16_t *)(const void *)src;
-    for (uint32_t i = 0; i < HAL_PAGE_BYTES / 2; i++)
-        d[i] = s[i];
+    for (uint32_t i = 0; i < HAL_PAGE_BYTES / 2; i++) d[i] = s[i];
     hal_perf_add_writes(2, HAL_DEST_VRAM, HAL_PAGE_BYTES / 2, 1);
 }
 
@@ -203,8 +192,7 @@ static void copy32(uint8_t *dst, const uint8_t *src)
 {
     volatile uint32_t *d = (volatile uint32_t *)(void *)dst;
     const uint32_t *s = (const uint32_t *)(const void *)src;
-    for (uint32_t i = 0; i < HAL_PAGE_BYTES / 4; i++)
-        d[i] = s[i];
+    for (uint32_t i = 0; i < HAL_PAGE_BYTES / 4; i++) d[i] = s[i];
     hal_perf_add_writes(4, HAL_DEST_VRAM, HAL_PAGE_BYTES / 4, 1);
 }
 
@@ -221,15 +209,12 @@ void hal_present(hal_present_mode m)
         return;
     case HAL_PRESENT_COPY8:
     case HAL_PRESENT_COPY16:
-    case HAL_PRESENT_COPY32:
-        break;
-    default:
-        return;
+    case HAL_PRESENT_COPY32: break;
+    default: return;
     }
     shown = hal_target_vram(shown_index());
     src = copy_buffer();
-    if (shown == NULL || src == NULL)
-        return;
+    if (shown == NULL || src == NULL) return;
     if (m == HAL_PRESENT_COPY8)
         copy8(shown, src);
     else if (m == HAL_PRESENT_COPY16)
@@ -240,18 +225,15 @@ void hal_present(hal_present_mode m)
 
 const uint8_t *hal_shown_page(void)
 {
-    if (hal_target_vram_planar())
-        return NULL;
+    if (hal_target_vram_planar()) return NULL;
     return hal_target_vram(shown_index());
 }
 
 void hal_set_palette(const uint8_t *rgb)
 {
     uint8_t *pal = hal_target_palette();
-    if (rgb == NULL || pal == NULL)
-        return;
-    for (uint32_t i = 0; i < HAL_PALETTE_BYTES; i++)
-        pal[i] = rgb[i];
+    if (rgb == NULL || pal == NULL) return;
+    for (uint32_t i = 0; i < HAL_PALETTE_BYTES; i++) pal[i] = rgb[i];
 }
 
 const uint8_t *hal_get_palette(void)

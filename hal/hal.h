@@ -41,9 +41,9 @@ int hal_present_parse(const char *name);
 
 /* ---- performance counters --------------------------------------------- */
 typedef enum {
-    HAL_EV_WRITES,        /* framebuffer write transactions of any width (drawing + present) */
-    HAL_EV_BYTES,         /* bytes written to any framebuffer */
-    HAL_EV_WRITES8,       /* write transactions by width */
+    HAL_EV_WRITES,  /* framebuffer write transactions of any width (drawing + present) */
+    HAL_EV_BYTES,   /* bytes written to any framebuffer */
+    HAL_EV_WRITES8, /* write transactions by width */
     HAL_EV_WRITES16,
     HAL_EV_WRITES32,
     HAL_EV_VRAM_WRITES,   /* transactions that hit VRAM */
@@ -69,10 +69,10 @@ typedef struct {
 void hal_perf_reset(void);
 void hal_perf_set_bus(hal_bus_model m);
 hal_bus_model hal_perf_bus(void);
-uint64_t hal_perf_event(hal_event e);            /* running total of one event */
-void hal_perf_select(int counter, hal_event e);  /* counter 0 or 1: count e from now, from zero */
-uint64_t hal_perf_read(int counter);             /* counts of the selected event since selected */
-uint64_t hal_perf_tsc(void);                     /* modelled bus cycles since reset */
+uint64_t hal_perf_event(hal_event e);           /* running total of one event */
+void hal_perf_select(int counter, hal_event e); /* counter 0 or 1: count e from now, from zero */
+uint64_t hal_perf_read(int counter);            /* counts of the selected event since selected */
+uint64_t hal_perf_tsc(void);                    /* modelled bus cycles since reset */
 
 /* ---- framebuffer writes (counted) -------------------------------------- */
 typedef struct {
@@ -117,8 +117,7 @@ static inline __attribute__((always_inline)) void hal_fill_run(uint8_t *p, uint3
     }
     uint32_t n32 = n >> 2;
     volatile uint32_t *d = (volatile uint32_t *)(void *)p;
-    for (uint32_t i = 0; i < n32; i++)
-        d[i] = c32;
+    for (uint32_t i = 0; i < n32; i++) d[i] = c32;
     w[2] += n32;
     p += n32 * 4u;
     n &= 3u;
@@ -139,7 +138,7 @@ static inline __attribute__((always_inline)) void hal_fill_run(uint8_t *p, uint3
  * the same span, adding them to w[0..2]. row is 4-aligned like the surface's
  * rows, so each dword is read aligned. */
 static inline __attribute__((always_inline)) void hal_copy_run(uint8_t *p, const uint8_t *row, uint32_t x, uint32_t n,
-                                                             uint32_t w[3])
+                                                               uint32_t w[3])
 {
     const uint8_t *q = row + x;
     if (((uintptr_t)p & 1u) != 0) {
@@ -159,8 +158,7 @@ static inline __attribute__((always_inline)) void hal_copy_run(uint8_t *p, const
     uint32_t n32 = n >> 2;
     volatile uint32_t *d = (volatile uint32_t *)(void *)p;
     const uint32_t *s = (const uint32_t *)(const void *)q;
-    for (uint32_t i = 0; i < n32; i++)
-        d[i] = s[i];
+    for (uint32_t i = 0; i < n32; i++) d[i] = s[i];
     w[2] += n32;
     p += n32 * 4u;
     q += n32 * 4u;
@@ -201,7 +199,7 @@ static inline int hal_surface_linear(const hal_surface *s)
  * hal_fill_span makes, counted into t. The caller keeps 0 <= y < 200, 0 <= x,
  * 1 <= len and x + len <= 320. */
 static inline __attribute__((always_inline)) void hal_fill_linear(const hal_surface *s, int y, int x, int len,
-                                                                 uint8_t colour, hal_tally *t)
+                                                                  uint8_t colour, hal_tally *t)
 {
     hal_fill_run(s->pixels + (uint32_t)y * HAL_WIDTH + (uint32_t)x, (uint32_t)len, colour, t->w);
     t->pixels += (uint32_t)len;
@@ -210,7 +208,7 @@ static inline __attribute__((always_inline)) void hal_fill_linear(const hal_surf
 /* hal_put_span into a linear surface, counted into t (the caller keeps the
  * bounds hal_fill_linear asks for). */
 static inline __attribute__((always_inline)) void hal_put_linear(const hal_surface *s, int y, int x, int len,
-                                                                const uint8_t *row, hal_tally *t)
+                                                                 const uint8_t *row, hal_tally *t)
 {
     hal_copy_run(s->pixels + (uint32_t)y * HAL_WIDTH + (uint32_t)x, row, (uint32_t)x, (uint32_t)len, t->w);
     t->pixels += (uint32_t)len;
@@ -251,17 +249,17 @@ const uint8_t *hal_get_palette(void);
 #define HAL_KEY_SCREENSHOT (1u << 20) /* the host's emu: save the frame shown as a PNG */
 #define HAL_KEY_QUIT (1u << 30)
 
-uint32_t hal_input(void);     /* HAL_KEY_* bits held or pressed since the last call */
-uint32_t hal_ticks_ms(void);  /* milliseconds since the target started */
-void hal_frame_done(void);    /* the engine finished a frame: show it, stream it, ... */
+uint32_t hal_input(void);    /* HAL_KEY_* bits held or pressed since the last call */
+uint32_t hal_ticks_ms(void); /* milliseconds since the target started */
+void hal_frame_done(void);   /* the engine finished a frame: show it, stream it, ... */
 
 /* ---- what each target provides to the shared code ------------------------ */
-uint8_t *hal_target_vram(int page);        /* page 0 or 1, HAL_PAGE_BYTES each */
+uint8_t *hal_target_vram(int page); /* page 0 or 1, HAL_PAGE_BYTES each */
 /* The system-memory back buffer of the copy modes, or NULL: the target keeps
  * none, and the copy modes draw into the VRAM page the display does not show
  * (which needs two distinct linear pages). */
 uint8_t *hal_target_sysmem(void);
-uint8_t *hal_target_palette(void);         /* HAL_PALETTE_BYTES */
+uint8_t *hal_target_palette(void); /* HAL_PALETTE_BYTES */
 void hal_target_set_display_start(int page);
 int hal_target_display_start(void);
 /* How the VRAM pages are laid out: 0 linear (pitch 320, every target but

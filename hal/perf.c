@@ -23,10 +23,10 @@
 #define HAL_BUS_DEFAULT_SYSMEM 1u
 
 static struct {
-    uint64_t total[HAL_EV_COUNT];          /* running totals since reset */
-    hal_event sel[HAL_PERF_COUNTERS];      /* event each counter counts */
-    uint64_t base[HAL_PERF_COUNTERS];      /* total[sel] when selected or reset */
-    uint64_t tsc;                          /* modelled bus cycles since reset */
+    uint64_t total[HAL_EV_COUNT];     /* running totals since reset */
+    hal_event sel[HAL_PERF_COUNTERS]; /* event each counter counts */
+    uint64_t base[HAL_PERF_COUNTERS]; /* total[sel] when selected or reset */
+    uint64_t tsc;                     /* modelled bus cycles since reset */
     hal_bus_model bus;
     /* span counts not yet in total[] or tsc; each span adds at most 320 to pixels
      * and no more than that to any other sum (hal_fill_span clips len to the row;
@@ -36,8 +36,8 @@ static struct {
         uint32_t n8, n16, n32, pixels, bytes, vram, sysmem;
     } span;
 } perf = {
-    .sel = { HAL_EV_WRITES, HAL_EV_VRAM_WRITES },
-    .bus = { HAL_BUS_DEFAULT_VRAM, HAL_BUS_DEFAULT_SYSMEM },
+    .sel = {HAL_EV_WRITES, HAL_EV_VRAM_WRITES},
+    .bus = {HAL_BUS_DEFAULT_VRAM, HAL_BUS_DEFAULT_SYSMEM},
 };
 
 static const char *const event_names[HAL_EV_COUNT] = {
@@ -81,10 +81,8 @@ void hal_perf_fold(void)
 void hal_perf_reset(void)
 {
     hal_perf_fold();
-    for (int i = 0; i < HAL_EV_COUNT; i++)
-        perf.total[i] = 0;
-    for (int c = 0; c < HAL_PERF_COUNTERS; c++)
-        perf.base[c] = 0;
+    for (int i = 0; i < HAL_EV_COUNT; i++) perf.total[i] = 0;
+    for (int c = 0; c < HAL_PERF_COUNTERS; c++) perf.base[c] = 0;
     perf.tsc = 0;
 }
 
@@ -107,8 +105,7 @@ uint64_t hal_perf_event(hal_event e)
 
 void hal_perf_select(int counter, hal_event e)
 {
-    if (counter < 0 || counter >= HAL_PERF_COUNTERS || !event_ok(e))
-        return;
+    if (counter < 0 || counter >= HAL_PERF_COUNTERS || !event_ok(e)) return;
     hal_perf_fold();
     perf.sel[counter] = e;
     perf.base[counter] = perf.total[e];
@@ -116,8 +113,7 @@ void hal_perf_select(int counter, hal_event e)
 
 uint64_t hal_perf_read(int counter)
 {
-    if (counter < 0 || counter >= HAL_PERF_COUNTERS)
-        return 0;
+    if (counter < 0 || counter >= HAL_PERF_COUNTERS) return 0;
     hal_perf_fold();
     return perf.total[perf.sel[counter]] - perf.base[counter];
 }
@@ -154,8 +150,7 @@ void hal_perf_add_writes(unsigned width_bytes, int dest, uint32_t count, int is_
     perf.total[HAL_EV_BYTES] += n * width_bytes;
     perf.total[by_width] += n;
     count_destination(dest, n);
-    if (is_copy)
-        perf.total[HAL_EV_COPY_WRITES] += n;
+    if (is_copy) perf.total[HAL_EV_COPY_WRITES] += n;
 }
 
 void hal_perf_add_span(int dest, uint32_t n8, uint32_t n16, uint32_t n32, uint32_t pixels, uint32_t bytes)
@@ -170,8 +165,7 @@ void hal_perf_add_span(int dest, uint32_t n8, uint32_t n16, uint32_t n32, uint32
     else
         perf.span.sysmem += n;
     perf.span.pixels += pixels;
-    if (perf.span.pixels >= 0x80000000u)
-        hal_perf_fold();
+    if (perf.span.pixels >= 0x80000000u) hal_perf_fold();
 }
 
 void hal_perf_add_pixels(uint32_t count)

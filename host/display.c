@@ -44,14 +44,14 @@ static const char usage[] =
 
 typedef struct {
     int fd;
-    int writable;          /* acks can go back */
+    int writable; /* acks can go back */
     const char *png_dir;
     int window;
     long max_frames;
-    uint64_t frame_bytes;  /* wire bytes of the frame messages shown (approx: bytes between frames) */
+    uint64_t frame_bytes; /* wire bytes of the frame messages shown (approx: bytes between frames) */
     uint64_t bytes_at_last;
     long shown;
-    long no_palette;       /* frames that passed every check but came before any palette */
+    long no_palette; /* frames that passed every check but came before any palette */
     int have_palette;
     uint8_t palette[HAL_PALETTE_BYTES];
     int quit;
@@ -117,16 +117,13 @@ static void on_event(void *ctx, const fl_event *ev)
         memcpy(b->palette, ev->palette, sizeof b->palette);
         b->have_palette = 1;
         break;
-    case FL_EV_FRAME:
-        show_frame(b, ev);
-        break;
+    case FL_EV_FRAME: show_frame(b, ev); break;
     case FL_EV_HELLO:
         if (ev->hello.scene_name[0])
             fprintf(stderr, "display: the sender draws scene %s (blob CRC-32 %08x)\n", ev->hello.scene_name,
                     (unsigned)ev->hello.scene_crc);
         break;
-    default:
-        break;
+    default: break;
     }
 }
 
@@ -155,8 +152,8 @@ static void print_summary(const board *b, int json)
                 "display: %ld frames shown, %ld not shown for want of a palette, %u bad messages, "
                 "%u frames dropped, %u missed, %u resyncs, %u keyframe requests, %u bytes (%lu per frame "
                 "shown)\n",
-                b->shown, b->no_palette, c->msgs_bad, c->frames_dropped, c->frames_missed, c->resyncs,
-                c->keyreqs_sent, c->bytes, per_frame);
+                b->shown, b->no_palette, c->msgs_bad, c->frames_dropped, c->frames_missed, c->resyncs, c->keyreqs_sent,
+                c->bytes, per_frame);
         if (h->scene_name[0])
             fprintf(stderr, "display: scene %s, blob CRC-32 %08x\n", h->scene_name, (unsigned)h->scene_crc);
     }
@@ -192,8 +189,8 @@ static int verdict(const board *b, const char *port)
         return 1;
     }
     if (b->no_palette > 0) {
-        fprintf(stderr, "display: %s: %ld frames but no palette in %s bytes: nothing shown\n", name,
-                b->no_palette, nbytes);
+        fprintf(stderr, "display: %s: %ld frames but no palette in %s bytes: nothing shown\n", name, b->no_palette,
+                nbytes);
         return 1;
     }
     if (c->msgs_bad > 0 || c->frames_dropped > 0) {

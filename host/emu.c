@@ -178,8 +178,8 @@ static int run_headless(engine *e, const char *dir, long frames)
     }
     if (finish_link() != 0) return 1;
     if (dir)
-        printf("emu: wrote %ld frames of a turn around the start to %s/frame_000.png .. frame_%03ld.png\n", frames,
-               dir, frames - 1);
+        printf("emu: wrote %ld frames of a turn around the start to %s/frame_000.png .. frame_%03ld.png\n", frames, dir,
+               frames - 1);
     print_counters(e);
     print_view(e);
     return 0;

@@ -82,7 +82,8 @@ static uint8_t *read_file(const char *path, size_t *len)
 static uint8_t *visits;
 static uint8_t *cell(fx_t x, fx_t y)
 {
-    uint32_t cx = (uint32_t)((x >> CELL_SHIFT) + CELLS / 2) % CELLS, cy = (uint32_t)((y >> CELL_SHIFT) + CELLS / 2) % CELLS;
+    uint32_t cx = (uint32_t)((x >> CELL_SHIFT) + CELLS / 2) % CELLS,
+             cy = (uint32_t)((y >> CELL_SHIFT) + CELLS / 2) % CELLS;
     return &visits[cy * CELLS + cx];
 }
 
@@ -128,12 +129,18 @@ static int cmd_walk(int argc, char **argv)
     long frames = 200, dt = 50;
     int flat = 0;
     for (int i = 0; i < argc; i++) {
-        if (!strcmp(argv[i], "--frames") && i + 1 < argc) frames = atol(argv[++i]);
-        else if (!strcmp(argv[i], "--flat")) flat = 1;
-        else if (!strcmp(argv[i], "--dt") && i + 1 < argc) dt = atol(argv[++i]);
-        else if (!strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
-        else if (argv[i][0] != '-' && !spec) spec = argv[i];
-        else return usage();
+        if (!strcmp(argv[i], "--frames") && i + 1 < argc)
+            frames = atol(argv[++i]);
+        else if (!strcmp(argv[i], "--flat"))
+            flat = 1;
+        else if (!strcmp(argv[i], "--dt") && i + 1 < argc)
+            dt = atol(argv[++i]);
+        else if (!strcmp(argv[i], "--out") && i + 1 < argc)
+            out = argv[++i];
+        else if (argv[i][0] != '-' && !spec)
+            spec = argv[i];
+        else
+            return usage();
     }
     if (!spec || frames < 1 || dt < 1) return usage();
     char err[512];
@@ -179,7 +186,7 @@ static int cmd_walk(int argc, char **argv)
             for (unsigned k = 0; k < sizeof ks / sizeof ks[0]; k++) {
                 int cand = ((target + ks[k] * 30) % 360 + 360) % 360, d;
                 if (free_dist(&e.sc, c->x, c->y, z, cand, 1024, &d) < 64) d = 0;
-                if (abs(ks[k]) >= 4) d /= 2;           /* turning back only if nothing else */
+                if (abs(ks[k]) >= 4) d /= 2;              /* turning back only if nothing else */
                 if (ahead >= 96 && k == 0) d = d * 3 / 2; /* a re-look keeps the heading unless much better */
                 if (stuck > 8 && k == 0) d = 0;
                 if (d > bestd) bestd = d, best = cand;
@@ -193,8 +200,10 @@ static int cmd_walk(int argc, char **argv)
         if (diff < -3) keys |= HAL_KEY_TURN_RIGHT;
         if (abs(diff) < 60 && free_dist(&e.sc, c->x, c->y, z, here, 32, NULL) >= 16) keys |= HAL_KEY_FORWARD;
         eng_step(&e, keys, (uint32_t)dt);
-        if ((keys & HAL_KEY_FORWARD) && c->x == lastx && c->y == lasty) stuck++;
-        else if (keys & HAL_KEY_FORWARD) stuck = stuck > 0 ? stuck - 1 : 0;
+        if ((keys & HAL_KEY_FORWARD) && c->x == lastx && c->y == lasty)
+            stuck++;
+        else if (keys & HAL_KEY_FORWARD)
+            stuck = stuck > 0 ? stuck - 1 : 0;
         lastx = c->x;
         lasty = c->y;
 
@@ -254,20 +263,34 @@ static int cmd_encode(int argc, char **argv, int bench)
     long key_interval = 64, scratch_bytes = 16384, repeat = 1, limit = -1;
     int sizes = 0, with_crc = 0, no_crc = 0;
     for (int i = 0; i < argc; i++) {
-        if (!strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
-        else if (!strcmp(argv[i], "--info") && i + 1 < argc) infof = argv[++i];
-        else if (!strcmp(argv[i], "--palette") && i + 1 < argc) palf = argv[++i];
-        else if (!strcmp(argv[i], "--key-interval") && i + 1 < argc) key_interval = atol(argv[++i]);
-        else if (!strcmp(argv[i], "--scratch") && i + 1 < argc) scratch_bytes = atol(argv[++i]);
-        else if (!strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = atol(argv[++i]);
-        else if (!strcmp(argv[i], "--frames") && i + 1 < argc) limit = atol(argv[++i]);
-        else if (!strcmp(argv[i], "--sizes")) sizes = 1;
-        else if (!strcmp(argv[i], "--crc")) with_crc = 1;
-        else if (!strcmp(argv[i], "--no-crc")) no_crc = 1;
-        else if (!strcmp(argv[i], "--scene") && i + 1 < argc) scene_name = argv[++i];
-        else if (!strcmp(argv[i], "--scene-crc") && i + 1 < argc) scene_crc = strtoul(argv[++i], NULL, 16);
-        else if (argv[i][0] != '-' && !in) in = argv[i];
-        else return usage();
+        if (!strcmp(argv[i], "--out") && i + 1 < argc)
+            out = argv[++i];
+        else if (!strcmp(argv[i], "--info") && i + 1 < argc)
+            infof = argv[++i];
+        else if (!strcmp(argv[i], "--palette") && i + 1 < argc)
+            palf = argv[++i];
+        else if (!strcmp(argv[i], "--key-interval") && i + 1 < argc)
+            key_interval = atol(argv[++i]);
+        else if (!strcmp(argv[i], "--scratch") && i + 1 < argc)
+            scratch_bytes = atol(argv[++i]);
+        else if (!strcmp(argv[i], "--repeat") && i + 1 < argc)
+            repeat = atol(argv[++i]);
+        else if (!strcmp(argv[i], "--frames") && i + 1 < argc)
+            limit = atol(argv[++i]);
+        else if (!strcmp(argv[i], "--sizes"))
+            sizes = 1;
+        else if (!strcmp(argv[i], "--crc"))
+            with_crc = 1;
+        else if (!strcmp(argv[i], "--no-crc"))
+            no_crc = 1;
+        else if (!strcmp(argv[i], "--scene") && i + 1 < argc)
+            scene_name = argv[++i];
+        else if (!strcmp(argv[i], "--scene-crc") && i + 1 < argc)
+            scene_crc = strtoul(argv[++i], NULL, 16);
+        else if (argv[i][0] != '-' && !in)
+            in = argv[i];
+        else
+            return usage();
     }
     if (!in || (!bench && !out) || key_interval < 0 || scratch_bytes < 0) return usage();
     size_t len;
@@ -314,8 +337,10 @@ static int cmd_encode(int argc, char **argv, int bench)
     uint8_t *scratch = malloc((size_t)scratch_bytes + 1);
     uint32_t crc_sink = 0;
     for (long rep = 0; rep < repeat; rep++) {
-        if (bench) fl_enc_init(&enc, put_count, &counted, scratch, (uint32_t)scratch_bytes);
-        else fl_enc_init(&enc, put_file, fo, scratch, (uint32_t)scratch_bytes);
+        if (bench)
+            fl_enc_init(&enc, put_count, &counted, scratch, (uint32_t)scratch_bytes);
+        else
+            fl_enc_init(&enc, put_file, fo, scratch, (uint32_t)scratch_bytes);
         enc.key_interval = (uint32_t)key_interval;
         fl_enc_scene(&enc, scene_name, (uint32_t)scene_crc);
         fl_enc_hello(&enc);
@@ -331,7 +356,8 @@ static int cmd_encode(int argc, char **argv, int bench)
         }
     }
     if (bench)
-        printf("{\"frames\": %ld, \"repeat\": %ld, \"bytes\": %llu, \"keyframes\": %u, \"raw_fallbacks\": %u, \"crc\": %u}\n",
+        printf("{\"frames\": %ld, \"repeat\": %ld, \"bytes\": %llu, \"keyframes\": %u, \"raw_fallbacks\": %u, \"crc\": "
+               "%u}\n",
                nframes, repeat, (unsigned long long)counted, enc.keyframes, enc.raw_fallbacks, crc_sink & 1u);
     if (fo) fclose(fo);
     free(scratch);
@@ -347,8 +373,8 @@ typedef struct {
 
 static const char *reason_name(fl_reason r)
 {
-    static const char *names[] = {"none", "framing", "short", "long", "crc", "version", "length",
-                                  "type", "payload", "no_base", "decode", "frame_crc"};
+    static const char *names[] = {"none",   "framing", "short",   "long",    "crc",    "version",
+                                  "length", "type",    "payload", "no_base", "decode", "frame_crc"};
     return (unsigned)r < sizeof names / sizeof names[0] ? names[r] : "?";
 }
 
@@ -365,10 +391,11 @@ static void on_event(void *ctx, const fl_event *ev)
     dec_ctx *c = ctx;
     switch (ev->kind) {
     case FL_EV_HELLO:
-        printf("{\"event\": \"hello\", \"frame\": %u, \"version\": %u, \"width\": %u, \"height\": %u, \"gun_bits\": %u, "
-               "\"key_interval\": %u, \"window\": %u, \"methods\": %u, \"scene\": \"",
-               (unsigned)ev->frame_no, ev->hello.version, ev->hello.width, ev->hello.height, ev->hello.gun_bits,
-               ev->hello.key_interval, ev->hello.window, ev->hello.methods);
+        printf(
+            "{\"event\": \"hello\", \"frame\": %u, \"version\": %u, \"width\": %u, \"height\": %u, \"gun_bits\": %u, "
+            "\"key_interval\": %u, \"window\": %u, \"methods\": %u, \"scene\": \"",
+            (unsigned)ev->frame_no, ev->hello.version, ev->hello.width, ev->hello.height, ev->hello.gun_bits,
+            ev->hello.key_interval, ev->hello.window, ev->hello.methods);
         for (const char *q = ev->hello.scene_name; *q; q++) printf(*q == '"' || *q == '\\' ? "\\%c" : "%c", *q);
         printf("\", \"scene_crc32\": \"%08x\"}\n", (unsigned)ev->hello.scene_crc);
         break;
@@ -386,12 +413,8 @@ static void on_event(void *ctx, const fl_event *ev)
         printf("{\"event\": \"drop\", \"frame\": %u, \"type\": %u, \"reason\": \"%s\"}\n", (unsigned)ev->frame_no,
                ev->type, reason_name(ev->reason));
         break;
-    case FL_EV_BAD:
-        printf("{\"event\": \"bad\", \"reason\": \"%s\"}\n", reason_name(ev->reason));
-        break;
-    case FL_EV_KEYREQ:
-        printf("{\"event\": \"keyreq\", \"frame\": %u}\n", (unsigned)ev->frame_no);
-        break;
+    case FL_EV_BAD: printf("{\"event\": \"bad\", \"reason\": \"%s\"}\n", reason_name(ev->reason)); break;
+    case FL_EV_KEYREQ: printf("{\"event\": \"keyreq\", \"frame\": %u}\n", (unsigned)ev->frame_no); break;
     case FL_EV_OTHER:
         printf("{\"event\": \"other\", \"frame\": %u, \"type\": %u}\n", (unsigned)ev->frame_no, ev->type);
         break;
@@ -409,10 +432,14 @@ static int cmd_decode(int argc, char **argv)
     const char *in = NULL, *fout = NULL;
     long chunk = 4096;
     for (int i = 0; i < argc; i++) {
-        if (!strcmp(argv[i], "--chunk") && i + 1 < argc) chunk = atol(argv[++i]);
-        else if (!strcmp(argv[i], "--frames-out") && i + 1 < argc) fout = argv[++i];
-        else if (argv[i][0] != '-' && !in) in = argv[i];
-        else return usage();
+        if (!strcmp(argv[i], "--chunk") && i + 1 < argc)
+            chunk = atol(argv[++i]);
+        else if (!strcmp(argv[i], "--frames-out") && i + 1 < argc)
+            fout = argv[++i];
+        else if (argv[i][0] != '-' && !in)
+            in = argv[i];
+        else
+            return usage();
     }
     if (!in || chunk < 1) return usage();
     size_t len;
@@ -433,7 +460,8 @@ static int cmd_decode(int argc, char **argv)
     }
     const fl_counters *k = &dec.count;
     printf("{\"counters\": {\"bytes\": %u, \"msgs_ok\": %u, \"msgs_bad\": %u, \"resyncs\": %u, \"frames_shown\": %u, "
-           "\"frames_dropped\": %u, \"frames_missed\": %u, \"keyreqs_sent\": %u, \"palreqs_sent\": %u, \"acks_sent\": %u, \"palettes\": %u, "
+           "\"frames_dropped\": %u, \"frames_missed\": %u, \"keyreqs_sent\": %u, \"palreqs_sent\": %u, \"acks_sent\": "
+           "%u, \"palettes\": %u, "
            "\"hellos\": %u}, \"back_bytes\": %llu}\n",
            k->bytes, k->msgs_ok, k->msgs_bad, k->resyncs, k->frames_shown, k->frames_dropped, k->frames_missed,
            k->keyreqs_sent, k->palreqs_sent, k->acks_sent, k->palettes, k->hellos, (unsigned long long)back);

@@ -109,8 +109,7 @@ int link_open(link_sender *l, const char *port, long baud, char *err, size_t err
     l->fd = port_open(port, baud, &writable, err, errlen);
     if (l->fd < 0) return -1;
     if (!writable) {
-        snprintf(err, errlen, "%s: frames cannot be sent on it (expected a tty, a pty or socket://HOST:PORT)",
-                 port);
+        snprintf(err, errlen, "%s: frames cannot be sent on it (expected a tty, a pty or socket://HOST:PORT)", port);
         if (l->fd > 0) close(l->fd);
         return -1;
     }
@@ -198,8 +197,7 @@ void link_print_summary(const link_sender *l, FILE *f)
             "link %s: %u frames (%u keyframes, %u deltas, %u raw), %u bytes; %u acks, %u keyframe requests, "
             "%u timeouts, %u bad messages received\n",
             l->port, (unsigned)e->frames, (unsigned)e->keyframes, (unsigned)e->deltas, (unsigned)e->raw_fallbacks,
-            (unsigned)e->bytes, (unsigned)e->acks, (unsigned)e->keyreqs, (unsigned)e->timeouts,
-            (unsigned)e->rx_bad);
+            (unsigned)e->bytes, (unsigned)e->acks, (unsigned)e->keyreqs, (unsigned)e->timeouts, (unsigned)e->rx_bad);
 }
 
 void link_print_json(const link_sender *l, FILE *f)

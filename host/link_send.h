@@ -27,12 +27,12 @@
 #define LINK_PENDING 4096   /* bytes from the receiver kept while a frame is written */
 
 typedef struct {
-    const char *port;        /* as given, for messages */
+    const char *port; /* as given, for messages */
     int fd;
-    int failed;              /* the link stopped (err says why) */
-    int closed;              /* the receiver closed its end */
-    int heard;               /* the receiver has sent something intact: flow control is on */
-    int have_prev;           /* prev holds frame prev_no, the last one sent */
+    int failed;    /* the link stopped (err says why) */
+    int closed;    /* the receiver closed its end */
+    int heard;     /* the receiver has sent something intact: flow control is on */
+    int have_prev; /* prev holds frame prev_no, the last one sent */
     uint32_t prev_no;
     int palette_sent;
     char err[256];

@@ -67,8 +67,10 @@ int port_open(const char *port, long baud, int *writable, char *err, size_t errl
         return fd;
     }
     int fd = open(port, O_RDWR | O_NOCTTY);
-    if (fd < 0 && (errno == EACCES || errno == EROFS || errno == EISDIR)) fd = open(port, O_RDONLY);
-    else if (fd >= 0) *writable = 1;
+    if (fd < 0 && (errno == EACCES || errno == EROFS || errno == EISDIR))
+        fd = open(port, O_RDONLY);
+    else if (fd >= 0)
+        *writable = 1;
     if (fd < 0) {
         snprintf(err, errlen, "%s: cannot open: %s", port, strerror(errno));
         return -1;

@@ -21,57 +21,56 @@
 #include "port.h"
 #include "scene_start.h"
 
-static const char usage[] =
-    "usage: render SCENE [--at X,Y[,Z]] [--angle DEG] [options]\n"
-    "\n"
-    "Render one frame of SCENE headless and print its counters as one JSON object.\n"
-    "SCENE is a compiled scene (.bsc), a text scene, or FILE.wad:MAP (compiled on the\n"
-    "fly; a WAD named without a folder is looked for in $DOOMWADDIR and\n"
-    "/usr/share/games/doom).\n"
-    "\n"
-    "  --at X,Y[,Z]       eye position in map units (decimals allowed; rounded to\n"
-    "                     16.16). Default: the scene's player start. Z defaults to\n"
-    "                     the floor under the eye + 41.\n"
-    "  --angle DEG        view angle in degrees, 0 = east, counter-clockwise\n"
-    "                     (default: the player start's angle)\n"
-    "  --look PX          vertical shear in pixels, -100..100 (default 0)\n"
-    "  --mode MODE        direct (zero overdraw, the default), spans (zero overdraw,\n"
-    "                     sorted edge lists) or painter (back to\n"
-    "                     front, Listing 62.1)\n"
-    "  --present P        flip | copy8 | copy16 | copy32 (default flip)\n"
-    "  --split S          BSP split strategy when compiling a source: fewest |\n"
-    "                     balanced | mixed (default mixed)\n"
-    "  -o FILE.png        write the frame as a PNG (palette indices kept exactly)\n"
-    "  --raw FILE         write the 64,000 frame bytes\n"
-    "  --ids FILE         write the surface-id buffer: 320x200 little-endian uint32,\n"
-    "                     kind << 24 | index (0 none, 1 wall, 2 floor, 3 ceiling, 4 object)\n"
-    "  --flat             draw a textured scene (a WAD map) in flat colours\n"
-    "  --repeat N         render the same frame N times (default 1); counters are\n"
-    "                     those of the last frame\n"
-    "  --link PORT        also send the frame over the frame link (docs/frame-link.md)\n"
-    "                     to a display board: PORT as build/display takes it, a tty or\n"
-    "                     pty (set raw at --baud) or socket://HOST:PORT. The JSON gains\n"
-    "                     \"link\": the link's bytes, frames, keyframes, deltas, acks\n"
-    "  --baud B           serial speed for a tty PORT (default 115200)\n"
-    "  -h, --help         this text\n"
-    "\n"
-    "Moving objects and doors (docs/objects.md):\n"
-    "  --time MS          objects along their paths at MS milliseconds, and doors as\n"
-    "                     they would be after MS ms with the player standing at the\n"
-    "                     camera from time 0 (default: time 0, doors as compiled)\n"
-    "  --objects FILE     replace the scene's objects by FILE's: one per line,\n"
-    "                     'object MODEL X Y Z YAW' (map units, degrees; no paths;\n"
-    "                     '#' starts a comment). MODEL is a model number, or a\n"
-    "                     model name when SCENE is a text scene (names are read\n"
-    "                     from its 'model' lines: a compiled scene or a WAD map\n"
-    "                     has no names; a WAD's models are numbered in order of\n"
-    "                     first use by its things)\n"
-    "  --no-objects       draw no objects\n"
-    "  --door SECTOR=H    set door SECTOR's ceiling to H, between its closed and\n"
-    "                     open heights (repeatable; after --time)\n"
-    "The JSON gains \"objects\" (each object as drawn: model, x, y, z, yaw, the exact\n"
-    "16.16 values), \"ceilings\" (sectors whose ceiling is not the compiled one) and the\n"
-    "renderer's \"objects_visible\" and \"object_faces\".\n";
+static const char usage[] = "usage: render SCENE [--at X,Y[,Z]] [--angle DEG] [options]\n"
+                            "\n"
+                            "Render one frame of SCENE headless and print its counters as one JSON object.\n"
+                            "SCENE is a compiled scene (.bsc), a text scene, or FILE.wad:MAP (compiled on the\n"
+                            "fly; a WAD named without a folder is looked for in $DOOMWADDIR and\n"
+                            "/usr/share/games/doom).\n"
+                            "\n"
+                            "  --at X,Y[,Z]       eye position in map units (decimals allowed; rounded to\n"
+                            "                     16.16). Default: the scene's player start. Z defaults to\n"
+                            "                     the floor under the eye + 41.\n"
+                            "  --angle DEG        view angle in degrees, 0 = east, counter-clockwise\n"
+                            "                     (default: the player start's angle)\n"
+                            "  --look PX          vertical shear in pixels, -100..100 (default 0)\n"
+                            "  --mode MODE        direct (zero overdraw, the default), spans (zero overdraw,\n"
+                            "                     sorted edge lists) or painter (back to\n"
+                            "                     front, Listing 62.1)\n"
+                            "  --present P        flip | copy8 | copy16 | copy32 (default flip)\n"
+                            "  --split S          BSP split strategy when compiling a source: fewest |\n"
+                            "                     balanced | mixed (default mixed)\n"
+                            "  -o FILE.png        write the frame as a PNG (palette indices kept exactly)\n"
+                            "  --raw FILE         write the 64,000 frame bytes\n"
+                            "  --ids FILE         write the surface-id buffer: 320x200 little-endian uint32,\n"
+                            "                     kind << 24 | index (0 none, 1 wall, 2 floor, 3 ceiling, 4 object)\n"
+                            "  --flat             draw a textured scene (a WAD map) in flat colours\n"
+                            "  --repeat N         render the same frame N times (default 1); counters are\n"
+                            "                     those of the last frame\n"
+                            "  --link PORT        also send the frame over the frame link (docs/frame-link.md)\n"
+                            "                     to a display board: PORT as build/display takes it, a tty or\n"
+                            "                     pty (set raw at --baud) or socket://HOST:PORT. The JSON gains\n"
+                            "                     \"link\": the link's bytes, frames, keyframes, deltas, acks\n"
+                            "  --baud B           serial speed for a tty PORT (default 115200)\n"
+                            "  -h, --help         this text\n"
+                            "\n"
+                            "Moving objects and doors (docs/objects.md):\n"
+                            "  --time MS          objects along their paths at MS milliseconds, and doors as\n"
+                            "                     they would be after MS ms with the player standing at the\n"
+                            "                     camera from time 0 (default: time 0, doors as compiled)\n"
+                            "  --objects FILE     replace the scene's objects by FILE's: one per line,\n"
+                            "                     'object MODEL X Y Z YAW' (map units, degrees; no paths;\n"
+                            "                     '#' starts a comment). MODEL is a model number, or a\n"
+                            "                     model name when SCENE is a text scene (names are read\n"
+                            "                     from its 'model' lines: a compiled scene or a WAD map\n"
+                            "                     has no names; a WAD's models are numbered in order of\n"
+                            "                     first use by its things)\n"
+                            "  --no-objects       draw no objects\n"
+                            "  --door SECTOR=H    set door SECTOR's ceiling to H, between its closed and\n"
+                            "                     open heights (repeatable; after --time)\n"
+                            "The JSON gains \"objects\" (each object as drawn: model, x, y, z, yaw, the exact\n"
+                            "16.16 values), \"ceilings\" (sectors whose ceiling is not the compiled one) and the\n"
+                            "renderer's \"objects_visible\" and \"object_faces\".\n";
 
 typedef struct {
     const char *arg; /* as given, for messages */
@@ -92,7 +91,7 @@ typedef struct {
     const char *objects; /* --objects FILE */
     const char *link;    /* --link PORT */
     long baud;
-    door_opt *doors;     /* room for every argument */
+    door_opt *doors; /* room for every argument */
     int ndoors;
 } options;
 
@@ -146,9 +145,9 @@ static int parse_at(options *o, const char *arg)
 /* Options that take a value (every other option stands alone). */
 static int takes_value(const char *a)
 {
-    static const char *const with_value[] = {"--at", "--angle", "--look", "--mode", "--present", "--split", "-o",
-                                             "--raw", "--ids", "--time", "--link", "--baud", "--objects", "--door",
-                                             "--repeat"};
+    static const char *const with_value[] = {"--at",    "--angle", "--look",    "--mode", "--present",
+                                             "--split", "-o",      "--raw",     "--ids",  "--time",
+                                             "--link",  "--baud",  "--objects", "--door", "--repeat"};
     for (size_t i = 0; i < sizeof with_value / sizeof *with_value; i++)
         if (!strcmp(a, with_value[i])) return 1;
     return 0;
@@ -182,7 +181,9 @@ static int parse_args(options *o, int argc, char **argv)
             if (at == -1)
                 return die("--at '%s': expected X,Y or X,Y,Z: two or three decimal numbers such as 128,-64.5%s", val,
                            "");
-            if (at == -2) return die("--at '%s': outside the map: each coordinate must be above -32768 and below 32768%s", val, "");
+            if (at == -2)
+                return die("--at '%s': outside the map: each coordinate must be above -32768 and below 32768%s", val,
+                           "");
         } else if (!strcmp(a, "--angle")) {
             if (fxtext_parse(val, &o->cam.angle_deg)) return die("--angle '%s': expected degrees%s", val, "");
             o->have_angle = 1;
@@ -190,8 +191,10 @@ static int parse_args(options *o, int argc, char **argv)
             char *end;
             errno = 0;
             long v = strtol(val, &end, 10);
-            if (*end || end == val || errno) return die("--look '%s': expected a whole number of pixels such as -20%s", val, "");
-            if (v < -VIEW_LOOK_MAX || v > VIEW_LOOK_MAX) return die("--look '%s': expected whole pixels -100..100%s", val, "");
+            if (*end || end == val || errno)
+                return die("--look '%s': expected a whole number of pixels such as -20%s", val, "");
+            if (v < -VIEW_LOOK_MAX || v > VIEW_LOOK_MAX)
+                return die("--look '%s': expected whole pixels -100..100%s", val, "");
             o->cam.look = (int32_t)v;
         } else if (!strcmp(a, "--mode")) {
             int m = render_mode_parse(val);
@@ -199,13 +202,18 @@ static int parse_args(options *o, int argc, char **argv)
             o->mode = (render_mode)m;
         } else if (!strcmp(a, "--present")) {
             int m = hal_present_parse(val);
-            if (m < 0) return die("--present '%s': unknown present mode (have: flip, copy8, copy16, copy32)%s", val, "");
+            if (m < 0)
+                return die("--present '%s': unknown present mode (have: flip, copy8, copy16, copy32)%s", val, "");
             o->present = (hal_present_mode)m;
         } else if (!strcmp(a, "--split")) {
-            if (!strcmp(val, "fewest")) o->bspc.split = BSPC_SPLIT_FEWEST;
-            else if (!strcmp(val, "balanced")) o->bspc.split = BSPC_SPLIT_BALANCED;
-            else if (!strcmp(val, "mixed")) o->bspc.split = BSPC_SPLIT_MIXED;
-            else return die("--split '%s': expected fewest, balanced or mixed%s", val, "");
+            if (!strcmp(val, "fewest"))
+                o->bspc.split = BSPC_SPLIT_FEWEST;
+            else if (!strcmp(val, "balanced"))
+                o->bspc.split = BSPC_SPLIT_BALANCED;
+            else if (!strcmp(val, "mixed"))
+                o->bspc.split = BSPC_SPLIT_MIXED;
+            else
+                return die("--split '%s': expected fewest, balanced or mixed%s", val, "");
         } else if (!strcmp(a, "-o")) {
             o->png = val;
         } else if (!strcmp(a, "--raw")) {
@@ -243,7 +251,8 @@ static int parse_args(options *o, int argc, char **argv)
         } else if (!strcmp(a, "--repeat")) {
             char *end;
             o->repeat = strtol(val, &end, 10);
-            if (*end || o->repeat < 1 || o->repeat > 1000000) return die("--repeat '%s': expected 1..1000000%s", val, "");
+            if (*end || o->repeat < 1 || o->repeat > 1000000)
+                return die("--repeat '%s': expected 1..1000000%s", val, "");
         } else {
             return die("option %s is not handled%s", a, ""); /* takes_value and this chain disagree */
         }
@@ -276,14 +285,16 @@ static int object_words(char *line, char *tok[7])
     char *save;
     int nt = 0;
     for (char *t = strtok_r(line, " \t\r\n", &save); t; t = strtok_r(NULL, " \t\r\n", &save))
-        if (nt < 7) tok[nt++] = t;
-        else nt++;
+        if (nt < 7)
+            tok[nt++] = t;
+        else
+            nt++;
     return nt;
 }
 
 /* MODEL: a text scene's model name, else a model number below the scene's count. */
-static int object_model(const char *path, int lineno, const char *m, const scene *s, const bspc_name *names,
-                        int nnames, uint32_t *model)
+static int object_model(const char *path, int lineno, const char *m, const scene *s, const bspc_name *names, int nnames,
+                        uint32_t *model)
 {
     int named = -1;
     for (int i = 0; i < nnames; i++)
@@ -302,8 +313,10 @@ static int object_model(const char *path, int lineno, const char *m, const scene
             file_error(path, lineno, "model '%s': no model of that name or number (numbers 0..%u)", m,
                        (unsigned)s->nmodels - 1);
         else
-            file_error(path, lineno, "model '%s': expected a model number 0..%u (only a text scene's "
-                       "models have names)", m, (unsigned)s->nmodels - 1);
+            file_error(path, lineno,
+                       "model '%s': expected a model number 0..%u (only a text scene's "
+                       "models have names)",
+                       m, (unsigned)s->nmodels - 1);
         return -1;
     }
     *model = (uint32_t)v;
@@ -445,7 +458,7 @@ static int refuse_beyond_scene(const options *o, const scene *s)
  * all. The same answer as the compiler's winding number for closed sectors. */
 static int in_void(const scene *s, fx_t x, fx_t y)
 {
-    __int128 best_hx = -1;             /* the nearest crossing so far, best_hx / best_dy past x; none yet */
+    __int128 best_hx = -1; /* the nearest crossing so far, best_hx / best_dy past x; none yet */
     int64_t best_dy = 1;
     uint32_t sector = SCN_NONE;
     for (uint32_t i = 0; i < s->nlines; i++) {
@@ -486,8 +499,7 @@ static int apply_doors(const options *o, const scene *s, world_state *w)
             char lo[48], hi[48];
             fxtext_format(sec->ceil_h, lo, sizeof lo);
             fxtext_format(sec->open_h, hi, sizeof hi);
-            fprintf(stderr, "render: --door '%s': the door moves between %s (closed) and %s (open)\n", d->arg, lo,
-                    hi);
+            fprintf(stderr, "render: --door '%s': the door moves between %s (closed) and %s (open)\n", d->arg, lo, hi);
             return -1;
         }
         w->ceil[d->sector] = d->h;
@@ -613,8 +625,8 @@ static void print_json(const options *o, const engine *e, uint32_t crc, const li
 
 /* --link: hello, palette and the frame as a keyframe, then its ack awaited
  * (at most the ack timeout). 0, or -1 after a message naming the port. */
-static int send_link(link_sender *l, const engine *e, const uint8_t *frame, const char *scene_name,
-                     const uint8_t *blob, size_t blob_len)
+static int send_link(link_sender *l, const engine *e, const uint8_t *frame, const char *scene_name, const uint8_t *blob,
+                     size_t blob_len)
 {
     fl_frame_info info = link_info_of(e);
     if (link_hello(l, scene_name, blob, blob_len) == 0 && link_frame(l, 0, frame, hal_get_palette(), &info) == 0 &&

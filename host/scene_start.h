@@ -15,8 +15,8 @@ typedef struct {
     const char *name; /* for messages: the spec, or "built-in scene" */
     const void *data; /* the compiled scene the engine runs */
     size_t len;
-    uint8_t *blob;    /* data when it was read or compiled (malloc'd), else NULL */
-    void *work;       /* the engine's work memory (malloc'd) */
+    uint8_t *blob; /* data when it was read or compiled (malloc'd), else NULL */
+    void *work;    /* the engine's work memory (malloc'd) */
 } scene_start;
 
 /* Reads or compiles spec (with opt) or, when spec is NULL, takes the built-in

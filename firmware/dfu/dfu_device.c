@@ -8,7 +8,7 @@
 
 enum { WORK_NONE = 0, WORK_BLOCK = 1, WORK_MANIFEST = 2 };
 
-#define CHUNK 64u   /* read-back buffer on the stack */
+#define CHUNK 64u /* read-back buffer on the stack */
 
 static int due(uint32_t now, uint32_t t)
 {
@@ -40,8 +40,8 @@ uint32_t dfu_app_capacity(const dfu_flash_t *f)
 
 static int geometry_ok(const dfu_flash_t *f)
 {
-    return f && f->erase && f->program && f->read && f->page_size >= DFU_TRAILER_LEN &&
-           f->size / f->page_size >= 2u && f->size % f->page_size == 0u;
+    return f && f->erase && f->program && f->read && f->page_size >= DFU_TRAILER_LEN && f->size / f->page_size >= 2u &&
+           f->size % f->page_size == 0u;
 }
 
 /* CRC-32 of flash [0, n), read back through the callback; -1 on a read failure. */
@@ -51,8 +51,7 @@ static int flash_crc(const dfu_flash_t *f, uint32_t n, uint32_t *crc)
     uint32_t c = 0;
     for (uint32_t off = 0; off < n;) {
         uint32_t k = n - off < CHUNK ? n - off : CHUNK;
-        if (f->read(f->ctx, off, buf, k) != 0)
-            return -1;
+        if (f->read(f->ctx, off, buf, k) != 0) return -1;
         c = crc_update(c, buf, k);
         off += k;
     }
@@ -71,21 +70,16 @@ static void trailer_build(uint8_t t[DFU_TRAILER_LEN], uint32_t length, uint32_t 
 int dfu_app_check(const dfu_flash_t *f, dfu_app_info_t *info)
 {
     uint8_t t[DFU_TRAILER_LEN];
-    if (info)
-        info->length = info->crc = 0;
-    if (!geometry_ok(f) || f->read(f->ctx, trailer_offset(f), t, DFU_TRAILER_LEN) != 0)
-        return 0;
-    if (get32(t) != DFU_TRAILER_MAGIC || get32(t + 12) != crc_update(0, t, 12))
-        return 0;
+    if (info) info->length = info->crc = 0;
+    if (!geometry_ok(f) || f->read(f->ctx, trailer_offset(f), t, DFU_TRAILER_LEN) != 0) return 0;
+    if (get32(t) != DFU_TRAILER_MAGIC || get32(t + 12) != crc_update(0, t, 12)) return 0;
     uint32_t length = get32(t + 4), crc = get32(t + 8), actual;
     if (info) {
         info->length = length;
         info->crc = crc;
     }
-    if (length == 0 || length > trailer_offset(f))
-        return 0;
-    if (flash_crc(f, length, &actual) != 0)
-        return 0;
+    if (length == 0 || length > trailer_offset(f)) return 0;
+    if (flash_crc(f, length, &actual) != 0) return 0;
     return actual == crc;
 }
 
@@ -123,12 +117,10 @@ static void boot(dfu_dev_t *d, int stay_in_dfu)
         enter_error(d, DFU_STATUS_ERR_FIRMWARE);
 }
 
-int dfu_dev_init(dfu_dev_t *d, const dfu_dev_config_t *cfg, const dfu_flash_t *flash,
-                 int stay_in_dfu, uint32_t now_ms)
+int dfu_dev_init(dfu_dev_t *d, const dfu_dev_config_t *cfg, const dfu_flash_t *flash, int stay_in_dfu, uint32_t now_ms)
 {
     (void)now_ms;
-    if (!d || !cfg || !geometry_ok(flash) || cfg->transfer_size == 0 ||
-        cfg->transfer_size > DFU_MAX_TRANSFER)
+    if (!d || !cfg || !geometry_ok(flash) || cfg->transfer_size == 0 || cfg->transfer_size > DFU_MAX_TRANSFER)
         return -1;
     d->cfg = *cfg;
     d->flash = *flash;
@@ -142,15 +134,12 @@ int dfu_dev_init(dfu_dev_t *d, const dfu_dev_config_t *cfg, const dfu_flash_t *f
 static uint8_t erase_page(const dfu_flash_t *f, uint32_t page)
 {
     uint8_t buf[CHUNK];
-    if (f->erase(f->ctx, page) != 0)
-        return DFU_STATUS_ERR_ERASE;
+    if (f->erase(f->ctx, page) != 0) return DFU_STATUS_ERR_ERASE;
     for (uint32_t off = 0; off < f->page_size;) {
         uint32_t k = f->page_size - off < CHUNK ? f->page_size - off : CHUNK;
-        if (f->read(f->ctx, page + off, buf, k) != 0)
-            return DFU_STATUS_ERR_CHECK_ERASED;
+        if (f->read(f->ctx, page + off, buf, k) != 0) return DFU_STATUS_ERR_CHECK_ERASED;
         for (uint32_t i = 0; i < k; i++)
-            if (buf[i] != 0xFFu)
-                return DFU_STATUS_ERR_CHECK_ERASED;
+            if (buf[i] != 0xFFu) return DFU_STATUS_ERR_CHECK_ERASED;
         off += k;
     }
     return DFU_STATUS_OK;
@@ -160,15 +149,12 @@ static uint8_t erase_page(const dfu_flash_t *f, uint32_t page)
 static uint8_t program_verify(const dfu_flash_t *f, uint32_t off, const uint8_t *src, uint32_t n)
 {
     uint8_t buf[CHUNK];
-    if (f->program(f->ctx, off, src, n) != 0)
-        return DFU_STATUS_ERR_WRITE;
+    if (f->program(f->ctx, off, src, n) != 0) return DFU_STATUS_ERR_WRITE;
     for (uint32_t done = 0; done < n;) {
         uint32_t k = n - done < CHUNK ? n - done : CHUNK;
-        if (f->read(f->ctx, off + done, buf, k) != 0)
-            return DFU_STATUS_ERR_VERIFY;
+        if (f->read(f->ctx, off + done, buf, k) != 0) return DFU_STATUS_ERR_VERIFY;
         for (uint32_t i = 0; i < k; i++)
-            if (buf[i] != src[done + i])
-                return DFU_STATUS_ERR_VERIFY;
+            if (buf[i] != src[done + i]) return DFU_STATUS_ERR_VERIFY;
         done += k;
     }
     return DFU_STATUS_OK;
@@ -181,21 +167,18 @@ static uint8_t do_block(dfu_dev_t *d)
     const dfu_flash_t *f = &d->flash;
     uint8_t st;
     if (!d->invalidated) {
-        if ((st = erase_page(f, trailer_offset(f))) != DFU_STATUS_OK)
-            return st;
+        if ((st = erase_page(f, trailer_offset(f))) != DFU_STATUS_OK) return st;
         d->invalidated = 1;
     }
     uint32_t off = d->received, end = d->received + d->block_len;
     const uint8_t *src = d->block;
     while (off < end) {
         if (off >= d->erased_end) {
-            if ((st = erase_page(f, d->erased_end)) != DFU_STATUS_OK)
-                return st;
+            if ((st = erase_page(f, d->erased_end)) != DFU_STATUS_OK) return st;
             d->erased_end += f->page_size;
         }
         uint32_t n = (d->erased_end < end ? d->erased_end : end) - off;
-        if ((st = program_verify(f, off, src, n)) != DFU_STATUS_OK)
-            return st;
+        if ((st = program_verify(f, off, src, n)) != DFU_STATUS_OK) return st;
         off += n;
         src += n;
     }
@@ -212,14 +195,11 @@ static uint8_t do_manifest(dfu_dev_t *d)
     const dfu_flash_t *f = &d->flash;
     uint32_t crc;
     uint8_t t[DFU_TRAILER_LEN];
-    if (d->received == 0 || !d->invalidated)
-        return DFU_STATUS_ERR_NOTDONE;
-    if (flash_crc(f, d->received, &crc) != 0 || crc != d->crc)
-        return DFU_STATUS_ERR_VERIFY;
+    if (d->received == 0 || !d->invalidated) return DFU_STATUS_ERR_NOTDONE;
+    if (flash_crc(f, d->received, &crc) != 0 || crc != d->crc) return DFU_STATUS_ERR_VERIFY;
     trailer_build(t, d->received, d->crc);
     uint8_t st = program_verify(f, trailer_offset(f), t, DFU_TRAILER_LEN);
-    if (st != DFU_STATUS_OK)
-        return st;
+    if (st != DFU_STATUS_OK) return st;
     return dfu_app_check(f, 0) ? DFU_STATUS_OK : DFU_STATUS_ERR_VERIFY;
 }
 
@@ -228,8 +208,7 @@ void dfu_dev_poll(dfu_dev_t *d, uint32_t now)
     uint8_t st;
     switch (d->state) {
     case DFU_STATE_APP_DETACH:
-        if (due(now, d->busy_until))
-            d->state = DFU_STATE_APP_IDLE;
+        if (due(now, d->busy_until)) d->state = DFU_STATE_APP_IDLE;
         break;
     case DFU_STATE_DNBUSY:
         if (d->work == WORK_BLOCK) {
@@ -239,8 +218,7 @@ void dfu_dev_poll(dfu_dev_t *d, uint32_t now)
                 break;
             }
         }
-        if (due(now, d->busy_until))
-            d->state = DFU_STATE_DNLOAD_SYNC;
+        if (due(now, d->busy_until)) d->state = DFU_STATE_DNLOAD_SYNC;
         break;
     case DFU_STATE_MANIFEST:
         if (d->work == WORK_MANIFEST) {
@@ -252,20 +230,17 @@ void dfu_dev_poll(dfu_dev_t *d, uint32_t now)
             d->manifested = 1;
         }
         if (due(now, d->busy_until))
-            d->state = (d->cfg.attributes & DFU_ATTR_MANIFEST_TOLERANT)
-                           ? DFU_STATE_MANIFEST_SYNC
-                           : DFU_STATE_MANIFEST_WAIT_RESET;
+            d->state = (d->cfg.attributes & DFU_ATTR_MANIFEST_TOLERANT) ? DFU_STATE_MANIFEST_SYNC
+                                                                        : DFU_STATE_MANIFEST_WAIT_RESET;
         break;
-    default:
-        break;
+    default: break;
     }
 }
 
 void dfu_dev_bus_reset(dfu_dev_t *d, uint32_t now)
 {
     switch (d->state) {
-    case DFU_STATE_APP_IDLE:
-        break;
+    case DFU_STATE_APP_IDLE: break;
     case DFU_STATE_APP_DETACH:
         d->detach_pending = 0;
         if (due(now, d->busy_until)) {
@@ -276,9 +251,7 @@ void dfu_dev_bus_reset(dfu_dev_t *d, uint32_t now)
             d->status = DFU_STATUS_OK;
         }
         break;
-    default:
-        boot(d, 0);
-        break;
+    default: boot(d, 0); break;
     }
 }
 
@@ -288,14 +261,9 @@ static dfu_dev_result stall(dfu_dev_t *d, uint8_t status)
 {
     switch (d->state) {
     case DFU_STATE_APP_IDLE:
-    case DFU_STATE_MANIFEST_WAIT_RESET:
-        break;                        /* no state change */
-    case DFU_STATE_APP_DETACH:
-        d->state = DFU_STATE_APP_IDLE;
-        break;
-    default:
-        enter_error(d, status);
-        break;
+    case DFU_STATE_MANIFEST_WAIT_RESET: break; /* no state change */
+    case DFU_STATE_APP_DETACH: d->state = DFU_STATE_APP_IDLE; break;
+    default: enter_error(d, status); break;
     }
     return DFU_DEV_STALL;
 }
@@ -303,15 +271,12 @@ static dfu_dev_result stall(dfu_dev_t *d, uint8_t status)
 static uint32_t block_poll_ms(const dfu_dev_t *d)
 {
     uint32_t ps = d->flash.page_size, end = d->received + d->block_len, pages = 0;
-    if (end > d->erased_end)
-        pages = (end - d->erased_end + ps - 1u) / ps;
-    if (!d->invalidated)
-        pages++;
+    if (end > d->erased_end) pages = (end - d->erased_end + ps - 1u) / ps;
+    if (!d->invalidated) pages++;
     return d->cfg.program_ms + pages * d->cfg.erase_ms;
 }
 
-static dfu_dev_result getstatus(dfu_dev_t *d, uint32_t now, uint16_t w_length, uint8_t *data,
-                                uint16_t *actual)
+static dfu_dev_result getstatus(dfu_dev_t *d, uint32_t now, uint16_t w_length, uint8_t *data, uint16_t *actual)
 {
     uint32_t poll = 0;
     switch (d->state) {
@@ -334,44 +299,36 @@ static dfu_dev_result getstatus(dfu_dev_t *d, uint32_t now, uint16_t w_length, u
             d->state = DFU_STATE_IDLE;
         }
         break;
-    default:
-        break;
+    default: break;
     }
-    if (poll > DFU_POLL_TIMEOUT_MAX)
-        poll = DFU_POLL_TIMEOUT_MAX;
+    if (poll > DFU_POLL_TIMEOUT_MAX) poll = DFU_POLL_TIMEOUT_MAX;
     d->poll_ms = poll;
     d->busy_until = now + poll;
-    uint8_t r[DFU_GETSTATUS_LEN] = {d->status, (uint8_t)poll, (uint8_t)(poll >> 8),
-                                    (uint8_t)(poll >> 16), d->state, 0};
+    uint8_t r[DFU_GETSTATUS_LEN] = {d->status, (uint8_t)poll, (uint8_t)(poll >> 8), (uint8_t)(poll >> 16), d->state, 0};
     uint16_t n = w_length < DFU_GETSTATUS_LEN ? w_length : DFU_GETSTATUS_LEN;
-    for (uint16_t i = 0; i < n; i++)
-        data[i] = r[i];
+    for (uint16_t i = 0; i < n; i++) data[i] = r[i];
     *actual = n;
     return DFU_DEV_ACK;
 }
 
 static dfu_dev_result dnload(dfu_dev_t *d, uint16_t w_value, uint16_t w_length, const uint8_t *data)
 {
-    if (!(d->cfg.attributes & DFU_ATTR_CAN_DNLOAD))
-        return stall(d, DFU_STATUS_ERR_STALLEDPKT);
+    if (!(d->cfg.attributes & DFU_ATTR_CAN_DNLOAD)) return stall(d, DFU_STATUS_ERR_STALLEDPKT);
     if (w_length == 0) {
-        if (d->state != DFU_STATE_DNLOAD_IDLE)
-            return stall(d, DFU_STATUS_ERR_NOTDONE);  /* nothing received yet */
+        if (d->state != DFU_STATE_DNLOAD_IDLE) return stall(d, DFU_STATUS_ERR_NOTDONE); /* nothing received yet */
         d->state = DFU_STATE_MANIFEST_SYNC;
         d->manifested = 0;
         return DFU_DEV_ACK;
     }
-    if (w_length > d->cfg.transfer_size)
-        return stall(d, DFU_STATUS_ERR_STALLEDPKT);
+    if (w_length > d->cfg.transfer_size) return stall(d, DFU_STATUS_ERR_STALLEDPKT);
     if (d->state == DFU_STATE_IDLE) {
-        session_reset(d);              /* a new download starts */
+        session_reset(d); /* a new download starts */
     } else if (w_value != d->next_block) {
-        return stall(d, DFU_STATUS_ERR_ADDRESS);     /* block out of sequence */
+        return stall(d, DFU_STATUS_ERR_ADDRESS); /* block out of sequence */
     }
     if (w_length > dfu_app_capacity(&d->flash) - d->received)
-        return stall(d, DFU_STATUS_ERR_ADDRESS);     /* image larger than the region */
-    for (uint16_t i = 0; i < w_length; i++)
-        d->block[i] = data[i];
+        return stall(d, DFU_STATUS_ERR_ADDRESS); /* image larger than the region */
+    for (uint16_t i = 0; i < w_length; i++) d->block[i] = data[i];
     d->block_len = w_length;
     d->next_block = (uint16_t)(w_value + 1u);
     d->state = DFU_STATE_DNLOAD_SYNC;
@@ -389,74 +346,61 @@ static dfu_dev_result upload(dfu_dev_t *d, uint16_t w_length, uint8_t *data, uin
     }
     uint32_t left = d->upload_len - d->upload_pos;
     uint16_t n = left < w_length ? (uint16_t)left : w_length;
-    if (n && d->flash.read(d->flash.ctx, d->upload_pos, data, n) != 0)
-        return stall(d, DFU_STATUS_ERR_UNKNOWN);
+    if (n && d->flash.read(d->flash.ctx, d->upload_pos, data, n) != 0) return stall(d, DFU_STATUS_ERR_UNKNOWN);
     d->upload_pos += n;
     *actual = n;
-    d->state = n < w_length ? DFU_STATE_IDLE : DFU_STATE_UPLOAD_IDLE;  /* short frame ends it */
+    d->state = n < w_length ? DFU_STATE_IDLE : DFU_STATE_UPLOAD_IDLE; /* short frame ends it */
     return DFU_DEV_ACK;
 }
 
-dfu_dev_result dfu_dev_request(dfu_dev_t *d, uint32_t now, uint8_t bm_request_type,
-                               uint8_t b_request, uint16_t w_value, uint16_t w_length,
-                               uint8_t *data, uint16_t *actual)
+dfu_dev_result dfu_dev_request(dfu_dev_t *d, uint32_t now, uint8_t bm_request_type, uint8_t b_request, uint16_t w_value,
+                               uint16_t w_length, uint8_t *data, uint16_t *actual)
 {
     uint16_t dummy;
-    if (!actual)
-        actual = &dummy;
+    if (!actual) actual = &dummy;
     *actual = 0;
-    dfu_dev_poll(d, now);            /* end a timed state that is over */
+    dfu_dev_poll(d, now); /* end a timed state that is over */
 
-    int in = b_request == DFU_REQ_UPLOAD || b_request == DFU_REQ_GETSTATUS ||
-             b_request == DFU_REQ_GETSTATE;
-    if (b_request > DFU_REQ_ABORT ||
-        bm_request_type != (in ? DFU_REQTYPE_IN : DFU_REQTYPE_OUT) || (w_length && !data))
+    int in = b_request == DFU_REQ_UPLOAD || b_request == DFU_REQ_GETSTATUS || b_request == DFU_REQ_GETSTATE;
+    if (b_request > DFU_REQ_ABORT || bm_request_type != (in ? DFU_REQTYPE_IN : DFU_REQTYPE_OUT) || (w_length && !data))
         return stall(d, DFU_STATUS_ERR_STALLEDPKT);
 
     uint8_t s = d->state;
     switch (b_request) {
     case DFU_REQ_GETSTATUS:
-        if (s == DFU_STATE_DNBUSY || s == DFU_STATE_MANIFEST)
-            break;                    /* the host must wait bwPollTimeout */
+        if (s == DFU_STATE_DNBUSY || s == DFU_STATE_MANIFEST) break; /* the host must wait bwPollTimeout */
         return getstatus(d, now, w_length, data, actual);
     case DFU_REQ_GETSTATE:
-        if (s == DFU_STATE_DNBUSY || s == DFU_STATE_MANIFEST)
-            break;
+        if (s == DFU_STATE_DNBUSY || s == DFU_STATE_MANIFEST) break;
         if (w_length) {
             data[0] = s;
             *actual = 1;
         }
         return DFU_DEV_ACK;
     case DFU_REQ_DETACH:
-        if (s != DFU_STATE_APP_IDLE)
-            break;
+        if (s != DFU_STATE_APP_IDLE) break;
         d->state = DFU_STATE_APP_DETACH;
         d->busy_until = now + (w_value < d->cfg.detach_timeout_ms ? w_value : d->cfg.detach_timeout_ms);
         d->detach_pending = (d->cfg.attributes & DFU_ATTR_WILL_DETACH) ? 1 : 0;
         return DFU_DEV_ACK;
     case DFU_REQ_DNLOAD:
-        if (s != DFU_STATE_IDLE && s != DFU_STATE_DNLOAD_IDLE)
-            break;
+        if (s != DFU_STATE_IDLE && s != DFU_STATE_DNLOAD_IDLE) break;
         return dnload(d, w_value, w_length, data);
     case DFU_REQ_UPLOAD:
-        if (s != DFU_STATE_IDLE && s != DFU_STATE_UPLOAD_IDLE)
-            break;
+        if (s != DFU_STATE_IDLE && s != DFU_STATE_UPLOAD_IDLE) break;
         return upload(d, w_length, data, actual);
     case DFU_REQ_CLRSTATUS:
-        if (s != DFU_STATE_ERROR)
-            break;
+        if (s != DFU_STATE_ERROR) break;
         session_reset(d);
         d->state = DFU_STATE_IDLE;
         d->status = DFU_STATUS_OK;
         return DFU_DEV_ACK;
     case DFU_REQ_ABORT:
-        if (s != DFU_STATE_IDLE && s != DFU_STATE_DNLOAD_IDLE && s != DFU_STATE_UPLOAD_IDLE)
-            break;
+        if (s != DFU_STATE_IDLE && s != DFU_STATE_DNLOAD_IDLE && s != DFU_STATE_UPLOAD_IDLE) break;
         session_reset(d);
         d->state = DFU_STATE_IDLE;
         return DFU_DEV_ACK;
-    default:
-        break;
+    default: break;
     }
     return stall(d, DFU_STATUS_ERR_STALLEDPKT);
 }

@@ -68,20 +68,16 @@ dfu_image_err dfu_image_parse(const uint8_t *data, size_t len, dfu_image_t *out)
         goto done;
     }
     img.payload_len = len - img.suffix_len;
-    if (img.payload_len == 0)
-        err = DFU_IMAGE_EMPTY;
+    if (img.payload_len == 0) err = DFU_IMAGE_EMPTY;
 done:
-    if (out)
-        *out = img;
+    if (out) *out = img;
     return err;
 }
 
 dfu_image_err dfu_image_match(const dfu_image_t *img, uint16_t vid, uint16_t pid)
 {
-    if (img->id_vendor != DFU_ID_ANY && img->id_vendor != vid)
-        return DFU_IMAGE_WRONG_VENDOR;
-    if (img->id_product != DFU_ID_ANY && img->id_product != pid)
-        return DFU_IMAGE_WRONG_PRODUCT;
+    if (img->id_vendor != DFU_ID_ANY && img->id_vendor != vid) return DFU_IMAGE_WRONG_VENDOR;
+    if (img->id_product != DFU_ID_ANY && img->id_product != pid) return DFU_IMAGE_WRONG_PRODUCT;
     return DFU_IMAGE_OK;
 }
 
@@ -91,10 +87,12 @@ const char *dfu_image_strerror(dfu_image_err e)
     case DFU_IMAGE_OK: return "valid DFU image";
     case DFU_IMAGE_TOO_SHORT: return "too short to hold a DFU suffix (truncated, or not a DFU image)";
     case DFU_IMAGE_NO_SIGNATURE:
-        return "no DFU suffix signature \"UFD\" at the end (truncated, or a raw binary: add a suffix with --add-suffix)";
+        return "no DFU suffix signature \"UFD\" at the end (truncated, or a raw binary: add a suffix with "
+               "--add-suffix)";
     case DFU_IMAGE_BAD_LENGTH: return "DFU suffix length field (bLength) is not 16, the length of a DFU 1.1 suffix";
     case DFU_IMAGE_BAD_CRC: return "CRC mismatch: the file is corrupted";
-    case DFU_IMAGE_BAD_VERSION: return "DFU suffix bcdDFU is not 0x0100 (not a DFU 1.1 image; DfuSe files are not supported)";
+    case DFU_IMAGE_BAD_VERSION:
+        return "DFU suffix bcdDFU is not 0x0100 (not a DFU 1.1 image; DfuSe files are not supported)";
     case DFU_IMAGE_EMPTY: return "no firmware before the DFU suffix";
     case DFU_IMAGE_WRONG_VENDOR: return "made for another vendor id (idVendor in the suffix)";
     case DFU_IMAGE_WRONG_PRODUCT: return "made for another product id (idProduct in the suffix)";
@@ -102,8 +100,8 @@ const char *dfu_image_strerror(dfu_image_err e)
     return "unknown image error";
 }
 
-void dfu_suffix_build(uint8_t out[DFU_SUFFIX_LEN], const uint8_t *payload, size_t n,
-                      uint16_t vid, uint16_t pid, uint16_t bcd_device)
+void dfu_suffix_build(uint8_t out[DFU_SUFFIX_LEN], const uint8_t *payload, size_t n, uint16_t vid, uint16_t pid,
+                      uint16_t bcd_device)
 {
     wr16(out + 0, bcd_device);
     wr16(out + 2, pid);
@@ -113,7 +111,7 @@ void dfu_suffix_build(uint8_t out[DFU_SUFFIX_LEN], const uint8_t *payload, size_
     out[9] = 'F';
     out[10] = 'D';
     out[11] = DFU_SUFFIX_LEN;
-    uint32_t crc = ~dfu_suffix_crc(payload, n);   /* back to zlib form to continue it */
+    uint32_t crc = ~dfu_suffix_crc(payload, n); /* back to zlib form to continue it */
     uint32_t v = ~crc_update(crc, out, 12);
     out[12] = (uint8_t)v;
     out[13] = (uint8_t)(v >> 8);

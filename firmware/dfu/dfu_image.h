@@ -30,23 +30,23 @@
 
 typedef enum dfu_image_err {
     DFU_IMAGE_OK = 0,
-    DFU_IMAGE_TOO_SHORT,       /* shorter than a suffix */
-    DFU_IMAGE_NO_SIGNATURE,    /* no "UFD": no suffix, or the file is truncated */
-    DFU_IMAGE_BAD_LENGTH,      /* bLength is not 16 (the DFU 1.1 suffix) */
-    DFU_IMAGE_BAD_CRC,         /* dwCRC does not match the file: corrupted */
-    DFU_IMAGE_BAD_VERSION,     /* bcdDFU is not 0x0100 (e.g. 0x011A, a DfuSe file) */
-    DFU_IMAGE_EMPTY,           /* no firmware bytes before the suffix */
-    DFU_IMAGE_WRONG_VENDOR,    /* idVendor neither 0xFFFF nor the device's */
-    DFU_IMAGE_WRONG_PRODUCT,   /* idProduct neither 0xFFFF nor the device's */
+    DFU_IMAGE_TOO_SHORT,     /* shorter than a suffix */
+    DFU_IMAGE_NO_SIGNATURE,  /* no "UFD": no suffix, or the file is truncated */
+    DFU_IMAGE_BAD_LENGTH,    /* bLength is not 16 (the DFU 1.1 suffix) */
+    DFU_IMAGE_BAD_CRC,       /* dwCRC does not match the file: corrupted */
+    DFU_IMAGE_BAD_VERSION,   /* bcdDFU is not 0x0100 (e.g. 0x011A, a DfuSe file) */
+    DFU_IMAGE_EMPTY,         /* no firmware bytes before the suffix */
+    DFU_IMAGE_WRONG_VENDOR,  /* idVendor neither 0xFFFF nor the device's */
+    DFU_IMAGE_WRONG_PRODUCT, /* idProduct neither 0xFFFF nor the device's */
 } dfu_image_err;
 
 typedef struct dfu_image {
-    const uint8_t *payload;    /* the firmware bytes (points into the parsed buffer) */
+    const uint8_t *payload; /* the firmware bytes (points into the parsed buffer) */
     size_t payload_len;
     uint16_t bcd_device, id_product, id_vendor, bcd_dfu;
-    uint8_t suffix_len;        /* bLength */
-    uint32_t crc_stored;       /* dwCRC as found in the file */
-    uint32_t crc_computed;     /* dwCRC as computed over the file */
+    uint8_t suffix_len;    /* bLength */
+    uint32_t crc_stored;   /* dwCRC as found in the file */
+    uint32_t crc_computed; /* dwCRC as computed over the file */
 } dfu_image_t;
 
 /* Validate a whole DFU file: length, signature, bLength, CRC, bcdDFU, a non-empty
@@ -65,7 +65,7 @@ uint32_t dfu_suffix_crc(const uint8_t *data, size_t n);
 
 /* Make the 16-byte suffix for payload[0..n): out must hold 16 bytes and is the
  * suffix to append; the CRC covers payload and the first 12 suffix bytes. */
-void dfu_suffix_build(uint8_t out[DFU_SUFFIX_LEN], const uint8_t *payload, size_t n,
-                      uint16_t vid, uint16_t pid, uint16_t bcd_device);
+void dfu_suffix_build(uint8_t out[DFU_SUFFIX_LEN], const uint8_t *payload, size_t n, uint16_t vid, uint16_t pid,
+                      uint16_t bcd_device);
 
 #endif

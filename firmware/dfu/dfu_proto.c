@@ -3,14 +3,15 @@
 #include "dfu_proto.h"
 
 static const char *const state_names[] = {
-    "appIDLE", "appDETACH", "dfuIDLE", "dfuDNLOAD-SYNC", "dfuDNBUSY", "dfuDNLOAD-IDLE",
-    "dfuMANIFEST-SYNC", "dfuMANIFEST", "dfuMANIFEST-WAIT-RESET", "dfuUPLOAD-IDLE", "dfuERROR",
+    "appIDLE",        "appDETACH",        "dfuIDLE",     "dfuDNLOAD-SYNC",         "dfuDNBUSY",
+    "dfuDNLOAD-IDLE", "dfuMANIFEST-SYNC", "dfuMANIFEST", "dfuMANIFEST-WAIT-RESET", "dfuUPLOAD-IDLE",
+    "dfuERROR",
 };
 
 static const char *const status_names[] = {
-    "OK", "errTARGET", "errFILE", "errWRITE", "errERASE", "errCHECK_ERASED", "errPROG",
-    "errVERIFY", "errADDRESS", "errNOTDONE", "errFIRMWARE", "errVENDOR", "errUSBR",
-    "errPOR", "errUNKNOWN", "errSTALLEDPKT",
+    "OK",      "errTARGET", "errFILE",    "errWRITE",      "errERASE",    "errCHECK_ERASED",
+    "errPROG", "errVERIFY", "errADDRESS", "errNOTDONE",    "errFIRMWARE", "errVENDOR",
+    "errUSBR", "errPOR",    "errUNKNOWN", "errSTALLEDPKT",
 };
 
 static const char *const status_texts[] = {
@@ -43,18 +44,15 @@ const char *dfu_state_name(unsigned state)
 
 const char *dfu_status_name(unsigned status)
 {
-    return status < sizeof status_names / sizeof status_names[0] ? status_names[status]
-                                                                 : "unknown status";
+    return status < sizeof status_names / sizeof status_names[0] ? status_names[status] : "unknown status";
 }
 
 const char *dfu_status_text(unsigned status)
 {
-    return status < sizeof status_texts / sizeof status_texts[0] ? status_texts[status]
-                                                                 : "unknown status code";
+    return status < sizeof status_texts / sizeof status_texts[0] ? status_texts[status] : "unknown status code";
 }
 
 const char *dfu_request_name(unsigned request)
 {
-    return request < sizeof request_names / sizeof request_names[0] ? request_names[request]
-                                                                    : "unknown request";
+    return request < sizeof request_names / sizeof request_names[0] ? request_names[request] : "unknown request";
 }

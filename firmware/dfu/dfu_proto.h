@@ -9,7 +9,7 @@
 
 /* bmRequestType of DFU class requests: class, interface recipient. */
 #define DFU_REQTYPE_OUT 0x21u /* host to device */
-#define DFU_REQTYPE_IN  0xA1u /* device to host */
+#define DFU_REQTYPE_IN 0xA1u  /* device to host */
 
 /* bRequest (DFU 1.1, table 3.2). */
 enum dfu_request {

@@ -134,7 +134,8 @@ int args_parse(fw_args *a, char *line, unsigned offered, char *err, int errsize)
         if (!val) return fail(err, errsize, "%s: missing value", o);
         i++;
         if (same(o, "--frames")) {
-            if (parse_int(val, &a->frames) || a->frames < 0) return fail(err, errsize, "--frames '%s': expected a count", val);
+            if (parse_int(val, &a->frames) || a->frames < 0)
+                return fail(err, errsize, "--frames '%s': expected a count", val);
         } else if (same(o, "--linger")) {
             if (parse_int(val, &a->linger_ms) || a->linger_ms < 0 || a->linger_ms > 60000)
                 return fail(err, errsize, "--linger '%s': expected milliseconds, 0..60000", val);
@@ -154,15 +155,20 @@ int args_parse(fw_args *a, char *line, unsigned offered, char *err, int errsize)
         } else if (same(o, "--look")) {
             if (parse_int(val, &a->look)) return fail(err, errsize, "--look '%s': expected pixels", val);
         } else if (same(o, "--mode")) {
-            if ((a->mode = render_mode_parse(val)) < 0) return fail(err, errsize, "--mode '%s': direct, spans or painter", val);
+            if ((a->mode = render_mode_parse(val)) < 0)
+                return fail(err, errsize, "--mode '%s': direct, spans or painter", val);
         } else if (same(o, "--present")) {
             if ((a->present = hal_present_parse(val)) < 0)
                 return fail(err, errsize, "--present '%s': flip, copy8, copy16 or copy32", val);
         } else if (same(o, "--acks")) {
-            if (same(val, "auto")) a->acks = ARGS_ACKS_AUTO;
-            else if (same(val, "on")) a->acks = ARGS_ACKS_ON;
-            else if (same(val, "off")) a->acks = ARGS_ACKS_OFF;
-            else return fail(err, errsize, "--acks '%s': auto, on or off", val);
+            if (same(val, "auto"))
+                a->acks = ARGS_ACKS_AUTO;
+            else if (same(val, "on"))
+                a->acks = ARGS_ACKS_ON;
+            else if (same(val, "off"))
+                a->acks = ARGS_ACKS_OFF;
+            else
+                return fail(err, errsize, "--acks '%s': auto, on or off", val);
         } else {
             return fail(err, errsize, "unknown option '%s'", o);
         }

@@ -36,15 +36,15 @@
 #include <stdint.h>
 
 typedef struct {
-    int32_t frames;             /* -1: the path's length */
-    int32_t linger_ms;          /* wait this long after the last frame before exiting (0) */
-    const char *path;           /* NULL: the build's */
+    int32_t frames;    /* -1: the path's length */
+    int32_t linger_ms; /* wait this long after the last frame before exiting (0) */
+    const char *path;  /* NULL: the build's */
     int have_at, have_z, have_angle;
     int32_t x, y, z, angle_deg; /* 16.16 */
     int32_t look;
-    int mode, present;          /* -1: the engine's defaults */
+    int mode, present; /* -1: the engine's defaults */
     int no_stream, no_tick, fault, wait, no_objects, flat;
-    int acks;                   /* ARGS_ACKS_* */
+    int acks; /* ARGS_ACKS_* */
 } fw_args;
 
 /* Options only some targets have: args_parse's offered. */

@@ -53,8 +53,8 @@ typedef struct {
 } bare_work;
 
 typedef struct {
-    const char *name;  /* the prefix of every message: "firmware: ..." */
-    unsigned offered;  /* the ARGS_* options this target has */
+    const char *name; /* the prefix of every message: "firmware: ..." */
+    unsigned offered; /* the ARGS_* options this target has */
     /* The log sink: one line, or part of one, by format.h's printf. */
     void (*log)(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
     /* After the options are read and the path found (e.g. stop the tick). NULL: none. */

@@ -13,24 +13,24 @@
  * (firmware/camera.c), so 7 frames turn about 24 degrees and 35 frames walk
  * 256 units. */
 static const campath_step default_steps[] = {
-    {0, 2},            /* the player start: (96, 160), 20 degrees */
-    {RIGHT, 7},        /* face the corridor (about -4 degrees) */
-    {FWD, 86},         /* across the hall, up the step, through the corridor */
-    {LEFT, 12},        /* in the sky-lit court, turn left (about 40 degrees) */
-    {UP, 20},          /* look up at the sky */
-    {LEFT, 30},        /* turn, still looking up */
-    {DOWN, 20},        /* level again */
-    {LEFT, 24},        /* turn toward the window and the gallery */
-    {0, 3},            /* stand: identical frames */
+    {0, 2},     /* the player start: (96, 160), 20 degrees */
+    {RIGHT, 7}, /* face the corridor (about -4 degrees) */
+    {FWD, 86},  /* across the hall, up the step, through the corridor */
+    {LEFT, 12}, /* in the sky-lit court, turn left (about 40 degrees) */
+    {UP, 20},   /* look up at the sky */
+    {LEFT, 30}, /* turn, still looking up */
+    {DOWN, 20}, /* level again */
+    {LEFT, 24}, /* turn toward the window and the gallery */
+    {0, 3},     /* stand: identical frames */
 };
 
 static const campath_step map01_steps[] = {
-    {0, 2},            /* the player start: (-192, -160), facing east */
-    {FWD, 74},         /* along the corridor east, down the stairs */
-    {LEFT, 26},        /* turn to the north (about 90 degrees) */
-    {FWD, 40},         /* into the alcove */
-    {RIGHT, 20},       /* and a look to the right */
-    {0, 3},            /* stand: identical frames */
+    {0, 2},      /* the player start: (-192, -160), facing east */
+    {FWD, 74},   /* along the corridor east, down the stairs */
+    {LEFT, 26},  /* turn to the north (about 90 degrees) */
+    {FWD, 40},   /* into the alcove */
+    {RIGHT, 20}, /* and a look to the right */
+    {0, 3},      /* stand: identical frames */
 };
 
 const campath campath_default = {"default", default_steps, sizeof default_steps / sizeof default_steps[0]};

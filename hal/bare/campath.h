@@ -39,9 +39,9 @@ extern const campath campath_map01;
 
 #define CAMPATH_TIC_HZ 35u
 
-uint32_t campath_frames(const campath *p);                 /* frames in the whole path */
-uint32_t campath_keys(const campath *p, uint32_t frame);   /* keys held at frame (0 past the end) */
-uint32_t campath_dt_ms(uint32_t frame);                    /* ms frame advances the clock: 28 or 29 */
-const campath *campath_find(const char *name);             /* by name, or NULL */
+uint32_t campath_frames(const campath *p);               /* frames in the whole path */
+uint32_t campath_keys(const campath *p, uint32_t frame); /* keys held at frame (0 past the end) */
+uint32_t campath_dt_ms(uint32_t frame);                  /* ms frame advances the clock: 28 or 29 */
+const campath *campath_find(const char *name);           /* by name, or NULL */
 
 #endif

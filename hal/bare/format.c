@@ -24,8 +24,10 @@ static void put_num(out_buf *o, uint32_t v, unsigned base, int neg, int width, c
         v /= base;
     } while (v);
     if (neg) {
-        if (pad == '0') put(o, '-');
-        else tmp[n++] = '-';
+        if (pad == '0')
+            put(o, '-');
+        else
+            tmp[n++] = '-';
         width--;
     }
     for (int i = n; i < width; i++) put(o, pad);
@@ -58,26 +60,16 @@ int fmt_format(char *buf, int size, const char *fmt, va_list ap)
             while (*s) put(&o, *s++);
             break;
         }
-        case 'c':
-            put(&o, (char)va_arg(ap, int));
-            break;
+        case 'c': put(&o, (char)va_arg(ap, int)); break;
         case 'd': {
             int v = va_arg(ap, int);
             put_num(&o, v < 0 ? 0u - (uint32_t)v : (uint32_t)v, 10, v < 0, width, pad);
             break;
         }
-        case 'u':
-            put_num(&o, va_arg(ap, unsigned), 10, 0, width, pad);
-            break;
-        case 'x':
-            put_num(&o, va_arg(ap, unsigned), 16, 0, width, pad);
-            break;
-        case '%':
-            put(&o, '%');
-            break;
-        case '\0':
-            fmt--;
-            break;
+        case 'u': put_num(&o, va_arg(ap, unsigned), 10, 0, width, pad); break;
+        case 'x': put_num(&o, va_arg(ap, unsigned), 16, 0, width, pad); break;
+        case '%': put(&o, '%'); break;
+        case '\0': fmt--; break;
         default:
             put(&o, '%');
             put(&o, *fmt);
@@ -87,4 +79,3 @@ int fmt_format(char *buf, int size, const char *fmt, va_list ap)
     if (size > 0) buf[o.len] = '\0';
     return o.len;
 }
-

@@ -25,6 +25,5 @@ int scene_refusal_format(char *buf, int size, const char *scene_name, scene_stat
     if (se->section >= 0)
         return print(buf, size, "the built-in scene %s is invalid: %s (%s record %u); refusing to run", scene_name,
                      scene_status_text(st), scene_section_name(se->section), (unsigned)se->index);
-    return print(buf, size, "the built-in scene %s is invalid: %s; refusing to run", scene_name,
-                 scene_status_text(st));
+    return print(buf, size, "the built-in scene %s is invalid: %s; refusing to run", scene_name, scene_status_text(st));
 }

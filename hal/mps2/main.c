@@ -95,9 +95,8 @@ static int mps2_start(const bare_run *r)
     log_printf("firmware: mps2-an385 Cortex-M3; scene %s (%u bytes, CRC-32 %08x, work %u of %u bytes, world state %u); "
                "%s %u frames; mode %s, present %s; stream %s\n",
                fw_scene_name, (unsigned)fw_scene_len, (unsigned)scene_crc, (unsigned)r->need, (unsigned)r->avail,
-               (unsigned)obj_state_bytes(&r->e.sc), r->fixed_view ? "fixed view," : r->path->name,
-               (unsigned)r->frames, render_mode_name(r->e.mode), hal_present_name(r->e.present),
-               a->no_stream ? "off" : stream_kind());
+               (unsigned)obj_state_bytes(&r->e.sc), r->fixed_view ? "fixed view," : r->path->name, (unsigned)r->frames,
+               render_mode_name(r->e.mode), hal_present_name(r->e.present), a->no_stream ? "off" : stream_kind());
     if (!a->no_stream && stream_begin(&r->e, fw_scene_name, scene_crc) != 0) {
         log_printf("firmware: the frame link did not start\n");
         return FW_EXIT_LINK;

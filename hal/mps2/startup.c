@@ -43,7 +43,10 @@ __attribute__((section(".vectors"), used)) const vector mps2_vectors[16 + 32] = 
     fault_handler, /* MemManage */
     fault_handler, /* BusFault */
     fault_handler, /* UsageFault */
-    0, 0, 0, 0,
+    0,
+    0,
+    0,
+    0,
     default_handler, /* SVCall */
     default_handler, /* DebugMonitor */
     0,
@@ -85,13 +88,12 @@ uint32_t mps2_stack_unused(void)
 /* Pass the exception frame (on whichever stack was in use) and IPSR to C. */
 __attribute__((naked)) void fault_handler(void)
 {
-    __asm__ volatile(
-        "tst lr, #4\n"
-        "ite eq\n"
-        "mrseq r0, msp\n"
-        "mrsne r0, psp\n"
-        "mrs r1, ipsr\n"
-        "b fault_report\n");
+    __asm__ volatile("tst lr, #4\n"
+                     "ite eq\n"
+                     "mrseq r0, msp\n"
+                     "mrsne r0, psp\n"
+                     "mrs r1, ipsr\n"
+                     "b fault_report\n");
 }
 
 static const char *fault_name(uint32_t exc)
@@ -123,8 +125,8 @@ void fault_report(const uint32_t *frame, uint32_t ipsr)
     }
     log_set_sinks(LOG_TO_UART | LOG_TO_SEMIHOST);
     uart_putc(0); /* ends any frame-link message cut short, so the text stands on its own */
-    log_printf("\nFAULT: %s: pc=0x%08x lr=0x%08x xpsr=0x%08x sp=0x%08x\n", fault_name(exc), (unsigned)frame[6], (unsigned)frame[5],
-               (unsigned)frame[7], (unsigned)(uintptr_t)frame);
+    log_printf("\nFAULT: %s: pc=0x%08x lr=0x%08x xpsr=0x%08x sp=0x%08x\n", fault_name(exc), (unsigned)frame[6],
+               (unsigned)frame[5], (unsigned)frame[7], (unsigned)(uintptr_t)frame);
     log_printf("FAULT: cfsr=0x%08x hfsr=0x%08x mmfar=0x%08x bfar=0x%08x\n", (unsigned)SCB_CFSR, (unsigned)hfsr,
                (unsigned)SCB_MMFAR, (unsigned)SCB_BFAR);
     uart_flush();

@@ -28,10 +28,10 @@ static fl_encoder enc;
 static _Alignas(4) uint8_t scratch[SCRATCH_BYTES];
 static struct {
     stream_acks acks;
-    int heard;            /* the receiver has sent something intact */
-    int have_prev;        /* a frame was sent ... */
-    uint32_t prev_no;     /* ... with this number */
-    int prev_flip;        /* ... in flip mode (so it is on the hidden page now) */
+    int heard;        /* the receiver has sent something intact */
+    int have_prev;    /* a frame was sent ... */
+    uint32_t prev_no; /* ... with this number */
+    int prev_flip;    /* ... in flip mode (so it is on the hidden page now) */
 } st;
 
 static void put(void *ctx, const uint8_t *p, uint32_t n)

@@ -32,7 +32,7 @@ static volatile uint8_t rx_held; /* a byte waits in the data register: the ring 
 void uart_init(void)
 {
     UART_CTRL = 0;
-    UART_BAUDDIV = MPS2_SYSCLK_HZ / UART_BAUD; /* 217; the UART needs >= 16 */
+    UART_BAUDDIV = MPS2_SYSCLK_HZ / UART_BAUD;        /* 217; the UART needs >= 16 */
     UART_STATE = STATE_TX_OVERRUN | STATE_RX_OVERRUN; /* write 1 to clear */
     UART_INTSTATUS = 0xFu;
     rx_head = rx_tail = 0;

@@ -25,11 +25,11 @@
 void uart_init(void);
 void uart_putc(uint8_t c);
 void uart_write(const void *p, size_t n);
-void uart_puts(const char *s);       /* text, '\n' sent as "\r\n" */
-void uart_flush(void);               /* wait until the last byte has left the TX buffer */
-int uart_getc(void);                 /* next received byte, or -1 if none is waiting */
-int uart_rx_ready(void);             /* 1 if a received byte is waiting */
-uint32_t uart_rx_overruns(void);     /* received bytes the hardware dropped (overrun) */
+void uart_puts(const char *s);   /* text, '\n' sent as "\r\n" */
+void uart_flush(void);           /* wait until the last byte has left the TX buffer */
+int uart_getc(void);             /* next received byte, or -1 if none is waiting */
+int uart_rx_ready(void);         /* 1 if a received byte is waiting */
+uint32_t uart_rx_overruns(void); /* received bytes the hardware dropped (overrun) */
 
 /* The RX interrupt handler (vector table, startup.c). */
 void uart0_rx_irq(void);

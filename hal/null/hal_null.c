@@ -14,13 +14,12 @@
 static struct {
     uint32_t input;
     uint32_t frames;
-    uint32_t ticks;      /* ms */
-    uint32_t tick_frac;  /* carried remainder, in 1/35 ms */
-    int manual_ticks;    /* 1 once the host set the clock */
+    uint32_t ticks;     /* ms */
+    uint32_t tick_frac; /* carried remainder, in 1/35 ms */
+    int manual_ticks;   /* 1 once the host set the clock */
 } st;
 
-#define HAL_KEY_EDGES ((uint32_t)HAL_KEY_NEXT_MODE | (uint32_t)HAL_KEY_NEXT_PRESENT | \
-                       (uint32_t)HAL_KEY_PRINT_COUNTERS)
+#define HAL_KEY_EDGES ((uint32_t)HAL_KEY_NEXT_MODE | (uint32_t)HAL_KEY_NEXT_PRESENT | (uint32_t)HAL_KEY_PRINT_COUNTERS)
 
 uint32_t hal_input(void)
 {

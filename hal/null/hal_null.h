@@ -17,9 +17,9 @@
 
 #include <stdint.h>
 
-void hal_null_set_input(uint32_t keys);  /* HAL_KEY_* bits */
-void hal_null_set_ticks(uint32_t ms);    /* take manual control of the clock */
-uint32_t hal_null_frames(void);          /* hal_frame_done calls since reset */
+void hal_null_set_input(uint32_t keys); /* HAL_KEY_* bits */
+void hal_null_set_ticks(uint32_t ms);   /* take manual control of the clock */
+uint32_t hal_null_frames(void);         /* hal_frame_done calls since reset */
 /* Zero both VRAM pages, the system-memory buffer and the palette; display
  * start 0; input 0; frames 0; clock back to automatic at 0. Does not touch
  * the performance counters (hal_perf_reset does). */

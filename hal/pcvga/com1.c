@@ -4,8 +4,8 @@
 #include "io.h"
 
 #define COM1 0x3F8
-#define REG_DATA 0      /* THR / RBR; divisor low with DLAB */
-#define REG_IER 1       /* interrupt enable; divisor high with DLAB */
+#define REG_DATA 0 /* THR / RBR; divisor low with DLAB */
+#define REG_IER 1  /* interrupt enable; divisor high with DLAB */
 #define REG_FCR 2
 #define REG_LCR 3
 #define REG_MCR 4
@@ -18,13 +18,13 @@
 
 void com1_init(void)
 {
-    io_out8(COM1 + REG_IER, 0x00);           /* polled: no interrupts */
+    io_out8(COM1 + REG_IER, 0x00); /* polled: no interrupts */
     io_out8(COM1 + REG_LCR, LCR_DLAB);
     io_out8(COM1 + REG_DATA, BAUD_DIVISOR & 0xFFu);
     io_out8(COM1 + REG_IER, BAUD_DIVISOR >> 8);
     io_out8(COM1 + REG_LCR, LCR_8N1);
-    io_out8(COM1 + REG_FCR, 0xC7);           /* FIFOs on and cleared */
-    io_out8(COM1 + REG_MCR, 0x03);           /* DTR, RTS */
+    io_out8(COM1 + REG_FCR, 0xC7); /* FIFOs on and cleared */
+    io_out8(COM1 + REG_MCR, 0x03); /* DTR, RTS */
 }
 
 void com1_putc(char c)

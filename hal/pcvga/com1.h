@@ -6,8 +6,8 @@
 #define PCVGA_COM1_H
 
 void com1_init(void);
-void com1_putc(char c);     /* waits while the transmitter is full */
+void com1_putc(char c);        /* waits while the transmitter is full */
 void com1_puts(const char *s); /* "\n" goes out as "\r\n", for terminals */
-int com1_getc(void);        /* a received byte, or -1 if none has arrived */
+int com1_getc(void);           /* a received byte, or -1 if none has arrived */
 
 #endif

@@ -21,7 +21,7 @@
 
 void pcvga_use_present(hal_present_mode m); /* sets the VGA's layout for m */
 void pcvga_sync_dac(void);
-void pcvga_set_path(const campath *p);      /* NULL: no input */
+void pcvga_set_path(const campath *p); /* NULL: no input */
 /* The frame the display shows, read back from the VGA into frame (64,000 bytes). */
 void pcvga_read_shown(uint8_t *frame);
 

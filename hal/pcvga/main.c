@@ -109,7 +109,8 @@ static bare_work pcvga_work(uint32_t need)
 static void pcvga_work_refused(uint32_t need, uint32_t avail)
 {
     log_printf("pcvga: the scene %s needs %u bytes of work memory; %u are free above the kernel "
-               "(give QEMU more with -m)\n", fw_scene_name, (unsigned)need, (unsigned)avail);
+               "(give QEMU more with -m)\n",
+               fw_scene_name, (unsigned)need, (unsigned)avail);
 }
 
 static int pcvga_run_start(const bare_run *r)

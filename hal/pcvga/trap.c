@@ -35,11 +35,29 @@ void trap_dispatch(struct trap_frame *f);
 static idt_gate idt[IRQ_BASE + 16];
 static volatile uint32_t ticks;
 
-static const char *const exception_names[32] = { /* Intel's mnemonics */
-    "#DE divide error", "#DB debug", "NMI", "#BP breakpoint", "#OF overflow", "#BR bound range",
-    "#UD invalid opcode", "#NM no coprocessor", "#DF", "coprocessor segment overrun", "#TS invalid TSS",
-    "#NP segment not present", "#SS stack fault", "#GP general protection", "#PF page fault", "reserved",
-    "#MF x87 error", "#AC alignment check", "#MC machine check", "#XM SIMD error", "#VE virtualisation",
+static const char *const exception_names[32] = {
+    /* Intel's mnemonics */
+    "#DE divide error",
+    "#DB debug",
+    "NMI",
+    "#BP breakpoint",
+    "#OF overflow",
+    "#BR bound range",
+    "#UD invalid opcode",
+    "#NM no coprocessor",
+    "#DF",
+    "coprocessor segment overrun",
+    "#TS invalid TSS",
+    "#NP segment not present",
+    "#SS stack fault",
+    "#GP general protection",
+    "#PF page fault",
+    "reserved",
+    "#MF x87 error",
+    "#AC alignment check",
+    "#MC machine check",
+    "#XM SIMD error",
+    "#VE virtualisation",
     "#CP control protection",
 };
 

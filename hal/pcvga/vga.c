@@ -76,8 +76,8 @@ void vga_set_mode13h(void)
 
 void vga_set_unchained(void)
 {
-    reg_out(SEQ_INDEX, SEQ_MEMORY_MODE, 0x06);  /* chain-4 off, odd/even off, 256 KB */
-    reg_out(CRTC_INDEX, CRTC_UNDERLINE, 0x00);   /* doubleword addressing off */
+    reg_out(SEQ_INDEX, SEQ_MEMORY_MODE, 0x06);    /* chain-4 off, odd/even off, 256 KB */
+    reg_out(CRTC_INDEX, CRTC_UNDERLINE, 0x00);    /* doubleword addressing off */
     reg_out(CRTC_INDEX, CRTC_MODE_CONTROL, 0xE3); /* byte addressing */
     vga_map_mask(0x0Fu);
     clear_window(65536u); /* every plane at once */

@@ -20,11 +20,11 @@
 #define VGA_WINDOW ((uint8_t *)0xA0000)
 #define VGA_PLANAR_PAGE_BYTES 16000u /* 80 x 200 bytes a plane */
 
-void vga_set_mode13h(void);  /* chained 320x200x256, display start 0, page cleared */
-void vga_set_unchained(void); /* from mode 13h: chain-4 off, byte addressing, all 256 KB cleared */
-void vga_load_dac(const uint8_t *rgb);  /* 256 entries, 8 bits per gun */
-void vga_map_mask(unsigned planes);     /* bit p: writes reach plane p */
-void vga_set_start(uint32_t offset);    /* CRTC start address (unchained: a page's byte offset), set at vertical retrace */
+void vga_set_mode13h(void);            /* chained 320x200x256, display start 0, page cleared */
+void vga_set_unchained(void);          /* from mode 13h: chain-4 off, byte addressing, all 256 KB cleared */
+void vga_load_dac(const uint8_t *rgb); /* 256 entries, 8 bits per gun */
+void vga_map_mask(unsigned planes);    /* bit p: writes reach plane p */
+void vga_set_start(uint32_t offset); /* CRTC start address (unchained: a page's byte offset), set at vertical retrace */
 uint32_t vga_start(void);
 /* Read an unchained page at offset back into a linear 320x200 frame (reads
  * plane by plane through the read map select). */

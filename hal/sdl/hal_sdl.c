@@ -32,13 +32,14 @@ static struct {
     SDL_Texture *upscaled; /* 320s x 200s render target, linear; NULL if unsupported */
     uint32_t t0;
     uint32_t last_shown; /* SDL ticks when the last frame was shown */
-    uint32_t edges; /* edge-triggered bits (and quit) pressed since the last hal_input */
+    uint32_t edges;      /* edge-triggered bits (and quit) pressed since the last hal_input */
     SDL_Scancode sc_a, sc_z, sc_q, sc_w, sc_comma, sc_period, sc_m, sc_p, sc_c, sc_v, sc_s;
     char err[256];
 } sdl;
 
-#define HAL_KEY_EDGES ((uint32_t)HAL_KEY_NEXT_MODE | (uint32_t)HAL_KEY_NEXT_PRESENT | \
-                       (uint32_t)HAL_KEY_PRINT_COUNTERS | (uint32_t)HAL_KEY_PRINT_VIEW | (uint32_t)HAL_KEY_SCREENSHOT)
+#define HAL_KEY_EDGES                                                                                                  \
+    ((uint32_t)HAL_KEY_NEXT_MODE | (uint32_t)HAL_KEY_NEXT_PRESENT | (uint32_t)HAL_KEY_PRINT_COUNTERS |                 \
+     (uint32_t)HAL_KEY_PRINT_VIEW | (uint32_t)HAL_KEY_SCREENSHOT)
 
 /* ---- window -------------------------------------------------------------- */
 const char *hal_sdl_error(void)
@@ -53,14 +54,10 @@ static void fail(const char *what)
 
 static void destroy(void)
 {
-    if (sdl.upscaled)
-        SDL_DestroyTexture(sdl.upscaled);
-    if (sdl.frame)
-        SDL_DestroyTexture(sdl.frame);
-    if (sdl.ren)
-        SDL_DestroyRenderer(sdl.ren);
-    if (sdl.win)
-        SDL_DestroyWindow(sdl.win);
+    if (sdl.upscaled) SDL_DestroyTexture(sdl.upscaled);
+    if (sdl.frame) SDL_DestroyTexture(sdl.frame);
+    if (sdl.ren) SDL_DestroyRenderer(sdl.ren);
+    if (sdl.win) SDL_DestroyWindow(sdl.win);
     sdl.upscaled = NULL;
     sdl.frame = NULL;
     sdl.ren = NULL;
@@ -79,24 +76,18 @@ static SDL_Scancode key_sc(SDL_Keycode k, SDL_Scancode fallback)
 static int headless_fallback(const char *asked)
 {
     const char *drv = SDL_GetCurrentVideoDriver();
-    if (drv == NULL)
-        return 1;
-    if (strcmp(drv, "offscreen") != 0 && strcmp(drv, "dummy") != 0)
-        return 0;
+    if (drv == NULL) return 1;
+    if (strcmp(drv, "offscreen") != 0 && strcmp(drv, "dummy") != 0) return 0;
     return asked == NULL || strstr(asked, drv) == NULL;
 }
 
 int hal_sdl_init(int scale, const char *title)
 {
     sdl.err[0] = '\0';
-    if (sdl.win)
-        return 0;
-    if (scale <= 0)
-        scale = HAL_SDL_DEFAULT_SCALE;
-    if (scale > HAL_SDL_MAX_SCALE)
-        scale = HAL_SDL_MAX_SCALE;
-    if (title == NULL)
-        title = "hal";
+    if (sdl.win) return 0;
+    if (scale <= 0) scale = HAL_SDL_DEFAULT_SCALE;
+    if (scale > HAL_SDL_MAX_SCALE) scale = HAL_SDL_MAX_SCALE;
+    if (title == NULL) title = "hal";
 
     const char *asked = SDL_GetHint(SDL_HINT_VIDEODRIVER); /* also reads the environment */
     const char *xdg = getenv("XDG_RUNTIME_DIR"), *wl = getenv("WAYLAND_DISPLAY");
@@ -117,17 +108,15 @@ int hal_sdl_init(int scale, const char *title)
         SDL_Quit();
         return -1;
     }
-    sdl.win = SDL_CreateWindow(title, SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED,
-                               HAL_WIDTH * scale, HAL_SDL_ASPECT_H * scale, SDL_WINDOW_RESIZABLE);
+    sdl.win = SDL_CreateWindow(title, SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED, HAL_WIDTH * scale,
+                               HAL_SDL_ASPECT_H * scale, SDL_WINDOW_RESIZABLE);
     if (!sdl.win) {
         fail("SDL_CreateWindow");
         goto out;
     }
     sdl.ren = SDL_CreateRenderer(sdl.win, -1, SDL_RENDERER_TARGETTEXTURE);
-    if (!sdl.ren)
-        sdl.ren = SDL_CreateRenderer(sdl.win, -1, 0);
-    if (!sdl.ren)
-        sdl.ren = SDL_CreateRenderer(sdl.win, -1, SDL_RENDERER_SOFTWARE);
+    if (!sdl.ren) sdl.ren = SDL_CreateRenderer(sdl.win, -1, 0);
+    if (!sdl.ren) sdl.ren = SDL_CreateRenderer(sdl.win, -1, SDL_RENDERER_SOFTWARE);
     if (!sdl.ren) {
         fail("SDL_CreateRenderer");
         goto out;
@@ -137,16 +126,15 @@ int hal_sdl_init(int scale, const char *title)
         goto out;
     }
     SDL_SetHint(SDL_HINT_RENDER_SCALE_QUALITY, "nearest");
-    sdl.frame = SDL_CreateTexture(sdl.ren, SDL_PIXELFORMAT_ARGB8888, SDL_TEXTUREACCESS_STREAMING,
-                                  HAL_WIDTH, HAL_HEIGHT);
+    sdl.frame = SDL_CreateTexture(sdl.ren, SDL_PIXELFORMAT_ARGB8888, SDL_TEXTUREACCESS_STREAMING, HAL_WIDTH,
+                                  HAL_HEIGHT);
     if (!sdl.frame) {
         fail("SDL_CreateTexture");
         goto out;
     }
     if (SDL_RenderTargetSupported(sdl.ren)) {
         SDL_SetHint(SDL_HINT_RENDER_SCALE_QUALITY, "linear");
-        sdl.upscaled = SDL_CreateTexture(sdl.ren, SDL_PIXELFORMAT_ARGB8888,
-                                         SDL_TEXTUREACCESS_TARGET, HAL_WIDTH * scale,
+        sdl.upscaled = SDL_CreateTexture(sdl.ren, SDL_PIXELFORMAT_ARGB8888, SDL_TEXTUREACCESS_TARGET, HAL_WIDTH * scale,
                                          HAL_HEIGHT * scale);
         /* NULL: fall back to the direct nearest copy */
     }
@@ -172,8 +160,7 @@ out:
 
 void hal_sdl_quit(void)
 {
-    if (!sdl.win)
-        return;
+    if (!sdl.win) return;
     destroy();
     SDL_Quit();
 }
@@ -207,34 +194,22 @@ static void pump(void)
 
 uint32_t hal_input(void)
 {
-    if (!sdl.win)
-        return 0;
+    if (!sdl.win) return 0;
     pump();
     const Uint8 *k = SDL_GetKeyboardState(NULL);
     uint32_t keys = 0;
     int alt = k[SDL_SCANCODE_LALT] || k[SDL_SCANCODE_RALT];
-    if (k[SDL_SCANCODE_UP])
-        keys |= HAL_KEY_FORWARD;
-    if (k[SDL_SCANCODE_DOWN])
-        keys |= HAL_KEY_BACK;
-    if (k[SDL_SCANCODE_LEFT])
-        keys |= alt ? HAL_KEY_STRAFE_LEFT : HAL_KEY_TURN_LEFT;
-    if (k[SDL_SCANCODE_RIGHT])
-        keys |= alt ? HAL_KEY_STRAFE_RIGHT : HAL_KEY_TURN_RIGHT;
-    if (k[sdl.sc_comma])
-        keys |= HAL_KEY_STRAFE_LEFT;
-    if (k[sdl.sc_period])
-        keys |= HAL_KEY_STRAFE_RIGHT;
-    if (k[SDL_SCANCODE_PAGEUP] || k[sdl.sc_a])
-        keys |= HAL_KEY_FLY_UP;
-    if (k[SDL_SCANCODE_PAGEDOWN] || k[sdl.sc_z])
-        keys |= HAL_KEY_FLY_DOWN;
-    if (k[SDL_SCANCODE_HOME] || k[sdl.sc_q])
-        keys |= HAL_KEY_LOOK_UP;
-    if (k[SDL_SCANCODE_END] || k[sdl.sc_w])
-        keys |= HAL_KEY_LOOK_DOWN;
-    if (k[SDL_SCANCODE_LSHIFT] || k[SDL_SCANCODE_RSHIFT])
-        keys |= HAL_KEY_RUN;
+    if (k[SDL_SCANCODE_UP]) keys |= HAL_KEY_FORWARD;
+    if (k[SDL_SCANCODE_DOWN]) keys |= HAL_KEY_BACK;
+    if (k[SDL_SCANCODE_LEFT]) keys |= alt ? HAL_KEY_STRAFE_LEFT : HAL_KEY_TURN_LEFT;
+    if (k[SDL_SCANCODE_RIGHT]) keys |= alt ? HAL_KEY_STRAFE_RIGHT : HAL_KEY_TURN_RIGHT;
+    if (k[sdl.sc_comma]) keys |= HAL_KEY_STRAFE_LEFT;
+    if (k[sdl.sc_period]) keys |= HAL_KEY_STRAFE_RIGHT;
+    if (k[SDL_SCANCODE_PAGEUP] || k[sdl.sc_a]) keys |= HAL_KEY_FLY_UP;
+    if (k[SDL_SCANCODE_PAGEDOWN] || k[sdl.sc_z]) keys |= HAL_KEY_FLY_DOWN;
+    if (k[SDL_SCANCODE_HOME] || k[sdl.sc_q]) keys |= HAL_KEY_LOOK_UP;
+    if (k[SDL_SCANCODE_END] || k[sdl.sc_w]) keys |= HAL_KEY_LOOK_DOWN;
+    if (k[SDL_SCANCODE_LSHIFT] || k[SDL_SCANCODE_RSHIFT]) keys |= HAL_KEY_RUN;
     keys |= sdl.edges;
     sdl.edges &= ~HAL_KEY_EDGES; /* edges once; quit stays */
     return keys;
@@ -242,21 +217,18 @@ uint32_t hal_input(void)
 
 uint32_t hal_ticks_ms(void)
 {
-    if (!sdl.win)
-        return 0;
+    if (!sdl.win) return 0;
     return SDL_GetTicks() - sdl.t0;
 }
 
 /* ---- show a frame ------------------------------------------------------- */
 void hal_frame_done(void)
 {
-    if (!sdl.win)
-        return;
+    if (!sdl.win) return;
     const uint8_t *palette = hal_target_palette();
     uint32_t lut[256];
     for (int i = 0; i < 256; i++)
-        lut[i] = 0xff000000u | (uint32_t)palette[i * 3] << 16 |
-                 (uint32_t)palette[i * 3 + 1] << 8 | palette[i * 3 + 2];
+        lut[i] = 0xff000000u | (uint32_t)palette[i * 3] << 16 | (uint32_t)palette[i * 3 + 1] << 8 | palette[i * 3 + 2];
 
     const uint8_t *src = hal_target_vram(hal_target_display_start());
     void *pixels;
@@ -265,8 +237,7 @@ void hal_frame_done(void)
         for (int y = 0; y < HAL_HEIGHT; y++) {
             uint32_t *row = (uint32_t *)(void *)((uint8_t *)pixels + (size_t)y * (size_t)pitch);
             const uint8_t *s = src + y * HAL_WIDTH;
-            for (int x = 0; x < HAL_WIDTH; x++)
-                row[x] = lut[s[x]];
+            for (int x = 0; x < HAL_WIDTH; x++) row[x] = lut[s[x]];
         }
         SDL_UnlockTexture(sdl.frame);
     }

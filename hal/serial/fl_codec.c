@@ -25,8 +25,8 @@
 #error "framelink: little-endian targets only"
 #endif
 
-#define D_MAX 8      /* largest |movement| of an edge that continues */
-#define NPOS_BITS 9  /* positions 1..319 */
+#define D_MAX 8     /* largest |movement| of an edge that continues */
+#define NPOS_BITS 9 /* positions 1..319 */
 #define TOTAL_BITS 12
 
 /* Symbols. */
@@ -141,7 +141,7 @@ static uint32_t fmix(uint32_t h)
 typedef unsigned long fl_word __attribute__((may_alias));
 #define WB ((int)sizeof(fl_word))
 #define NW (FL_W / WB)
-#define ONES ((fl_word)~(fl_word)0 / 0xFF)
+#define ONES ((fl_word) ~(fl_word)0 / 0xFF)
 
 /* The first word in [w, end) that differs from bc, or end: the common case,
  * kept tight (one compare and branch per word; on a Cortex-M3 four words per
@@ -152,30 +152,29 @@ FORCE_INLINE const fl_word *skip_equal(const fl_word *w, const fl_word *end, fl_
     /* stops at the first word that differs, or where fewer than four are left */
     const fl_word *end4 = end - 3;
     register const fl_word *p __asm__("r0") = w;
-    __asm__ volatile(
-        "1:  cmp     %[p], %[end4]\n"
-        "    bhs     2f\n"
-        "    ldmia   %[p]!, {r4, r5, r6, r7}\n"
-        "    cmp     r4, %[bc]\n"
-        "    ittt    eq\n"
-        "    cmpeq   r5, %[bc]\n"
-        "    cmpeq   r6, %[bc]\n"
-        "    cmpeq   r7, %[bc]\n"
-        "    beq     1b\n"
-        "    subs    %[p], #16\n" /* which of the four */
-        "    cmp     r4, %[bc]\n"
-        "    bne     2f\n"
-        "    adds    %[p], #4\n"
-        "    cmp     r5, %[bc]\n"
-        "    bne     2f\n"
-        "    adds    %[p], #4\n"
-        "    cmp     r6, %[bc]\n"
-        "    it      eq\n"
-        "    addeq   %[p], #4\n"
-        "2:\n"
-        : [p] "+r"(p)
-        : [end4] "r"(end4), [bc] "r"(bc)
-        : "r4", "r5", "r6", "r7", "cc", "memory");
+    __asm__ volatile("1:  cmp     %[p], %[end4]\n"
+                     "    bhs     2f\n"
+                     "    ldmia   %[p]!, {r4, r5, r6, r7}\n"
+                     "    cmp     r4, %[bc]\n"
+                     "    ittt    eq\n"
+                     "    cmpeq   r5, %[bc]\n"
+                     "    cmpeq   r6, %[bc]\n"
+                     "    cmpeq   r7, %[bc]\n"
+                     "    beq     1b\n"
+                     "    subs    %[p], #16\n" /* which of the four */
+                     "    cmp     r4, %[bc]\n"
+                     "    bne     2f\n"
+                     "    adds    %[p], #4\n"
+                     "    cmp     r5, %[bc]\n"
+                     "    bne     2f\n"
+                     "    adds    %[p], #4\n"
+                     "    cmp     r6, %[bc]\n"
+                     "    it      eq\n"
+                     "    addeq   %[p], #4\n"
+                     "2:\n"
+                     : [p] "+r"(p)
+                     : [end4] "r"(end4), [bc] "r"(bc)
+                     : "r4", "r5", "r6", "r7", "cc", "memory");
     if (p < end4) return p;
     w = p;
 #else
@@ -243,24 +242,23 @@ static int rows_equal(const uint8_t *a, const uint8_t *b, int aligned)
     register const uint8_t *v __asm__("r1") = b;
     uint32_t same;
     const uint8_t *end = a + FL_W;
-    __asm__ volatile(
-        "1:  ldmia   %[u]!, {r4, r5, r6, r7}\n"
-        "    ldmia   %[v]!, {r8, r9, r10, r11}\n"
-        "    cmp     r4, r8\n"
-        "    ittt    eq\n"
-        "    cmpeq   r5, r9\n"
-        "    cmpeq   r6, r10\n"
-        "    cmpeq   r7, r11\n"
-        "    bne     2f\n"
-        "    cmp     %[u], %[end]\n"
-        "    bne     1b\n"
-        "    mov     %[same], #1\n"
-        "    b       3f\n"
-        "2:  mov     %[same], #0\n"
-        "3:\n"
-        : [u] "+r"(u), [v] "+r"(v), [same] "=r"(same)
-        : [end] "r"(end)
-        : "r4", "r5", "r6", "r7", "r8", "r9", "r10", "r11", "cc", "memory");
+    __asm__ volatile("1:  ldmia   %[u]!, {r4, r5, r6, r7}\n"
+                     "    ldmia   %[v]!, {r8, r9, r10, r11}\n"
+                     "    cmp     r4, r8\n"
+                     "    ittt    eq\n"
+                     "    cmpeq   r5, r9\n"
+                     "    cmpeq   r6, r10\n"
+                     "    cmpeq   r7, r11\n"
+                     "    bne     2f\n"
+                     "    cmp     %[u], %[end]\n"
+                     "    bne     1b\n"
+                     "    mov     %[same], #1\n"
+                     "    b       3f\n"
+                     "2:  mov     %[same], #0\n"
+                     "3:\n"
+                     : [u] "+r"(u), [v] "+r"(v), [same] "=r"(same)
+                     : [end] "r"(end)
+                     : "r4", "r5", "r6", "r7", "r8", "r9", "r10", "r11", "cc", "memory");
     return (int)same;
 #else
     const fl_word *u = (const fl_word *)(const void *)a, *v = (const fl_word *)(const void *)b;
@@ -369,8 +367,10 @@ static __attribute__((noinline)) void rc_carry(uint8_t *start, uint8_t *p)
 static __attribute__((noinline)) void rc_norm(rc_enc *r)
 {
     do {
-        if (r->p < r->end) *r->p++ = (uint8_t)(r->low >> 24);
-        else r->overflow = 1;
+        if (r->p < r->end)
+            *r->p++ = (uint8_t)(r->low >> 24);
+        else
+            r->overflow = 1;
         r->low <<= 8;
         r->range <<= 8;
     } while (r->range < (1u << 24));
@@ -416,8 +416,10 @@ static uint32_t rc_finish(rc_enc *r)
     }
     if ((v >> 32) && !r->overflow) rc_carry(r->start, r->p);
     for (int i = 3; i >= 0; i--) {
-        if (r->p < r->end) *r->p++ = (uint8_t)(v >> (8 * i));
-        else r->overflow = 1;
+        if (r->p < r->end)
+            *r->p++ = (uint8_t)(v >> (8 * i));
+        else
+            r->overflow = 1;
     }
     /* at least one byte: 0 means "did not fit" */
     while (r->p > r->start + 1 && r->p[-1] == 0) r->p--;
@@ -460,12 +462,12 @@ static void enc_colour(rc_enc *r, fl_coder *c, int set, int col, int cand0, int 
 typedef struct {
     rc_enc r;
     fl_coder *c;
-    const int32_t *at;      /* the row's transitions */
-    const fl_edges *ref;    /* the row above's edges */
-    fl_edges *out;          /* this row's edges */
-    const uint8_t *above;   /* the row above's pixels, or NULL */
-    uint32_t na, rn;        /* transitions, reference edges */
-    uint32_t i, j, no;      /* next transition, next reference edge, edges out */
+    const int32_t *at;    /* the row's transitions */
+    const fl_edges *ref;  /* the row above's edges */
+    fl_edges *out;        /* this row's edges */
+    const uint8_t *above; /* the row above's pixels, or NULL */
+    uint32_t na, rn;      /* transitions, reference edges */
+    uint32_t i, j, no;    /* next transition, next reference edge, edges out */
     int c0, prev;
 } row_enc;
 
@@ -562,8 +564,7 @@ _Static_assert(offsetof(fl_edges, dv) == NE * sizeof(int32_t) && offsetof(fl_edg
 static __attribute__((noinline)) void enc_row(row_enc *s, int c0ref)
 {
     const int32_t *at = s->at, *rpk = s->ref->pk;
-    if (s->c0 != c0ref)
-        enc_colour(&s->r, s->c, SET_C0, s->c0, s->rn ? (rpk[0] & 0xFF) : -1, -1, c0ref, c0ref);
+    if (s->c0 != c0ref) enc_colour(&s->r, s->c, SET_C0, s->c0, s->rn ? (rpk[0] & 0xFF) : -1, -1, c0ref, c0ref);
     /* pointers into the transitions, the edges above and the edges out: every
      * per-edge value is at a fixed offset from them */
     const int32_t *ap = at, *ae = at + s->na, *rp = rpk, *re = rpk + s->rn;
@@ -730,7 +731,7 @@ uint32_t fl_code_picture(fl_coder *c, const uint8_t *px, const uint8_t *base, ui
 typedef struct {
     uint32_t range, code;
     const uint8_t *p, *end;
-    int bad;            /* the data left the coder's range: corrupt */
+    int bad; /* the data left the coder's range: corrupt */
 } rc_dec;
 
 static inline uint32_t rd_byte(rc_dec *r)

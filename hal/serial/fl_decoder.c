@@ -8,8 +8,8 @@
 
 #define BACK_BYTES 5
 
-void fl_dec_init(fl_decoder *d, uint8_t *frame, uint8_t *work, fl_event_fn on_event, void *ev_ctx,
-                 fl_put_fn back_put, void *back_ctx)
+void fl_dec_init(fl_decoder *d, uint8_t *frame, uint8_t *work, fl_event_fn on_event, void *ev_ctx, fl_put_fn back_put,
+                 void *back_ctx)
 {
     uint8_t *p = (uint8_t *)d;
     for (uint32_t i = 0; i < sizeof *d; i++) p[i] = 0;
@@ -23,8 +23,8 @@ void fl_dec_init(fl_decoder *d, uint8_t *frame, uint8_t *work, fl_event_fn on_ev
     d->window = 4;
 }
 
-void fl_dec_init_pages(fl_decoder *d, uint8_t *page0, uint8_t *page1, uint8_t *work, fl_event_fn on_event,
-                       void *ev_ctx, fl_put_fn back_put, void *back_ctx)
+void fl_dec_init_pages(fl_decoder *d, uint8_t *page0, uint8_t *page1, uint8_t *work, fl_event_fn on_event, void *ev_ctx,
+                       fl_put_fn back_put, void *back_ctx)
 {
     fl_dec_init(d, page0, work, on_event, ev_ctx, back_put, back_ctx);
     d->recon = page1;
@@ -96,7 +96,7 @@ static void frame_msg(fl_decoder *d, const fl_msg *m)
     fl_frame_info info;
     fl_info_unpack(&info, m->payload);
     uint8_t flags = m->payload[FL_INFO_BYTES];
-    info.no_crc = (uint8_t)!(flags & 1u);
+    info.no_crc = (uint8_t) !(flags & 1u);
     uint32_t check = fl_get32(m->payload + FL_INFO_BYTES + 1);
     uint8_t method = m->payload[pre - 1];
     uint32_t base_no = key ? 0 : fl_get32(m->payload + FL_FRAME_PRE);
@@ -126,8 +126,10 @@ static void frame_msg(fl_decoder *d, const fl_msg *m)
         /* end to end: the frame check always, the pixel CRC-32 when it was sent */
         uint32_t crc = crc_update(0, d->recon, FL_FRAME_BYTES);
         uint32_t got = method == FL_METHOD_RAW_HASH ? fl_pixel_hash(d->recon) : fl_frame_check(d->recon);
-        if (got != check || (!info.no_crc && crc != info.crc)) why = FL_R_FRAME_CRC;
-        else info.crc = crc;
+        if (got != check || (!info.no_crc && crc != info.crc))
+            why = FL_R_FRAME_CRC;
+        else
+            info.crc = crc;
     }
 
     fl_event ev;
@@ -164,7 +166,8 @@ static void frame_msg(fl_decoder *d, const fl_msg *m)
     ev.frame_no = m->frame_no;
     ev.info = info;
     emit(d, &ev);
-    if (why != FL_R_NONE) want_key(d, m->frame_no);
+    if (why != FL_R_NONE)
+        want_key(d, m->frame_no);
     else if (!d->have_palette && !d->waiting_key) {
         /* frames but no palette: ask for it (once per keyframe interval of frames) */
         if (d->palette_wait++ % 64u == 0) {
@@ -179,8 +182,8 @@ static void frame_msg(fl_decoder *d, const fl_msg *m)
  * says, at most FL_SCENE_NAME_MAX, all printable. Returns 0, or -1 if invalid. */
 static int hello_unpack(fl_hello *h, const uint8_t *p, uint32_t n)
 {
-    if (n != FL_HELLO_CAPS && (n < FL_HELLO_MIN || n != FL_HELLO_MIN + (uint32_t)p[FL_HELLO_CAPS + 4] ||
-                               n > FL_HELLO_MAX))
+    if (n != FL_HELLO_CAPS &&
+        (n < FL_HELLO_MIN || n != FL_HELLO_MIN + (uint32_t)p[FL_HELLO_CAPS + 4] || n > FL_HELLO_MAX))
         return -1;
     uint32_t len = n == FL_HELLO_CAPS ? 0 : n - FL_HELLO_MIN;
     for (uint32_t i = 0; i < len; i++)
@@ -245,9 +248,7 @@ static void message(fl_decoder *d, const uint8_t *buf, uint32_t len)
         emit(d, &ev);
         return;
     case FL_MSG_KEYFRAME:
-    case FL_MSG_DELTA:
-        frame_msg(d, &m);
-        return;
+    case FL_MSG_DELTA: frame_msg(d, &m); return;
     case FL_MSG_ACK:
     case FL_MSG_KEYREQ:
         if (m.len != BACK_BYTES) break;
@@ -257,9 +258,7 @@ static void message(fl_decoder *d, const uint8_t *buf, uint32_t len)
         ev.frame_no = m.frame_no;
         emit(d, &ev);
         return;
-    default:
-        bad(d, FL_R_TYPE);
-        return;
+    default: bad(d, FL_R_TYPE); return;
     }
     bad(d, FL_R_PAYLOAD);
 }
@@ -270,7 +269,9 @@ void fl_dec_feed(fl_decoder *d, const uint8_t *p, uint32_t n)
         d->count.bytes++;
         int r = fl_reader_byte(&d->rx, p[i]);
         if (r == 0) continue;
-        if (r < 0) bad(d, (fl_reason)-r);
-        else message(d, d->rx.buf, d->rx.len);
+        if (r < 0)
+            bad(d, (fl_reason)-r);
+        else
+            message(d, d->rx.buf, d->rx.len);
     }
 }

@@ -175,8 +175,10 @@ void fl_reader_init(fl_reader *r, uint8_t *buf, uint32_t cap)
 
 static inline void append(fl_reader *r, uint8_t b)
 {
-    if (r->len < r->cap) r->buf[r->len++] = b;
-    else r->broken = FL_R_LONG;
+    if (r->len < r->cap)
+        r->buf[r->len++] = b;
+    else
+        r->broken = FL_R_LONG;
 }
 
 int fl_reader_byte(fl_reader *r, uint8_t b)
@@ -184,9 +186,12 @@ int fl_reader_byte(fl_reader *r, uint8_t b)
     if (b == 0) {
         int res = 0;
         if (r->started) {
-            if (r->broken) res = -(int)r->broken;
-            else if (r->left) res = -(int)FL_R_FRAMING; /* the last block was cut short */
-            else res = 1;
+            if (r->broken)
+                res = -(int)r->broken;
+            else if (r->left)
+                res = -(int)FL_R_FRAMING; /* the last block was cut short */
+            else
+                res = 1;
         }
         r->started = 0;
         r->broken = 0;

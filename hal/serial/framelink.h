@@ -30,14 +30,14 @@
 #define FL_FRAME_BYTES (FL_W * FL_H)
 #define FL_PALETTE_BYTES 768
 
-#define FL_HEADER_BYTES 9          /* version, type, frame u32, payload length u24 */
+#define FL_HEADER_BYTES 9 /* version, type, frame u32, payload length u24 */
 #define FL_CRC_BYTES 4
-#define FL_INFO_BYTES 26           /* fl_frame_info on the wire (without no_crc) */
-#define FL_FRAME_PRE 31            /* info, flags, frame check: the start of every frame payload */
-#define FL_PAYLOAD_MAX 65536u      /* largest payload a receiver accepts */
+#define FL_INFO_BYTES 26      /* fl_frame_info on the wire (without no_crc) */
+#define FL_FRAME_PRE 31       /* info, flags, frame check: the start of every frame payload */
+#define FL_PAYLOAD_MAX 65536u /* largest payload a receiver accepts */
 #define FL_MSG_MAX (FL_HEADER_BYTES + FL_PAYLOAD_MAX + FL_CRC_BYTES)
-#define FL_WINDOW_MAX 32           /* largest flow-control window */
-#define FL_SCENE_NAME_MAX 63       /* longest scene name a HELLO carries */
+#define FL_WINDOW_MAX 32     /* largest flow-control window */
+#define FL_SCENE_NAME_MAX 63 /* longest scene name a HELLO carries */
 
 /* Message types. */
 enum {
@@ -57,25 +57,25 @@ enum { FL_METHOD_RAW = 0, FL_METHOD_EDGE = 1, FL_METHOD_RAW_HASH = 2 };
 
 /* What the receiver knows about a frame besides its pixels. */
 typedef struct {
-    int32_t x, y, z;     /* camera, 16.16 map units (view.h: camera) */
-    int32_t angle;       /* degrees, 16.16 */
-    int32_t look;        /* pixels */
-    uint8_t mode;        /* render mode (render.h) */
-    uint8_t present;     /* present mode (hal.h) */
-    uint32_t crc;        /* crc_update(0, pixels, 64000) */
-    uint8_t no_crc;      /* sender: nonzero if crc was not computed (the link's own frame
+    int32_t x, y, z; /* camera, 16.16 map units (view.h: camera) */
+    int32_t angle;   /* degrees, 16.16 */
+    int32_t look;    /* pixels */
+    uint8_t mode;    /* render mode (render.h) */
+    uint8_t present; /* present mode (hal.h) */
+    uint32_t crc;    /* crc_update(0, pixels, 64000) */
+    uint8_t no_crc;  /* sender: nonzero if crc was not computed (the link's own frame
                           * check still protects the frame; the receiver fills crc in) */
 } fl_frame_info;
 
 /* Sender capabilities and the scene it draws (the HELLO payload). */
 typedef struct {
-    uint8_t version;       /* protocol version the sender speaks */
+    uint8_t version; /* protocol version the sender speaks */
     uint16_t width, height;
-    uint8_t gun_bits;      /* palette bits per gun: 8 */
-    uint16_t key_interval; /* a keyframe at least every this many frames (0: only when needed) */
-    uint8_t window;        /* frames the sender keeps in flight unacknowledged */
-    uint8_t methods;       /* bit per FL_METHOD_* it may use */
-    uint32_t scene_crc;    /* crc_update(0, blob) of the scene's compiled blob; 0: not said */
+    uint8_t gun_bits;                       /* palette bits per gun: 8 */
+    uint16_t key_interval;                  /* a keyframe at least every this many frames (0: only when needed) */
+    uint8_t window;                         /* frames the sender keeps in flight unacknowledged */
+    uint8_t methods;                        /* bit per FL_METHOD_* it may use */
+    uint32_t scene_crc;                     /* crc_update(0, blob) of the scene's compiled blob; 0: not said */
     char scene_name[FL_SCENE_NAME_MAX + 1]; /* printable ASCII, NUL-terminated; "": not said */
 } fl_hello;
 
@@ -86,42 +86,42 @@ typedef void (*fl_put_fn)(void *ctx, const uint8_t *p, uint32_t n);
 
 /* Streaming COBS writer: one 254-byte block buffered at a time. */
 typedef struct {
-    fl_put_fn put;      /* may be NULL: bytes are counted, not sent */
+    fl_put_fn put; /* may be NULL: bytes are counted, not sent */
     void *ctx;
-    uint32_t crc;       /* running crc_update state of the message */
-    uint32_t bytes;     /* encoded bytes written so far (counter) */
-    uint8_t n;          /* data bytes in blk[1..] */
-    uint8_t blk[255];   /* blk[0] is the code byte */
+    uint32_t crc;     /* running crc_update state of the message */
+    uint32_t bytes;   /* encoded bytes written so far (counter) */
+    uint8_t n;        /* data bytes in blk[1..] */
+    uint8_t blk[255]; /* blk[0] is the code byte */
 } fl_writer;
 
 /* Streaming COBS reader: reassembles one message at a time into buf. */
 typedef struct {
     uint8_t *buf;
     uint32_t cap, len;
-    uint8_t left;        /* data bytes left in the current COBS block */
-    uint8_t last_code;   /* code byte of the current block (0: none yet) */
-    uint8_t started;     /* a non-delimiter byte arrived since the last delimiter */
-    uint8_t broken;      /* fl_reason why this segment can no longer be a good message, 0 if none */
+    uint8_t left;      /* data bytes left in the current COBS block */
+    uint8_t last_code; /* code byte of the current block (0: none yet) */
+    uint8_t started;   /* a non-delimiter byte arrived since the last delimiter */
+    uint8_t broken;    /* fl_reason why this segment can no longer be a good message, 0 if none */
 } fl_reader;
 
 /* ---- the picture coder's working memory (both ends) ----------------------- */
 
-#define FL_ROW_EDGES (FL_W)    /* transitions a row can have (< 320) */
-typedef struct {               /* three arrays back to back: pk[k + FL_ROW_EDGES] is dv[k] */
-    int32_t pk[FL_ROW_EDGES];  /* next row's predicted position * 256 + the colour right of the edge */
-    int32_t dv[FL_ROW_EDGES];  /* 256 * how far the edge moved since the row above (0 if unknown) */
-    int32_t vc[FL_ROW_EDGES];  /* velocity class 0..3 (docs/frame-link.md) */
+#define FL_ROW_EDGES (FL_W)   /* transitions a row can have (< 320) */
+typedef struct {              /* three arrays back to back: pk[k + FL_ROW_EDGES] is dv[k] */
+    int32_t pk[FL_ROW_EDGES]; /* next row's predicted position * 256 + the colour right of the edge */
+    int32_t dv[FL_ROW_EDGES]; /* 256 * how far the edge moved since the row above (0 if unknown) */
+    int32_t vc[FL_ROW_EDGES]; /* velocity class 0..3 (docs/frame-link.md) */
     uint32_t n;
 } fl_edges;
 
 #define FL_CTX_COUNT 162
 #define FL_CACHE 4
 typedef struct {
-    fl_edges edges[2];           /* the row above and the row being coded */
-    int32_t at[FL_ROW_EDGES];    /* the row's transitions, x * 256 + colour */
-    uint16_t p[FL_CTX_COUNT];    /* adaptive model: probability of a 0 bit, in 1/4096 */
-    uint8_t cache[FL_CACHE];     /* colours, most recently coded first */
-    uint8_t hashes_valid;        /* encoder: row_hash holds the rows of hashes_of */
+    fl_edges edges[2];        /* the row above and the row being coded */
+    int32_t at[FL_ROW_EDGES]; /* the row's transitions, x * 256 + colour */
+    uint16_t p[FL_CTX_COUNT]; /* adaptive model: probability of a 0 bit, in 1/4096 */
+    uint8_t cache[FL_CACHE];  /* colours, most recently coded first */
+    uint8_t hashes_valid;     /* encoder: row_hash holds the rows of hashes_of */
     const uint8_t *hashes_of;
     uint32_t row_hash[FL_H];
 } fl_coder;
@@ -135,16 +135,16 @@ typedef struct {
     uint32_t ack_timeout_ms; /* a full window that long without an ack is given up. Default 500 */
 
     fl_writer w;
-    uint8_t *scratch;        /* caller's buffer for one coded frame message */
+    uint8_t *scratch; /* caller's buffer for one coded frame message */
     uint32_t scratch_bytes;
-    const uint8_t *palette;  /* last palette sent (kept to answer palette requests) */
+    const uint8_t *palette; /* last palette sent (kept to answer palette requests) */
 
     /* link state */
     uint8_t sent_any, force_key, want_palette, stalled;
-    uint32_t last_sent;      /* frame number of the last frame sent */
-    uint32_t last_key;       /* frame number of the last keyframe sent */
-    uint32_t since_key;      /* frames sent since that keyframe */
-    uint32_t last_coded;     /* coded bytes of the last frame's picture (0: it went raw) */
+    uint32_t last_sent;               /* frame number of the last frame sent */
+    uint32_t last_key;                /* frame number of the last keyframe sent */
+    uint32_t since_key;               /* frames sent since that keyframe */
+    uint32_t last_coded;              /* coded bytes of the last frame's picture (0: it went raw) */
     uint32_t inflight[FL_WINDOW_MAX]; /* numbers of the frames sent and not yet acknowledged (FIFO) */
     uint8_t in_head, in_count;
     uint32_t stall_since_ms;
@@ -209,28 +209,28 @@ int fl_enc_may_send(fl_encoder *e, uint32_t now_ms);
 #define FL_DEC_WORK_BYTES (FL_MSG_MAX + FL_FRAME_BYTES)
 
 typedef enum {
-    FL_EV_HELLO,      /* hello: capabilities in ev->hello */
-    FL_EV_PALETTE,    /* palette: ev->palette (768 bytes) */
-    FL_EV_FRAME,      /* a frame passed every check and is now in the frame buffer */
-    FL_EV_DROP,       /* a frame message arrived intact but was not shown (ev->reason) */
-    FL_EV_BAD,        /* a damaged or invalid message was discarded (ev->reason) */
-    FL_EV_KEYREQ,     /* the decoder sent a keyframe request (ev->frame_no: the frame it could not show) */
-    FL_EV_OTHER       /* an intact message for the other direction (ack/keyreq): ignored */
+    FL_EV_HELLO,   /* hello: capabilities in ev->hello */
+    FL_EV_PALETTE, /* palette: ev->palette (768 bytes) */
+    FL_EV_FRAME,   /* a frame passed every check and is now in the frame buffer */
+    FL_EV_DROP,    /* a frame message arrived intact but was not shown (ev->reason) */
+    FL_EV_BAD,     /* a damaged or invalid message was discarded (ev->reason) */
+    FL_EV_KEYREQ,  /* the decoder sent a keyframe request (ev->frame_no: the frame it could not show) */
+    FL_EV_OTHER    /* an intact message for the other direction (ack/keyreq): ignored */
 } fl_event_kind;
 
 typedef enum {
     FL_R_NONE,
-    FL_R_FRAMING,     /* COBS structure broken */
-    FL_R_SHORT,       /* shorter than header + CRC */
-    FL_R_LONG,        /* longer than FL_MSG_MAX */
-    FL_R_CRC,         /* message CRC mismatch */
-    FL_R_VERSION,     /* unsupported protocol version */
-    FL_R_LENGTH,      /* header length disagrees with the message */
-    FL_R_TYPE,        /* unknown message type */
-    FL_R_PAYLOAD,     /* payload size or layout invalid for its type */
-    FL_R_NO_BASE,     /* delta whose base frame is not the frame shown */
-    FL_R_DECODE,      /* picture data inconsistent */
-    FL_R_FRAME_CRC    /* reconstructed frame does not match its frame check or CRC-32 */
+    FL_R_FRAMING,  /* COBS structure broken */
+    FL_R_SHORT,    /* shorter than header + CRC */
+    FL_R_LONG,     /* longer than FL_MSG_MAX */
+    FL_R_CRC,      /* message CRC mismatch */
+    FL_R_VERSION,  /* unsupported protocol version */
+    FL_R_LENGTH,   /* header length disagrees with the message */
+    FL_R_TYPE,     /* unknown message type */
+    FL_R_PAYLOAD,  /* payload size or layout invalid for its type */
+    FL_R_NO_BASE,  /* delta whose base frame is not the frame shown */
+    FL_R_DECODE,   /* picture data inconsistent */
+    FL_R_FRAME_CRC /* reconstructed frame does not match its frame check or CRC-32 */
 } fl_reason;
 
 typedef struct {
@@ -247,10 +247,10 @@ typedef struct {
 typedef void (*fl_event_fn)(void *ctx, const fl_event *ev);
 
 typedef struct {
-    uint32_t bytes;          /* bytes fed */
-    uint32_t msgs_ok;        /* messages that passed framing, CRC, header and layout checks */
-    uint32_t msgs_bad;       /* non-empty segments that failed them (never acted on) */
-    uint32_t resyncs;        /* good messages right after one or more bad ones */
+    uint32_t bytes;    /* bytes fed */
+    uint32_t msgs_ok;  /* messages that passed framing, CRC, header and layout checks */
+    uint32_t msgs_bad; /* non-empty segments that failed them (never acted on) */
+    uint32_t resyncs;  /* good messages right after one or more bad ones */
     uint32_t frames_shown;
     uint32_t frames_dropped; /* intact frame messages not shown (no base, decode, frame CRC) */
     uint32_t frames_missed;  /* frame numbers skipped between intact frame messages */
@@ -261,21 +261,21 @@ typedef struct {
 } fl_counters;
 
 typedef struct {
-    uint8_t *frame;          /* caller's 64,000 bytes: the frame shown */
-    uint8_t *recon;          /* reconstruction (in work, or the hidden page: fl_dec_init_pages) */
+    uint8_t *frame; /* caller's 64,000 bytes: the frame shown */
+    uint8_t *recon; /* reconstruction (in work, or the hidden page: fl_dec_init_pages) */
     fl_reader rx;
     fl_event_fn on_event;
     void *ev_ctx;
-    fl_writer back;          /* receiver -> sender messages */
-    uint8_t send_acks;       /* default 1 */
-    uint8_t flip;            /* fl_dec_init_pages: a frame is shown by swapping frame and recon */
+    fl_writer back;    /* receiver -> sender messages */
+    uint8_t send_acks; /* default 1 */
+    uint8_t flip;      /* fl_dec_init_pages: a frame is shown by swapping frame and recon */
 
     uint8_t have_frame, have_palette, have_hello, waiting_key, last_bad, have_seen;
-    uint8_t window;          /* from hello (default 4) */
-    uint32_t shown_no;       /* number of the frame in the frame buffer */
-    uint32_t seen_no;        /* highest frame number seen in an intact frame message */
-    uint32_t waiting_drops;  /* frames dropped since the last keyframe request */
-    uint32_t palette_wait;   /* frames shown without a palette */
+    uint8_t window;         /* from hello (default 4) */
+    uint32_t shown_no;      /* number of the frame in the frame buffer */
+    uint32_t seen_no;       /* highest frame number seen in an intact frame message */
+    uint32_t waiting_drops; /* frames dropped since the last keyframe request */
+    uint32_t palette_wait;  /* frames shown without a palette */
     fl_frame_info shown_info;
     fl_hello hello;
     uint8_t palette[FL_PALETTE_BYTES];
@@ -288,8 +288,8 @@ typedef struct {
  * every check. work: FL_DEC_WORK_BYTES. on_event (may be NULL) is called for
  * every event. back_put (may be NULL) receives the acks and keyframe requests
  * the decoder sends to the sender. */
-void fl_dec_init(fl_decoder *d, uint8_t *frame, uint8_t *work, fl_event_fn on_event, void *ev_ctx,
-                 fl_put_fn back_put, void *back_ctx);
+void fl_dec_init(fl_decoder *d, uint8_t *frame, uint8_t *work, fl_event_fn on_event, void *ev_ctx, fl_put_fn back_put,
+                 void *back_ctx);
 
 /* Bytes of work memory a page-flipping decoder needs: one message. */
 #define FL_DEC_PAGES_WORK_BYTES (FL_MSG_MAX)
@@ -299,8 +299,8 @@ void fl_dec_init(fl_decoder *d, uint8_t *frame, uint8_t *work, fl_event_fn on_ev
  * each) take turns. d->frame is the page shown (page0 at first), d->recon the
  * hidden one, which holds anything, even a frame that failed its checks. work:
  * FL_DEC_PAGES_WORK_BYTES. Otherwise as fl_dec_init. */
-void fl_dec_init_pages(fl_decoder *d, uint8_t *page0, uint8_t *page1, uint8_t *work, fl_event_fn on_event,
-                       void *ev_ctx, fl_put_fn back_put, void *back_ctx);
+void fl_dec_init_pages(fl_decoder *d, uint8_t *page0, uint8_t *page1, uint8_t *work, fl_event_fn on_event, void *ev_ctx,
+                       fl_put_fn back_put, void *back_ctx);
 
 /* Feed received bytes, any chunking. Events are reported as messages complete. */
 void fl_dec_feed(fl_decoder *d, const uint8_t *p, uint32_t n);

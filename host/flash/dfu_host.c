@@ -20,8 +20,8 @@ typedef struct eng {
     dfu_host_report *r;
     unsigned timeout_ms, reenum_ms;
     dfu_func_desc desc;
-    int last_xfer;            /* the last transport error, 0 if none */
-    int sent_dnload;          /* a DNLOAD with data reached the device */
+    int last_xfer;   /* the last transport error, 0 if none */
+    int sent_dnload; /* a DNLOAD with data reached the device */
 } eng;
 
 typedef struct dstat {
@@ -46,8 +46,7 @@ const char *dfu_host_strerror(dfu_host_err e)
 
 static void say(eng *e, int level, const char *fmt, ...)
 {
-    if (!e->o || !e->o->log || e->o->verbose < level)
-        return;
+    if (!e->o || !e->o->log || e->o->verbose < level) return;
     char line[512];
     va_list ap;
     va_start(ap, fmt);
@@ -59,8 +58,7 @@ static void say(eng *e, int level, const char *fmt, ...)
 /* The first failure wins; later notes are appended with append(). */
 static void fail(eng *e, dfu_host_err err, const char *fmt, ...)
 {
-    if (e->r->err != DFU_HOST_OK)
-        return;
+    if (e->r->err != DFU_HOST_OK) return;
     e->r->err = err;
     va_list ap;
     va_start(ap, fmt);
@@ -71,8 +69,7 @@ static void fail(eng *e, dfu_host_err err, const char *fmt, ...)
 static void append(eng *e, const char *fmt, ...)
 {
     size_t used = strlen(e->r->msg);
-    if (used + 1 >= sizeof e->r->msg)
-        return;
+    if (used + 1 >= sizeof e->r->msg) return;
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(e->r->msg + used, sizeof e->r->msg - used, fmt, ap);
@@ -102,39 +99,31 @@ static void fail_xfer(eng *e, int x, const char *fmt, ...)
         fail(e, DFU_HOST_NO_DEVICE, "the device vanished (unplugged or reset) during %s", during);
         break;
     case DFU_XFER_TIMEOUT:
-        fail(e, DFU_HOST_TIMEOUT, "the device did not answer within %u ms during %s", e->timeout_ms,
-             during);
+        fail(e, DFU_HOST_TIMEOUT, "the device did not answer within %u ms during %s", e->timeout_ms, during);
         break;
-    case DFU_XFER_STALL:
-        fail(e, DFU_HOST_PROTOCOL, "the device stalled %s", during);
-        break;
-    default:
-        fail(e, DFU_HOST_IO, "USB error during %s%s%s", during, *detail ? ": " : "", detail);
-        break;
+    case DFU_XFER_STALL: fail(e, DFU_HOST_PROTOCOL, "the device stalled %s", during); break;
+    default: fail(e, DFU_HOST_IO, "USB error during %s%s%s", during, *detail ? ": " : "", detail); break;
     }
 }
 
 static int req(eng *e, uint8_t type, uint8_t request, uint16_t value, uint8_t *data, uint16_t len)
 {
     int x = e->t->control(e->t->ctx, type, request, value, data, len, e->timeout_ms);
-    if (x < 0)
-        e->last_xfer = x;
+    if (x < 0) e->last_xfer = x;
     say(e, 2, "  %s wValue=%u wLength=%u -> %d", dfu_request_name(request), value, len, x);
     return x;
 }
 
 static void sleep_ms(eng *e, uint32_t ms)
 {
-    if (ms)
-        e->t->sleep_ms(e->t->ctx, ms);
+    if (ms) e->t->sleep_ms(e->t->ctx, ms);
 }
 
 static int getstatus(eng *e, dstat *s)
 {
     uint8_t b[DFU_GETSTATUS_LEN];
     int x = req(e, DFU_REQTYPE_IN, DFU_REQ_GETSTATUS, 0, b, sizeof b);
-    if (x < 0)
-        return x;
+    if (x < 0) return x;
     if (x < (int)sizeof b) {
         e->last_xfer = DFU_XFER_IO;
         return DFU_XFER_IO;
@@ -146,8 +135,8 @@ static int getstatus(eng *e, dstat *s)
         e->r->dev_status = s->status;
         e->r->dev_state = s->state;
     }
-    say(e, 2, "  GETSTATUS: %s, %s, bwPollTimeout %u ms", dfu_status_name(s->status),
-        dfu_state_name(s->state), (unsigned)s->poll_ms);
+    say(e, 2, "  GETSTATUS: %s, %s, bwPollTimeout %u ms", dfu_status_name(s->status), dfu_state_name(s->state),
+        (unsigned)s->poll_ms);
     return 0;
 }
 
@@ -158,8 +147,8 @@ static void fail_device(eng *e, const dstat *s, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(where, sizeof where, fmt, ap);
     va_end(ap);
-    fail(e, DFU_HOST_DEVICE_ERROR, "the device reported %s (%s) %s, in state %s",
-         dfu_status_name(s->status), dfu_status_text(s->status), where, dfu_state_name(s->state));
+    fail(e, DFU_HOST_DEVICE_ERROR, "the device reported %s (%s) %s, in state %s", dfu_status_name(s->status),
+         dfu_status_text(s->status), where, dfu_state_name(s->state));
 }
 
 /* After a failure: bring a reachable device back to dfuIDLE (CLRSTATUS out of
@@ -187,23 +176,20 @@ static void recover(eng *e)
         }
         if (s.state == DFU_STATE_ERROR) {
             say(e, 1, "sending CLRSTATUS");
-            if (req(e, DFU_REQTYPE_OUT, DFU_REQ_CLRSTATUS, 0, NULL, 0) < 0)
-                return;
+            if (req(e, DFU_REQTYPE_OUT, DFU_REQ_CLRSTATUS, 0, NULL, 0) < 0) return;
             append(e, "; sent CLRSTATUS");
         } else if (s.state == DFU_STATE_DNLOAD_IDLE || s.state == DFU_STATE_UPLOAD_IDLE) {
             say(e, 1, "sending ABORT");
-            if (req(e, DFU_REQTYPE_OUT, DFU_REQ_ABORT, 0, NULL, 0) < 0)
-                return;
+            if (req(e, DFU_REQTYPE_OUT, DFU_REQ_ABORT, 0, NULL, 0) < 0) return;
             append(e, "; sent ABORT");
-        } else if (s.state == DFU_STATE_DNBUSY || s.state == DFU_STATE_MANIFEST ||
-                   s.state == DFU_STATE_DNLOAD_SYNC || s.state == DFU_STATE_MANIFEST_SYNC) {
+        } else if (s.state == DFU_STATE_DNBUSY || s.state == DFU_STATE_MANIFEST || s.state == DFU_STATE_DNLOAD_SYNC ||
+                   s.state == DFU_STATE_MANIFEST_SYNC) {
             sleep_ms(e, s.poll_ms);
         } else {
             break;
         }
     }
-    if (s.state == DFU_STATE_IDLE)
-        append(e, "; the device is back in dfuIDLE");
+    if (s.state == DFU_STATE_IDLE) append(e, "; the device is back in dfuIDLE");
     if (e->sent_dnload)
         append(e, ". No firmware was marked valid: the device stays in its bootloader; run the "
                   "download again");
@@ -218,8 +204,7 @@ static int reset_and_wait(eng *e, const char *why)
     x = e->t->reenumerate(e->t->ctx, e->reenum_ms);
     if (x >= 0) {
         e->last_xfer = 0;
-        if (x == 1)
-            e->t->functional(e->t->ctx, &e->desc);
+        if (x == 1) e->t->functional(e->t->ctx, &e->desc);
     }
     return x;
 }
@@ -259,11 +244,11 @@ static int detach(eng *e, uint8_t state)
 static int fits(eng *e, size_t len)
 {
     uint32_t cap = e->desc.app_capacity;
-    if (cap == 0 || len <= cap)
-        return 1;
-    fail(e, DFU_HOST_BAD_IMAGE, "the image's %zu bytes of firmware do not fit the device's "
-         "application area of %u bytes; nothing was sent, the device keeps its firmware", len,
-         (unsigned)cap);
+    if (cap == 0 || len <= cap) return 1;
+    fail(e, DFU_HOST_BAD_IMAGE,
+         "the image's %zu bytes of firmware do not fit the device's "
+         "application area of %u bytes; nothing was sent, the device keeps its firmware",
+         len, (unsigned)cap);
     return 0;
 }
 
@@ -279,8 +264,7 @@ static int to_idle(eng *e)
             return -1;
         }
         switch (s.state) {
-        case DFU_STATE_IDLE:
-            return 0;
+        case DFU_STATE_IDLE: return 0;
         case DFU_STATE_APP_IDLE:
         case DFU_STATE_APP_DETACH:
             if (detached) {
@@ -288,8 +272,7 @@ static int to_idle(eng *e)
                      dfu_state_name(s.state));
                 return -1;
             }
-            if (detach(e, s.state) < 0)
-                return -1;
+            if (detach(e, s.state) < 0) return -1;
             detached = 1;
             break;
         case DFU_STATE_ERROR:
@@ -311,22 +294,18 @@ static int to_idle(eng *e)
         case DFU_STATE_DNLOAD_SYNC:
         case DFU_STATE_DNBUSY:
         case DFU_STATE_MANIFEST_SYNC:
-        case DFU_STATE_MANIFEST:
-            sleep_ms(e, s.poll_ms ? s.poll_ms : 1);
-            break;
+        case DFU_STATE_MANIFEST: sleep_ms(e, s.poll_ms ? s.poll_ms : 1); break;
         case DFU_STATE_MANIFEST_WAIT_RESET:
             if ((x = reset_and_wait(e, "the device waits for a reset")) != 1) {
                 fail(e, DFU_HOST_TIMEOUT, "the device did not come back in DFU mode after a reset");
                 return -1;
             }
             break;
-        default:
-            fail(e, DFU_HOST_PROTOCOL, "the device reports an unknown state %u", s.state);
-            return -1;
+        default: fail(e, DFU_HOST_PROTOCOL, "the device reports an unknown state %u", s.state); return -1;
         }
     }
-    fail(e, DFU_HOST_PROTOCOL, "the device did not reach dfuIDLE (last: %s, %s)",
-         dfu_state_name(s.state), dfu_status_name(s.status));
+    fail(e, DFU_HOST_PROTOCOL, "the device did not reach dfuIDLE (last: %s, %s)", dfu_state_name(s.state),
+         dfu_status_name(s.status));
     return -1;
 }
 
@@ -342,22 +321,20 @@ static int wait_block(eng *e, uint32_t blk)
         }
         if (s.status != DFU_STATUS_OK || s.state == DFU_STATE_ERROR) {
             size_t end = e->r->bytes_done + e->r->transfer_size;
-            if (end > e->r->payload_len)
-                end = e->r->payload_len;
-            fail_device(e, &s, "while writing block %u of %u (image bytes %zu..%zu)", blk + 1,
-                        e->r->blocks_total, e->r->bytes_done, end - 1);
+            if (end > e->r->payload_len) end = e->r->payload_len;
+            fail_device(e, &s, "while writing block %u of %u (image bytes %zu..%zu)", blk + 1, e->r->blocks_total,
+                        e->r->bytes_done, end - 1);
             return -1;
         }
         switch (s.state) {
-        case DFU_STATE_DNLOAD_IDLE:
-            return 0;
+        case DFU_STATE_DNLOAD_IDLE: return 0;
         case DFU_STATE_DNBUSY:
         case DFU_STATE_DNLOAD_SYNC:
-            sleep_ms(e, s.poll_ms);   /* the device asked for this much time */
+            sleep_ms(e, s.poll_ms); /* the device asked for this much time */
             break;
         default:
-            fail(e, DFU_HOST_PROTOCOL, "after block %u the device is in %s, not dfuDNLOAD-IDLE",
-                 blk + 1, dfu_state_name(s.state));
+            fail(e, DFU_HOST_PROTOCOL, "after block %u the device is in %s, not dfuDNLOAD-IDLE", blk + 1,
+                 dfu_state_name(s.state));
             return -1;
         }
     }
@@ -386,8 +363,9 @@ static int manifest(eng *e, uint32_t blk)
         x = getstatus(e, &s);
         if (x < 0) {
             if (!tolerant && polls > 0) {
-                say(e, 1, "no answer during manifestation (normal for a device that is not "
-                          "manifestation-tolerant)");
+                say(e, 1,
+                    "no answer during manifestation (normal for a device that is not "
+                    "manifestation-tolerant)");
                 e->last_xfer = 0;
                 return 0;
             }
@@ -400,16 +378,11 @@ static int manifest(eng *e, uint32_t blk)
         }
         switch (s.state) {
         case DFU_STATE_MANIFEST_SYNC:
-        case DFU_STATE_MANIFEST:
-            sleep_ms(e, s.poll_ms);
-            break;
+        case DFU_STATE_MANIFEST: sleep_ms(e, s.poll_ms); break;
         case DFU_STATE_IDLE:
-        case DFU_STATE_MANIFEST_WAIT_RESET:
-            e->r->manifested = 1;
-            return 0;
+        case DFU_STATE_MANIFEST_WAIT_RESET: e->r->manifested = 1; return 0;
         default:
-            fail(e, DFU_HOST_PROTOCOL, "during manifestation the device is in %s",
-                 dfu_state_name(s.state));
+            fail(e, DFU_HOST_PROTOCOL, "during manifestation the device is in %s", dfu_state_name(s.state));
             return -1;
         }
     }
@@ -424,8 +397,10 @@ static void finish(eng *e)
     int x = reset_and_wait(e, "to run the new firmware");
     if (x < 0) {
         r->reenumerated = -1;
-        append(e, "; the device did not re-enumerate within %u ms (an application without USB "
-                  "does not)", e->reenum_ms);
+        append(e,
+               "; the device did not re-enumerate within %u ms (an application without USB "
+               "does not)",
+               e->reenum_ms);
         return;
     }
     r->reenumerated = x;
@@ -442,7 +417,8 @@ static void finish(eng *e)
     if (s.state == DFU_STATE_ERROR) {
         fail(e, DFU_HOST_DEVICE_ERROR,
              "after the reset the device reports %s (%s): it did not accept the new firmware and "
-             "stays in DFU mode", dfu_status_name(s.status), dfu_status_text(s.status));
+             "stays in DFU mode",
+             dfu_status_name(s.status), dfu_status_text(s.status));
     } else if (s.state == DFU_STATE_APP_IDLE || s.state == DFU_STATE_APP_DETACH) {
         append(e, "; the device re-enumerated and runs the new firmware (%s)", dfu_state_name(s.state));
     } else {
@@ -469,8 +445,8 @@ static void engine_init(eng *e, const dfu_transport *t, const dfu_host_opts *o, 
     t->functional(t->ctx, &e->desc);
 }
 
-dfu_host_err dfu_host_download(const dfu_transport *t, const uint8_t *payload, size_t len,
-                               const dfu_host_opts *o, dfu_host_report *r)
+dfu_host_err dfu_host_download(const dfu_transport *t, const uint8_t *payload, size_t len, const dfu_host_opts *o,
+                               dfu_host_report *r)
 {
     eng e;
     report_init(r, len);
@@ -482,17 +458,16 @@ dfu_host_err dfu_host_download(const dfu_transport *t, const uint8_t *payload, s
     r->payload_crc = crc_update(0, payload, len);
     uint16_t want = e.o->transfer_size;
     if (want && e.desc.transfer_size && want > e.desc.transfer_size) {
-        fail(&e, DFU_HOST_BAD_ARGS, "transfer size %u is larger than the device's wTransferSize %u",
-             want, e.desc.transfer_size);
+        fail(&e, DFU_HOST_BAD_ARGS, "transfer size %u is larger than the device's wTransferSize %u", want,
+             e.desc.transfer_size);
         return r->err;
     }
-    if (!fits(&e, len))
-        return r->err;
+    if (!fits(&e, len)) return r->err;
     if (to_idle(&e) < 0) {
         recover(&e);
         return r->err;
     }
-    if (!fits(&e, len))   /* the descriptor may have changed with DETACH */
+    if (!fits(&e, len)) /* the descriptor may have changed with DETACH */
         return r->err;
     if (!(e.desc.attributes & DFU_ATTR_CAN_DNLOAD)) {
         fail(&e, DFU_HOST_BAD_ARGS, "the device does not accept downloads (bitCanDnload is 0)");
@@ -504,14 +479,13 @@ dfu_host_err dfu_host_download(const dfu_transport *t, const uint8_t *payload, s
         return r->err;
     }
     if (e.desc.transfer_size && ts > e.desc.transfer_size) {
-        fail(&e, DFU_HOST_BAD_ARGS, "transfer size %u is larger than the device's wTransferSize %u",
-             ts, e.desc.transfer_size);
+        fail(&e, DFU_HOST_BAD_ARGS, "transfer size %u is larger than the device's wTransferSize %u", ts,
+             e.desc.transfer_size);
         return r->err;
     }
     r->transfer_size = ts;
     r->blocks_total = (uint32_t)((len + ts - 1) / ts);
-    if (r->blocks_total > 0xFFFFu)
-        say(&e, 1, "%u blocks: the 16-bit block number wraps around", r->blocks_total);
+    if (r->blocks_total > 0xFFFFu) say(&e, 1, "%u blocks: the 16-bit block number wraps around", r->blocks_total);
     uint8_t *buf = malloc(ts);
     if (!buf) {
         fail(&e, DFU_HOST_IO, "out of memory");
@@ -523,32 +497,27 @@ dfu_host_err dfu_host_download(const dfu_transport *t, const uint8_t *payload, s
         uint16_t n = (uint16_t)(len - off < ts ? len - off : ts);
         memcpy(buf, payload + off, n);
         int x = req(&e, DFU_REQTYPE_OUT, DFU_REQ_DNLOAD, (uint16_t)blk, buf, n);
-        if (x >= 0)
-            e.sent_dnload = 1;
+        if (x >= 0) e.sent_dnload = 1;
         dstat s;
         if (x == DFU_XFER_STALL && getstatus(&e, &s) == 0) {
             fail_device(&e, &s, "and refused block %u of %u", blk + 1, r->blocks_total);
             goto failed;
         }
         if (x < 0) {
-            fail_xfer(&e, x, "DNLOAD of block %u of %u (image bytes %zu..%zu)", blk + 1,
-                      r->blocks_total, off, off + n - 1);
+            fail_xfer(&e, x, "DNLOAD of block %u of %u (image bytes %zu..%zu)", blk + 1, r->blocks_total, off,
+                      off + n - 1);
             goto failed;
         }
-        if (wait_block(&e, blk) < 0)
-            goto failed;
+        if (wait_block(&e, blk) < 0) goto failed;
         off += n;
         r->blocks_done = blk + 1;
         r->bytes_done = off;
-        if (e.o->progress)
-            e.o->progress(e.o->user, off, len);
+        if (e.o->progress) e.o->progress(e.o->user, off, len);
     }
     free(buf);
     buf = NULL;
-    if (manifest(&e, blk) < 0)
-        goto failed;
-    snprintf(r->msg, sizeof r->msg, "downloaded %zu bytes in %u blocks of %u bytes; %s", len,
-             r->blocks_total, ts,
+    if (manifest(&e, blk) < 0) goto failed;
+    snprintf(r->msg, sizeof r->msg, "downloaded %zu bytes in %u blocks of %u bytes; %s", len, r->blocks_total, ts,
              r->manifested ? "the device verified the image and marked it valid"
                            : "manifestation not confirmed by the device");
     finish(&e);
@@ -559,20 +528,18 @@ failed:
     return r->err;
 }
 
-dfu_host_err dfu_host_flash(const dfu_transport *t, const uint8_t *file, size_t len,
-                            uint16_t vid, uint16_t pid, const dfu_host_opts *o,
-                            dfu_host_report *r)
+dfu_host_err dfu_host_flash(const dfu_transport *t, const uint8_t *file, size_t len, uint16_t vid, uint16_t pid,
+                            const dfu_host_opts *o, dfu_host_report *r)
 {
     dfu_image_t img;
     dfu_image_err ie = dfu_image_parse(file, len, &img);
-    if (ie == DFU_IMAGE_OK)
-        ie = dfu_image_match(&img, vid, pid);
+    if (ie == DFU_IMAGE_OK) ie = dfu_image_match(&img, vid, pid);
     if (ie != DFU_IMAGE_OK) {
         report_init(r, 0);
         r->err = DFU_HOST_BAD_IMAGE;
         if (ie == DFU_IMAGE_BAD_CRC)
-            snprintf(r->msg, sizeof r->msg, "%s (suffix dwCRC 0x%08x, computed 0x%08x)",
-                     dfu_image_strerror(ie), (unsigned)img.crc_stored, (unsigned)img.crc_computed);
+            snprintf(r->msg, sizeof r->msg, "%s (suffix dwCRC 0x%08x, computed 0x%08x)", dfu_image_strerror(ie),
+                     (unsigned)img.crc_stored, (unsigned)img.crc_computed);
         else if (ie == DFU_IMAGE_WRONG_VENDOR || ie == DFU_IMAGE_WRONG_PRODUCT)
             snprintf(r->msg, sizeof r->msg, "%s: the image is for %04x:%04x, the device is %04x:%04x",
                      dfu_image_strerror(ie), img.id_vendor, img.id_product, vid, pid);

@@ -17,17 +17,17 @@ typedef struct dfu_usb dfu_usb;
 
 typedef enum dfu_usb_err {
     DFU_USB_OK = 0,
-    DFU_USB_NOT_FOUND,    /* no device with that VID:PID (and serial), or no DFU interface */
-    DFU_USB_AMBIGUOUS,    /* several match: --serial needed */
-    DFU_USB_ACCESS,       /* no permission */
-    DFU_USB_BUSY,         /* interface claimed by another program */
-    DFU_USB_ERROR,        /* anything else */
+    DFU_USB_NOT_FOUND, /* no device with that VID:PID (and serial), or no DFU interface */
+    DFU_USB_AMBIGUOUS, /* several match: --serial needed */
+    DFU_USB_ACCESS,    /* no permission */
+    DFU_USB_BUSY,      /* interface claimed by another program */
+    DFU_USB_ERROR,     /* anything else */
 } dfu_usb_err;
 
 /* Open the DFU interface of the device vid:pid (serial may be NULL). On failure *out
  * is NULL and msg holds the explanation. */
-dfu_usb_err dfu_usb_open(dfu_usb **out, uint16_t vid, uint16_t pid, const char *serial,
-                         int verbose, char *msg, size_t msglen);
+dfu_usb_err dfu_usb_open(dfu_usb **out, uint16_t vid, uint16_t pid, const char *serial, int verbose, char *msg,
+                         size_t msglen);
 void dfu_usb_close(dfu_usb *u);
 dfu_transport dfu_usb_transport(dfu_usb *u);
 

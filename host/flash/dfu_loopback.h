@@ -18,23 +18,23 @@ typedef enum dfu_loop_op { DFU_LOOP_ERASE, DFU_LOOP_PROGRAM, DFU_LOOP_READ } dfu
 
 /* What a flash hook decides for an operation about to happen. */
 enum {
-    DFU_LOOP_PASS = 0,        /* do it */
-    DFU_LOOP_FAIL = 1,        /* do nothing, report failure */
-    DFU_LOOP_CORRUPT = 2,     /* do it with one bit flipped, report success */
+    DFU_LOOP_PASS = 0,    /* do it */
+    DFU_LOOP_FAIL = 1,    /* do nothing, report failure */
+    DFU_LOOP_CORRUPT = 2, /* do it with one bit flipped, report success */
 };
 
 typedef struct dfu_loopback {
     dfu_dev_t dev;
     dfu_dev_config_t cfg;
     dfu_flash_t flash;
-    uint8_t *mem;                   /* the RAM flash, flash.size bytes */
-    uint32_t now_ms;                /* the fake clock */
-    uint32_t reenum_ms;             /* simulated time to re-enumerate (default 300) */
+    uint8_t *mem;       /* the RAM flash, flash.size bytes */
+    uint32_t now_ms;    /* the fake clock */
+    uint32_t reenum_ms; /* simulated time to re-enumerate (default 300) */
     /* counters */
-    unsigned long requests;         /* control transfers that reached the device */
-    unsigned long by_request[7];    /* ... per bRequest */
+    unsigned long requests;      /* control transfers that reached the device */
+    unsigned long by_request[7]; /* ... per bRequest */
     unsigned long stalls, resets, erases, programs, reads;
-    unsigned long slept_ms;         /* total time the host slept */
+    unsigned long slept_ms; /* total time the host slept */
     /* faults: after this many requests the device vanishes (NO_DEVICE) or stops
      * answering (TIMEOUT); -1 = never */
     long vanish_after, timeout_after;
@@ -56,8 +56,8 @@ dfu_dev_config_t dfu_loop_default_config(void);
 /* Create a loopback device with an erased flash of flash_size bytes in pages of
  * page_size; it powers on (dfu_dev_init) with stay_in_dfu. Returns 0, or -1 (bad
  * geometry or configuration, out of memory). */
-int dfu_loop_init(dfu_loopback *lb, const dfu_dev_config_t *cfg, uint32_t flash_size,
-                  uint32_t page_size, int stay_in_dfu);
+int dfu_loop_init(dfu_loopback *lb, const dfu_dev_config_t *cfg, uint32_t flash_size, uint32_t page_size,
+                  int stay_in_dfu);
 void dfu_loop_free(dfu_loopback *lb);
 
 /* Unplug and plug in again: clears the faults, powers the device on again from what

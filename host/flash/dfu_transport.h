@@ -11,15 +11,15 @@
 /* Errors a transport returns (negative); success is >= 0. */
 enum dfu_xfer_err {
     DFU_XFER_OK = 0,
-    DFU_XFER_STALL = -1,      /* the device stalled the request */
-    DFU_XFER_TIMEOUT = -2,    /* no answer within the timeout */
-    DFU_XFER_NO_DEVICE = -3,  /* the device is gone (unplugged, reset away) */
-    DFU_XFER_IO = -4,         /* any other USB error (see last_error) */
+    DFU_XFER_STALL = -1,     /* the device stalled the request */
+    DFU_XFER_TIMEOUT = -2,   /* no answer within the timeout */
+    DFU_XFER_NO_DEVICE = -3, /* the device is gone (unplugged, reset away) */
+    DFU_XFER_IO = -4,        /* any other USB error (see last_error) */
 };
 
 /* The DFU functional descriptor of the interface in use. */
 typedef struct dfu_func_desc {
-    uint8_t attributes;          /* DFU_ATTR_* */
+    uint8_t attributes; /* DFU_ATTR_* */
     uint16_t detach_timeout_ms;
     uint16_t transfer_size;
     uint16_t bcd_dfu;
@@ -34,8 +34,8 @@ typedef struct dfu_transport {
     /* One control transfer to the DFU interface: bm_request_type DFU_REQTYPE_OUT
      * (data holds length bytes) or DFU_REQTYPE_IN (data receives up to length bytes).
      * Returns the bytes transferred, or a DFU_XFER_* error. */
-    int (*control)(void *ctx, uint8_t bm_request_type, uint8_t b_request, uint16_t w_value,
-                   uint8_t *data, uint16_t length, unsigned timeout_ms);
+    int (*control)(void *ctx, uint8_t bm_request_type, uint8_t b_request, uint16_t w_value, uint8_t *data,
+                   uint16_t length, unsigned timeout_ms);
     /* Wait this long (the device's bwPollTimeout). */
     void (*sleep_ms)(void *ctx, uint32_t ms);
     /* USB reset of the device; DFU_XFER_OK, or an error (NO_DEVICE is normal when

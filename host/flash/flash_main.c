@@ -29,75 +29,73 @@ enum { EXIT_USAGE = 1, EXIT_IMAGE = 2, EXIT_DEVICE = 3, EXIT_DOWNLOAD = 4 };
 
 static void usage(FILE *f)
 {
-    fputs(
-"build/flash - download firmware to a device over USB DFU 1.1\n"
-"\n"
-"Usage:\n"
-"  build/flash IMAGE.dfu --device VID:PID [--serial SN] [options]\n"
-"  build/flash IMAGE.dfu --loopback [--device VID:PID] [options]\n"
-"  build/flash --add-suffix IN.bin --vid VID --pid PID [--bcd-device BCD] -o OUT.dfu\n"
-"  build/flash --check IMAGE.dfu [--device VID:PID]\n"
-"  build/flash --list\n"
-"  build/flash --help\n"
-"\n"
-"Download (the first form). IMAGE is a DFU file: the firmware binary followed by a\n"
-"16-byte DFU suffix (make one with --add-suffix). The whole file is checked first -\n"
-"suffix signature, length, CRC, DFU version, and that the VID:PID it names is the\n"
-"device's (or FFFF, any) - and a corrupted or truncated file is refused before\n"
-"anything is sent. Then the device is brought to DFU mode (DETACH from its\n"
-"application, CLRSTATUS out of an error, ABORT of an old transfer), the firmware goes\n"
-"out in DNLOAD blocks, each followed by GETSTATUS polls that wait as long as the\n"
-"device asks (bwPollTimeout), the device checks the whole image and marks it valid\n"
-"(manifestation), and is reset; build/flash waits for it to come back and says what\n"
-"it runs. If a download fails part way, the device stays in its bootloader with no\n"
-"application marked valid (never half of one): run the same command again.\n"
-"\n"
-"  --device VID:PID     the device, in hex as lsusb shows it (e.g. 1209:0001)\n"
-"  --serial SN          which one, when several devices with that VID:PID are attached\n"
-"  --transfer-size N    bytes per DNLOAD block (default and maximum: the device's\n"
-"                       wTransferSize)\n"
-"  --timeout MS         how long to wait for each USB request (default 5000)\n"
-"  --reenum-timeout MS  how long to wait for the device after a reset (default 10000)\n"
-"  -v, --verbose        say each step; twice (-vv): every DFU request\n"
-"  --list               list the attached devices that have a DFU interface\n"
-"\n"
-"Without hardware. --loopback downloads into a simulated device instead of USB: the\n"
-"project's own bootloader state machine (firmware/dfu/) over 4 MiB of RAM flash in\n"
-"4 KiB pages, wTransferSize 4096, with simulated time, so you can watch a download\n"
-"succeed (add -v) and see what the device holds afterwards. It is the project's\n"
-"device, 1209:0001, so an image made for another VID:PID is refused as by the real\n"
-"one. --loopback-unplug-after N unplugs the simulated device after N requests,\n"
-"to show what an interrupted download leaves behind.\n"
-"\n"
-"Making an image. --add-suffix IN.bin --vid VID --pid PID -o OUT.dfu appends the DFU\n"
-"suffix to a raw binary (VID, PID and --bcd-device in hex, FFFF = any; bcdDevice\n"
-"defaults to FFFF). --check IMAGE.dfu validates an image and prints its suffix.\n"
-"\n"
-"Permissions. On Linux an ordinary user may not open USB devices: install the udev\n"
-"rule given in docs/flashing.md, or run as root.\n"
-"\n"
-"Exit status: 0 done; 1 usage error; 2 image rejected (nothing was sent);\n"
-"3 device not found, several found (use --serial), or no permission;\n"
-"4 the download failed (device error, timeout, device vanished).\n"
-"\n"
-"Examples:\n"
-"  build/flash --add-suffix firmware.bin --vid 1209 --pid 0001 -o firmware.dfu\n"
-"  build/flash firmware.dfu --loopback -v\n"
-"  build/flash firmware.dfu --device 1209:0001\n"
-"  build/flash firmware.dfu --device 1209:0001 --serial 0042 --transfer-size 1024\n"
-"\n"
-"More: docs/flashing.md (image format, what the bootloader guarantees).\n", f);
+    fputs("build/flash - download firmware to a device over USB DFU 1.1\n"
+          "\n"
+          "Usage:\n"
+          "  build/flash IMAGE.dfu --device VID:PID [--serial SN] [options]\n"
+          "  build/flash IMAGE.dfu --loopback [--device VID:PID] [options]\n"
+          "  build/flash --add-suffix IN.bin --vid VID --pid PID [--bcd-device BCD] -o OUT.dfu\n"
+          "  build/flash --check IMAGE.dfu [--device VID:PID]\n"
+          "  build/flash --list\n"
+          "  build/flash --help\n"
+          "\n"
+          "Download (the first form). IMAGE is a DFU file: the firmware binary followed by a\n"
+          "16-byte DFU suffix (make one with --add-suffix). The whole file is checked first -\n"
+          "suffix signature, length, CRC, DFU version, and that the VID:PID it names is the\n"
+          "device's (or FFFF, any) - and a corrupted or truncated file is refused before\n"
+          "anything is sent. Then the device is brought to DFU mode (DETACH from its\n"
+          "application, CLRSTATUS out of an error, ABORT of an old transfer), the firmware goes\n"
+          "out in DNLOAD blocks, each followed by GETSTATUS polls that wait as long as the\n"
+          "device asks (bwPollTimeout), the device checks the whole image and marks it valid\n"
+          "(manifestation), and is reset; build/flash waits for it to come back and says what\n"
+          "it runs. If a download fails part way, the device stays in its bootloader with no\n"
+          "application marked valid (never half of one): run the same command again.\n"
+          "\n"
+          "  --device VID:PID     the device, in hex as lsusb shows it (e.g. 1209:0001)\n"
+          "  --serial SN          which one, when several devices with that VID:PID are attached\n"
+          "  --transfer-size N    bytes per DNLOAD block (default and maximum: the device's\n"
+          "                       wTransferSize)\n"
+          "  --timeout MS         how long to wait for each USB request (default 5000)\n"
+          "  --reenum-timeout MS  how long to wait for the device after a reset (default 10000)\n"
+          "  -v, --verbose        say each step; twice (-vv): every DFU request\n"
+          "  --list               list the attached devices that have a DFU interface\n"
+          "\n"
+          "Without hardware. --loopback downloads into a simulated device instead of USB: the\n"
+          "project's own bootloader state machine (firmware/dfu/) over 4 MiB of RAM flash in\n"
+          "4 KiB pages, wTransferSize 4096, with simulated time, so you can watch a download\n"
+          "succeed (add -v) and see what the device holds afterwards. It is the project's\n"
+          "device, 1209:0001, so an image made for another VID:PID is refused as by the real\n"
+          "one. --loopback-unplug-after N unplugs the simulated device after N requests,\n"
+          "to show what an interrupted download leaves behind.\n"
+          "\n"
+          "Making an image. --add-suffix IN.bin --vid VID --pid PID -o OUT.dfu appends the DFU\n"
+          "suffix to a raw binary (VID, PID and --bcd-device in hex, FFFF = any; bcdDevice\n"
+          "defaults to FFFF). --check IMAGE.dfu validates an image and prints its suffix.\n"
+          "\n"
+          "Permissions. On Linux an ordinary user may not open USB devices: install the udev\n"
+          "rule given in docs/flashing.md, or run as root.\n"
+          "\n"
+          "Exit status: 0 done; 1 usage error; 2 image rejected (nothing was sent);\n"
+          "3 device not found, several found (use --serial), or no permission;\n"
+          "4 the download failed (device error, timeout, device vanished).\n"
+          "\n"
+          "Examples:\n"
+          "  build/flash --add-suffix firmware.bin --vid 1209 --pid 0001 -o firmware.dfu\n"
+          "  build/flash firmware.dfu --loopback -v\n"
+          "  build/flash firmware.dfu --device 1209:0001\n"
+          "  build/flash firmware.dfu --device 1209:0001 --serial 0042 --transfer-size 1024\n"
+          "\n"
+          "More: docs/flashing.md (image format, what the bootloader guarantees).\n",
+          f);
 }
 
 static int parse_hex16(const char *s, uint16_t *out)
 {
     char *end;
-    if (!s || !*s)
-        return -1;
+    if (!s || !*s) return -1;
     errno = 0;
     unsigned long v = strtoul(s, &end, 16);
-    if (errno || *end || v > 0xFFFFu || s[0] == '-' || s[0] == '+')
-        return -1;
+    if (errno || *end || v > 0xFFFFu || s[0] == '-' || s[0] == '+') return -1;
     *out = (uint16_t)v;
     return 0;
 }
@@ -106,8 +104,7 @@ static int parse_vidpid(const char *s, uint16_t *vid, uint16_t *pid)
 {
     char buf[32];
     const char *colon = s ? strchr(s, ':') : NULL;
-    if (!colon || (size_t)(colon - s) >= sizeof buf)
-        return -1;
+    if (!colon || (size_t)(colon - s) >= sizeof buf) return -1;
     memcpy(buf, s, (size_t)(colon - s));
     buf[colon - s] = 0;
     return parse_hex16(buf, vid) || parse_hex16(colon + 1, pid) ? -1 : 0;
@@ -117,11 +114,9 @@ static int parse_uint(const char *s, unsigned long max, unsigned long *out)
 {
     char *end;
     errno = 0;
-    if (!s || !*s || s[0] == '-')
-        return -1;
+    if (!s || !*s || s[0] == '-') return -1;
     unsigned long v = strtoul(s, &end, 10);
-    if (errno || *end || v > max)
-        return -1;
+    if (errno || *end || v > max) return -1;
     *out = v;
     return 0;
 }
@@ -143,19 +138,16 @@ static int read_file(const char *path, uint8_t **data, size_t *len)
             return -1;
         }
         n += fread(buf + n, 1, cap - n, f);
-        if (n < cap)
-            break;
+        if (n < cap) break;
         if (cap >= MAX_FILE) {
-            fprintf(stderr, "flash: %s: larger than %u MiB, not a firmware image\n", path,
-                    MAX_FILE >> 20);
+            fprintf(stderr, "flash: %s: larger than %u MiB, not a firmware image\n", path, MAX_FILE >> 20);
             free(buf);
             fclose(f);
             return -1;
         }
         cap *= 2;
         uint8_t *nb = realloc(buf, cap);
-        if (!nb)
-            free(buf);
+        if (!nb) free(buf);
         buf = nb;
     }
     int bad = ferror(f);
@@ -172,30 +164,28 @@ static int read_file(const char *path, uint8_t **data, size_t *len)
 
 static void print_suffix(FILE *f, const char *path, size_t len, const dfu_image_t *img)
 {
-    fprintf(f, "%s: DFU image, %zu bytes of firmware + %u-byte suffix: idVendor %04x, idProduct %04x, "
+    fprintf(f,
+            "%s: DFU image, %zu bytes of firmware + %u-byte suffix: idVendor %04x, idProduct %04x, "
             "bcdDevice %04x, bcdDFU %04x, dwCRC 0x%08x (ok), firmware CRC-32 0x%08x\n",
-            path, img->payload_len, img->suffix_len, img->id_vendor, img->id_product,
-            img->bcd_device, img->bcd_dfu, (unsigned)img->crc_stored,
-            (unsigned)crc_update(0, img->payload, img->payload_len));
+            path, img->payload_len, img->suffix_len, img->id_vendor, img->id_product, img->bcd_device, img->bcd_dfu,
+            (unsigned)img->crc_stored, (unsigned)crc_update(0, img->payload, img->payload_len));
     (void)len;
 }
 
 /* Validate IMAGE (and its VID:PID when known); print "flash: IMAGE: problem". */
-static int check_image(const char *path, const uint8_t *data, size_t len, int have_dev,
-                       uint16_t vid, uint16_t pid, dfu_image_t *img)
+static int check_image(const char *path, const uint8_t *data, size_t len, int have_dev, uint16_t vid, uint16_t pid,
+                       dfu_image_t *img)
 {
     dfu_image_err e = dfu_image_parse(data, len, img);
-    if (e == DFU_IMAGE_OK && have_dev)
-        e = dfu_image_match(img, vid, pid);
-    if (e == DFU_IMAGE_OK)
-        return 0;
+    if (e == DFU_IMAGE_OK && have_dev) e = dfu_image_match(img, vid, pid);
+    if (e == DFU_IMAGE_OK) return 0;
     fprintf(stderr, "flash: %s: %s", path, dfu_image_strerror(e));
     if (e == DFU_IMAGE_BAD_CRC)
         fprintf(stderr, " (suffix dwCRC 0x%08x, computed 0x%08x)", (unsigned)img->crc_stored,
                 (unsigned)img->crc_computed);
     else if (e == DFU_IMAGE_WRONG_VENDOR || e == DFU_IMAGE_WRONG_PRODUCT)
-        fprintf(stderr, ": the image is for %04x:%04x, the device is %04x:%04x", img->id_vendor,
-                img->id_product, vid, pid);
+        fprintf(stderr, ": the image is for %04x:%04x, the device is %04x:%04x", img->id_vendor, img->id_product, vid,
+                pid);
     else if (e == DFU_IMAGE_TOO_SHORT)
         fprintf(stderr, " (%zu bytes)", len);
     else if (e == DFU_IMAGE_BAD_LENGTH) /* the field as found, so the message names the value */
@@ -206,8 +196,8 @@ static int check_image(const char *path, const uint8_t *data, size_t len, int ha
     return -1;
 }
 
-static int add_suffix(const char *in, const char *out, int have_vid, uint16_t vid, int have_pid,
-                      uint16_t pid, uint16_t bcd)
+static int add_suffix(const char *in, const char *out, int have_vid, uint16_t vid, int have_pid, uint16_t pid,
+                      uint16_t bcd)
 {
     if (!in || !out || !have_vid || !have_pid) {
         fprintf(stderr, "flash: --add-suffix needs IN.bin, --vid, --pid and -o OUT.dfu (see --help)\n");
@@ -215,8 +205,7 @@ static int add_suffix(const char *in, const char *out, int have_vid, uint16_t vi
     }
     uint8_t *data;
     size_t len;
-    if (read_file(in, &data, &len) != 0)
-        return EXIT_IMAGE;
+    if (read_file(in, &data, &len) != 0) return EXIT_IMAGE;
     dfu_image_t img;
     if (len == 0) {
         fprintf(stderr, "flash: %s: empty file, nothing to make an image of\n", in);
@@ -234,8 +223,7 @@ static int add_suffix(const char *in, const char *out, int have_vid, uint16_t vi
     snprintf(tmp, sizeof tmp, "%s.tmp", out);
     FILE *f = fopen(tmp, "wb");
     int ok = f && fwrite(data, 1, len, f) == len && fwrite(suffix, 1, sizeof suffix, f) == sizeof suffix;
-    if (f && fclose(f) != 0)
-        ok = 0;
+    if (f && fclose(f) != 0) ok = 0;
     if (!ok || rename(tmp, out) != 0) {
         fprintf(stderr, "flash: %s: cannot write: %s\n", out, strerror(errno));
         remove(tmp);
@@ -243,8 +231,7 @@ static int add_suffix(const char *in, const char *out, int have_vid, uint16_t vi
         return EXIT_IMAGE;
     }
     free(data);
-    if (read_file(out, &data, &len) != 0)
-        return EXIT_IMAGE;
+    if (read_file(out, &data, &len) != 0) return EXIT_IMAGE;
     if (check_image(out, data, len, 0, 0, 0, &img) != 0) {
         free(data);
         return EXIT_IMAGE;
@@ -277,23 +264,19 @@ static int report_download(const char *path, dfu_host_err err, const dfu_host_re
         return 0;
     }
     fprintf(stderr, "flash: %s: %s\n", path, r->msg);
-    if (err == DFU_HOST_BAD_IMAGE)
-        return EXIT_IMAGE;
-    if (err == DFU_HOST_BAD_ARGS)
-        return EXIT_USAGE;
+    if (err == DFU_HOST_BAD_IMAGE) return EXIT_IMAGE;
+    if (err == DFU_HOST_BAD_ARGS) return EXIT_USAGE;
     return EXIT_DOWNLOAD;
 }
 
-static const char *req_names[] = {"DETACH", "DNLOAD", "UPLOAD", "GETSTATUS", "CLRSTATUS",
-                                   "GETSTATE", "ABORT"};
+static const char *req_names[] = {"DETACH", "DNLOAD", "UPLOAD", "GETSTATUS", "CLRSTATUS", "GETSTATE", "ABORT"};
 
-static int run_loopback(const char *path, const uint8_t *data, size_t len, const dfu_image_t *img,
-                        int have_dev, uint16_t vid, uint16_t pid, const dfu_host_opts *o,
-                        long unplug_after)
+static int run_loopback(const char *path, const uint8_t *data, size_t len, const dfu_image_t *img, int have_dev,
+                        uint16_t vid, uint16_t pid, const dfu_host_opts *o, long unplug_after)
 {
     if (have_dev && (vid != LOOP_VID || pid != LOOP_PID)) {
-        fprintf(stderr, "flash: no device found for %04x:%04x: the loopback device is %04x:%04x\n",
-                vid, pid, LOOP_VID, LOOP_PID);
+        fprintf(stderr, "flash: no device found for %04x:%04x: the loopback device is %04x:%04x\n", vid, pid, LOOP_VID,
+                LOOP_PID);
         return EXIT_DEVICE;
     }
     vid = LOOP_VID;
@@ -306,16 +289,15 @@ static int run_loopback(const char *path, const uint8_t *data, size_t len, const
     lb.vanish_after = unplug_after;
     printf("loopback: simulated DFU device %04x:%04x, %u KiB flash (%u KiB for the application), "
            "wTransferSize %u, state %s (%s)\n",
-           vid, pid, LOOP_FLASH_SIZE >> 10, dfu_app_capacity(&lb.flash) >> 10,
-           lb.cfg.transfer_size, dfu_state_name(lb.dev.state), dfu_status_name(lb.dev.status));
+           vid, pid, LOOP_FLASH_SIZE >> 10, dfu_app_capacity(&lb.flash) >> 10, lb.cfg.transfer_size,
+           dfu_state_name(lb.dev.state), dfu_status_name(lb.dev.status));
     dfu_transport t = dfu_loop_transport(&lb);
     dfu_host_report r;
     uint32_t t0 = lb.now_ms;
     dfu_host_err err = dfu_host_flash(&t, data, len, vid, pid, o, &r);
     int rc = report_download(path, err, &r);
     if (lb.vanished) {
-        printf("loopback: the device was unplugged after %lu requests; plugging it in again\n",
-               lb.requests);
+        printf("loopback: the device was unplugged after %lu requests; plugging it in again\n", lb.requests);
         dfu_loop_power_cycle(&lb, 0);
     }
     dfu_app_info_t info;
@@ -326,14 +308,14 @@ static int run_loopback(const char *path, const uint8_t *data, size_t len, const
         /* The host lost the device after it had marked the image valid: what the
          * device holds is the verdict, not the interrupted conversation. */
         printf("%s: the download completed on the device before it was unplugged: it holds the "
-               "image, marked valid, and runs it\n", path);
+               "image, marked valid, and runs it\n",
+               path);
         rc = 0;
     }
     printf("loopback: %lu requests (", lb.requests);
-    for (int i = 0; i < 7; i++)
-        printf("%s%s %lu", i ? ", " : "", req_names[i], lb.by_request[i]);
-    printf("), %lu stalls, %lu resets; simulated time %u ms, of which %lu ms waiting bwPollTimeout\n",
-           lb.stalls, lb.resets, lb.now_ms - t0, lb.slept_ms);
+    for (int i = 0; i < 7; i++) printf("%s%s %lu", i ? ", " : "", req_names[i], lb.by_request[i]);
+    printf("), %lu stalls, %lu resets; simulated time %u ms, of which %lu ms waiting bwPollTimeout\n", lb.stalls,
+           lb.resets, lb.now_ms - t0, lb.slept_ms);
     if (valid)
         printf("loopback: device state %s; application valid: %u bytes, CRC-32 0x%08x (the image's "
                "firmware: 0x%08x)\n",
@@ -341,7 +323,8 @@ static int run_loopback(const char *path, const uint8_t *data, size_t len, const
                (unsigned)crc_update(0, img->payload, img->payload_len));
     else
         printf("loopback: device state %s (%s); no valid application: the device stays in its "
-               "bootloader\n", dfu_state_name(lb.dev.state), dfu_status_name(lb.dev.status));
+               "bootloader\n",
+               dfu_state_name(lb.dev.state), dfu_status_name(lb.dev.status));
     dfu_loop_free(&lb);
     return rc;
 }
@@ -349,15 +332,28 @@ static int run_loopback(const char *path, const uint8_t *data, size_t len, const
 /* The command line, as parsed. */
 typedef struct {
     const char *serial, *add_in, *out, *check;
-    uint16_t vid, pid;            /* --device (or the loopback's own ids) */
-    uint16_t svid, spid, bcd;     /* --vid, --pid, --bcd-device for --add-suffix */
+    uint16_t vid, pid;        /* --device (or the loopback's own ids) */
+    uint16_t svid, spid, bcd; /* --vid, --pid, --bcd-device for --add-suffix */
     int have_dev, have_vid, have_pid, loopback, list, verbose;
     long unplug_after;
     unsigned long ts, timeout, reenum;
 } flash_args;
 
-enum { O_DEVICE = 256, O_SERIAL, O_TS, O_TIMEOUT, O_REENUM, O_LOOP, O_UNPLUG, O_ADD, O_VID,
-       O_PID, O_BCD, O_CHECK, O_LIST };
+enum {
+    O_DEVICE = 256,
+    O_SERIAL,
+    O_TS,
+    O_TIMEOUT,
+    O_REENUM,
+    O_LOOP,
+    O_UNPLUG,
+    O_ADD,
+    O_VID,
+    O_PID,
+    O_BCD,
+    O_CHECK,
+    O_LIST
+};
 
 /* One option c with its argument arg: -1 to go on, else the exit code (0 after --help). */
 static int parse_option(int c, const char *arg, const char *given, flash_args *a)
@@ -405,12 +401,20 @@ static int parse_option(int c, const char *arg, const char *given, flash_args *a
         uint16_t v;
         if (parse_hex16(arg, &v) != 0) {
             fprintf(stderr, "flash: %s wants a 16-bit hex number like 1209 (got \"%s\")\n",
-                    c == O_VID ? "--vid" : c == O_PID ? "--pid" : "--bcd-device", arg);
+                    c == O_VID   ? "--vid"
+                    : c == O_PID ? "--pid"
+                                 : "--bcd-device",
+                    arg);
             return EXIT_USAGE;
         }
-        if (c == O_VID) { a->svid = v; a->have_vid = 1; }
-        else if (c == O_PID) { a->spid = v; a->have_pid = 1; }
-        else a->bcd = v;
+        if (c == O_VID) {
+            a->svid = v;
+            a->have_vid = 1;
+        } else if (c == O_PID) {
+            a->spid = v;
+            a->have_pid = 1;
+        } else
+            a->bcd = v;
         break;
     }
     case O_CHECK: a->check = arg; break;
@@ -426,15 +430,23 @@ static int parse_option(int c, const char *arg, const char *given, flash_args *a
 static int parse_args(int argc, char **argv, flash_args *a)
 {
     static const struct option opts[] = {
-        {"help", no_argument, 0, 'h'},          {"verbose", no_argument, 0, 'v'},
-        {"device", required_argument, 0, O_DEVICE}, {"serial", required_argument, 0, O_SERIAL},
-        {"transfer-size", required_argument, 0, O_TS}, {"timeout", required_argument, 0, O_TIMEOUT},
-        {"reenum-timeout", required_argument, 0, O_REENUM}, {"loopback", no_argument, 0, O_LOOP},
+        {"help", no_argument, 0, 'h'},
+        {"verbose", no_argument, 0, 'v'},
+        {"device", required_argument, 0, O_DEVICE},
+        {"serial", required_argument, 0, O_SERIAL},
+        {"transfer-size", required_argument, 0, O_TS},
+        {"timeout", required_argument, 0, O_TIMEOUT},
+        {"reenum-timeout", required_argument, 0, O_REENUM},
+        {"loopback", no_argument, 0, O_LOOP},
         {"loopback-unplug-after", required_argument, 0, O_UNPLUG},
-        {"add-suffix", required_argument, 0, O_ADD}, {"vid", required_argument, 0, O_VID},
-        {"pid", required_argument, 0, O_PID},   {"bcd-device", required_argument, 0, O_BCD},
-        {"output", required_argument, 0, 'o'},  {"check", required_argument, 0, O_CHECK},
-        {"list", no_argument, 0, O_LIST},       {0, 0, 0, 0},
+        {"add-suffix", required_argument, 0, O_ADD},
+        {"vid", required_argument, 0, O_VID},
+        {"pid", required_argument, 0, O_PID},
+        {"bcd-device", required_argument, 0, O_BCD},
+        {"output", required_argument, 0, 'o'},
+        {"check", required_argument, 0, O_CHECK},
+        {"list", no_argument, 0, O_LIST},
+        {0, 0, 0, 0},
     };
     memset(a, 0, sizeof *a);
     a->bcd = 0xFFFF;
@@ -470,13 +482,14 @@ static const char *image_path(const flash_args *a, int argc, char **argv)
 
 static void print_functional(uint16_t vid, uint16_t pid, const dfu_func_desc *d)
 {
-    fprintf(stderr, "flash: opened %04x:%04x: bmAttributes 0x%02x (%s%s%s%s), wTransferSize %u, "
-            "wDetachTimeOut %u ms, bcdDFU %04x\n", vid, pid, d->attributes,
-            d->attributes & DFU_ATTR_CAN_DNLOAD ? "download" : "no download",
+    fprintf(stderr,
+            "flash: opened %04x:%04x: bmAttributes 0x%02x (%s%s%s%s), wTransferSize %u, "
+            "wDetachTimeOut %u ms, bcdDFU %04x\n",
+            vid, pid, d->attributes, d->attributes & DFU_ATTR_CAN_DNLOAD ? "download" : "no download",
             d->attributes & DFU_ATTR_CAN_UPLOAD ? ", upload" : "",
             d->attributes & DFU_ATTR_MANIFEST_TOLERANT ? ", manifestation-tolerant" : "",
-            d->attributes & DFU_ATTR_WILL_DETACH ? ", will detach" : "",
-            d->transfer_size, d->detach_timeout_ms, d->bcd_dfu);
+            d->attributes & DFU_ATTR_WILL_DETACH ? ", will detach" : "", d->transfer_size, d->detach_timeout_ms,
+            d->bcd_dfu);
 }
 
 /* The download to a real device through libusb: the exit code. */
@@ -519,19 +532,17 @@ int main(int argc, char **argv)
         }
         return add_suffix(a.add_in, a.out, a.have_vid, a.svid, a.have_pid, a.spid, a.bcd);
     }
-    if (a.list)
-        return dfu_usb_list(stdout) ? 0 : EXIT_DEVICE;
+    if (a.list) return dfu_usb_list(stdout) ? 0 : EXIT_DEVICE;
     const char *path = image_path(&a, argc, argv);
     if (!path) return EXIT_USAGE;
 
     uint8_t *data;
     size_t len;
-    if (read_file(path, &data, &len) != 0)
-        return EXIT_IMAGE;
+    if (read_file(path, &data, &len) != 0) return EXIT_IMAGE;
     dfu_image_t img;
     int match = a.have_dev;
     if (a.loopback && !a.have_dev) {
-        a.vid = LOOP_VID;   /* the simulated device's ids, checked as a real device's */
+        a.vid = LOOP_VID; /* the simulated device's ids, checked as a real device's */
         a.pid = LOOP_PID;
         match = 1;
     }
@@ -555,8 +566,7 @@ int main(int argc, char **argv)
     o.log = log_line;
     o.progress = a.verbose ? progress : NULL;
     o.user = &last_pct;
-    if (a.verbose)
-        print_suffix(stderr, path, len, &img);
+    if (a.verbose) print_suffix(stderr, path, len, &img);
 
     if (a.loopback)
         rc = run_loopback(path, data, len, &img, a.have_dev, a.vid, a.pid, &o, a.unplug_after);

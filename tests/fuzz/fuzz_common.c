@@ -90,8 +90,7 @@ void fuzz_draw(const uint8_t *blob, size_t len, const fuzz_view *view, int trust
     scene_error se;
     hal_null_reset();
     scene_status st = eng_init(&e, copy, (uint32_t)len, &se);
-    FUZZ_REQUIRE(!trusted || st == SCENE_OK, "the loader refused the compiler's output: %s",
-                 scene_status_text(st));
+    FUZZ_REQUIRE(!trusted || st == SCENE_OK, "the loader refused the compiler's output: %s", scene_status_text(st));
     uint32_t need = st == SCENE_OK ? eng_work_bytes(&e) : 0;
     void *work = need && need <= FUZZ_WORK_MAX ? malloc(need) : NULL;
     FUZZ_REQUIRE(!trusted || work, "the compiler's output needs %u bytes of work memory", need);

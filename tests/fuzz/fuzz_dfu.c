@@ -91,8 +91,10 @@ static dfu_image_err ref_parse(const uint8_t *d, size_t len, uint32_t *crc)
 static void check_match(const dfu_image_t *img, uint16_t vid, uint16_t pid)
 {
     dfu_image_err want = DFU_IMAGE_OK;
-    if (img->id_vendor != DFU_ID_ANY && img->id_vendor != vid) want = DFU_IMAGE_WRONG_VENDOR;
-    else if (img->id_product != DFU_ID_ANY && img->id_product != pid) want = DFU_IMAGE_WRONG_PRODUCT;
+    if (img->id_vendor != DFU_ID_ANY && img->id_vendor != vid)
+        want = DFU_IMAGE_WRONG_VENDOR;
+    else if (img->id_product != DFU_ID_ANY && img->id_product != pid)
+        want = DFU_IMAGE_WRONG_PRODUCT;
     REQUIRE(dfu_image_match(img, vid, pid) == want);
     REQUIRE(dfu_image_strerror(want)[0] != 0);
 }
@@ -192,11 +194,11 @@ enum { OP_ERASE, OP_PROGRAM, OP_READ, OP_KINDS };
 typedef struct {
     uint8_t *mem;
     uint32_t size, page;
-    uint32_t *prog_end;     /* per page: bytes programmed so far since its erase */
-    uint32_t *erase_epoch;  /* per page: the download it was erased in (0: none) */
-    uint32_t epoch;         /* the current download (bumped when one starts) */
-    uint32_t gen;           /* bumped on every change of mem */
-    int quiet;              /* the harness reading: no faults, no contract */
+    uint32_t *prog_end;    /* per page: bytes programmed so far since its erase */
+    uint32_t *erase_epoch; /* per page: the download it was erased in (0: none) */
+    uint32_t epoch;        /* the current download (bumped when one starts) */
+    uint32_t gen;          /* bumped on every change of mem */
+    int quiet;             /* the harness reading: no faults, no contract */
 
     /* one armed fault: the countdown-th next operation of a kind fails or corrupts */
     int fault_kind, fault_corrupt;
@@ -204,9 +206,9 @@ typedef struct {
     uint32_t rng;
 
     /* the host's view */
-    uint8_t *img;           /* the bytes sent in this download */
+    uint8_t *img; /* the bytes sent in this download */
     uint32_t img_len;
-    uint8_t *com;           /* the application last committed (or found at power-on) */
+    uint8_t *com; /* the application last committed (or found at power-on) */
     uint32_t com_len;
     int com_valid;
     uint32_t commits;
@@ -281,9 +283,9 @@ static int cb_program(void *ctx, uint32_t off, const uint8_t *src, uint32_t n)
     fake_flash *f = ctx;
     REQUIRE(off < f->size && n <= f->size - off && n > 0);
     uint32_t p = off / f->page, in = off % f->page;
-    REQUIRE(in + n <= f->page);                               /* one page */
-    REQUIRE(f->erase_epoch[p] == f->epoch && f->epoch != 0);  /* erased in this download */
-    REQUIRE(in >= f->prog_end[p]);                            /* upwards, each byte once */
+    REQUIRE(in + n <= f->page);                              /* one page */
+    REQUIRE(f->erase_epoch[p] == f->epoch && f->epoch != 0); /* erased in this download */
+    REQUIRE(in >= f->prog_end[p]);                           /* upwards, each byte once */
     if (off == trailer_at(f)) {
         REQUIRE(n == DFU_TRAILER_LEN);
         commit(f, src);
@@ -366,8 +368,7 @@ static void run_device(cursor *c)
         cfg.detach_timeout_ms = 0xFFFF;
         cfg.erase_ms = 1;
         break;
-    default:
-        break;
+    default: break;
     }
     uint32_t page = page_sizes[geo & 7u], pages = 2u + (geo >> 3 & 7u);
 
@@ -402,8 +403,7 @@ static void run_device(cursor *c)
     case 4: /* garbage */
         for (uint32_t i = 0; i < f.size; i++) f.mem[i] = (uint8_t)xorshift(&f.rng);
         break;
-    default: /* blank */
-        break;
+    default: /* blank */ break;
     }
     uint32_t n0;
     if (ref_valid(&f, &n0)) {
@@ -422,7 +422,10 @@ static void run_device(cursor *c)
         case 1: badc.transfer_size = DFU_MAX_TRANSFER + 1u; break;
         case 2: bad.size = bad.page_size; break;
         case 3: bad.size = bad.page_size * 2u + 1u; break;
-        case 4: bad.page_size = DFU_TRAILER_LEN - 1u; bad.size = bad.page_size * 4u; break;
+        case 4:
+            bad.page_size = DFU_TRAILER_LEN - 1u;
+            bad.size = bad.page_size * 4u;
+            break;
         case 5: bad.erase = NULL; break;
         case 6: bad.read = NULL; break;
         default: bad.program = NULL; break;
@@ -534,15 +537,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (size < 1) return 0;
     cursor c = {data + 1, size - 1};
     switch (data[0] % 3u) {
-    case 0:
-        run_file(data + 1, size - 1);
-        break;
-    case 1:
-        run_suffix(&c);
-        break;
-    default:
-        run_device(&c);
-        break;
+    case 0: run_file(data + 1, size - 1); break;
+    case 1: run_suffix(&c); break;
+    default: run_device(&c); break;
     }
     return 0;
 }

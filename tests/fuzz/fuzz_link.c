@@ -64,10 +64,10 @@
 
 /* Decoding a frame costs the receiver a few milliseconds under the sanitizers and
  * libFuzzer's tracing: a few frames per input keep an execution fast. */
-#define MAX_MSGS 24       /* framed: messages per input */
-#define MAX_REBUILT 3     /* framed: frame messages per input that are decoded (more are left out) */
-#define MAX_PADS 2        /* framed: 64 KB messages per input */
-#define MAX_RT 2          /* round trip: frames per input (a keyframe and a delta) */
+#define MAX_MSGS 24   /* framed: messages per input */
+#define MAX_REBUILT 3 /* framed: frame messages per input that are decoded (more are left out) */
+#define MAX_PADS 2    /* framed: 64 KB messages per input */
+#define MAX_RT 2      /* round trip: frames per input (a keyframe and a delta) */
 #define LINE_BYTES (2u * FL_MSG_MAX + 4096u)
 
 /* ---- input cursor ---------------------------------------------------------------- */
@@ -140,7 +140,7 @@ enum { EXPECT_ANY, EXPECT_SHOW, EXPECT_DROP };
 typedef struct {
     fl_decoder *d;
     uint8_t *frame, *work, *shadow;
-    int have_shown;          /* the events' view: a frame shown since the last HELLO */
+    int have_shown; /* the events' view: a frame shown since the last HELLO */
     uint32_t shown_no;
 
     uint32_t n_hello, n_palette, n_frame, n_drop, n_bad, n_keyreq, n_other;
@@ -150,7 +150,7 @@ typedef struct {
     uint32_t back_len;
     int back_overrun;
     uint32_t back_ack_shown, back_ack_dropped, back_keyreq, back_palreq;
-    fl_encoder *back_to;     /* round trip: the sender that hears the receiver */
+    fl_encoder *back_to; /* round trip: the sender that hears the receiver */
 
     /* a session numbered upwards: shown + dropped + missed spans its frame numbers */
     int sess_any, sess_up;
@@ -159,18 +159,18 @@ typedef struct {
     /* the message being fed (framed, round trip) */
     int expect;
     fl_reason expect_reason;
-    int keyreq_since_frame;  /* a keyframe request went back since the last frame was sent */
+    int keyreq_since_frame; /* a keyframe request went back since the last frame was sent */
     uint32_t spot_checks;
 
     /* what docs/frame-link.md, section 6, says the receiver does next */
-    int last_bad;            /* a bad segment since the last good message */
+    int last_bad; /* a bad segment since the last good message */
     uint32_t resyncs;
-    int waiting_key;         /* a keyframe was asked for and has not come */
+    int waiting_key; /* a keyframe was asked for and has not come */
     uint32_t waiting_drops, window;
-    int keyreq_due;          /* the drop just reported must be followed by a request */
+    int keyreq_due; /* the drop just reported must be followed by a request */
     int have_palette;
     uint32_t palette_wait, palreqs;
-    int ack_pending;         /* the ack of the frame message being handled went back */
+    int ack_pending; /* the ack of the frame message being handled went back */
     uint32_t ack_no, ack_status, keyreq_no;
 
     /* round trip: the frames sent, by number */
@@ -266,7 +266,7 @@ typedef struct {
     uint32_t frame_no;
     const uint8_t *pl;
     uint32_t plen;
-    uint32_t pre;            /* info, flags, check, [base], method */
+    uint32_t pre; /* info, flags, check, [base], method */
     uint8_t flags, method;
     uint32_t check, crc, base_no;
 } frame_msg;
@@ -379,12 +379,8 @@ static void on_drop(harness *h, const fl_event *ev)
     REQUIRE(frame_unchanged(h));
     int on_base = h->have_shown && m.base_no == h->shown_no;
     switch (ev->reason) {
-    case FL_R_NO_BASE:
-        REQUIRE(m.type == FL_MSG_DELTA && !on_base);
-        break;
-    case FL_R_DECODE:
-        REQUIRE(m.method == FL_METHOD_EDGE && (m.type == FL_MSG_KEYFRAME || on_base));
-        break;
+    case FL_R_NO_BASE: REQUIRE(m.type == FL_MSG_DELTA && !on_base); break;
+    case FL_R_DECODE: REQUIRE(m.method == FL_METHOD_EDGE && (m.type == FL_MSG_KEYFRAME || on_base)); break;
     case FL_R_FRAME_CRC:
         REQUIRE(m.type == FL_MSG_KEYFRAME || on_base);
         if (m.method != FL_METHOD_EDGE) {
@@ -393,8 +389,7 @@ static void on_drop(harness *h, const fl_event *ev)
             REQUIRE(ref_check_of(m.method, px) != m.check || ((m.flags & 1u) && ref_crc(px, FL_FRAME_BYTES) != m.crc));
         }
         break;
-    default:
-        REQUIRE(0);
+    default: REQUIRE(0);
     }
     REQUIRE(h->expect != EXPECT_SHOW);
     if (h->expect == EXPECT_DROP) REQUIRE(ev->reason == h->expect_reason);
@@ -461,8 +456,7 @@ static void on_event(void *ctx, const fl_event *ev)
         REQUIRE(ev->type == FL_MSG_ACK || ev->type == FL_MSG_KEYREQ);
         spot_check_unchanged(h);
         break;
-    default:
-        REQUIRE(0);
+    default: REQUIRE(0);
     }
     counters_agree(h);
 }
@@ -579,8 +573,10 @@ static void run_raw(cursor *c)
     uint32_t fed = 0, segments = 0;
     int started = 0;
     for (size_t i = 0; i < c->n; i++) {
-        if (c->p[i]) started = 1;
-        else if (started) segments++, started = 0;
+        if (c->p[i])
+            started = 1;
+        else if (started)
+            segments++, started = 0;
     }
     while (c->n) {
         uint32_t k = knob ? 1u + xorshift(&seed) % (knob * 8u) : (uint32_t)c->n;
@@ -651,8 +647,10 @@ static void run_framed(cursor *c)
     uint32_t fed = 0, frame_msgs = 0, rebuilt = 0, frame_no = 0, pads = 0;
     for (int msg = 0; msg < MAX_MSGS && c->n; msg++) {
         uint32_t ctl = u8_or0(c), type = ctl & 7u;
-        if (ctl & 0x08u) frame_no = u32_or0(c);
-        else frame_no++;
+        if (ctl & 0x08u)
+            frame_no = u32_or0(c);
+        else
+            frame_no++;
         uint32_t dpos = 0, dxor = 0;
         if (ctl & 0x80u) {
             dpos = u16_or0(c);
@@ -777,9 +775,7 @@ UNTRACED static void draw(uint8_t *px, const uint8_t *op, uint32_t *rng)
         for (int y = y0; y < FL_H && y < y0 + dd + 1; y++)
             for (int x = x0; x < FL_W; x += 1 + cc % 16) px[y * FL_W + x] = (uint8_t)(col + (x & 1));
         break;
-    case 6: /* the whole frame */
-        memset(px, col, FL_FRAME_BYTES);
-        break;
+    case 6: /* the whole frame */ memset(px, col, FL_FRAME_BYTES); break;
     default: { /* a diamond */
         int r = cc / 2;
         for (int y = y0 - r; y <= y0 + r; y++) {
@@ -929,12 +925,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         run_raw_sender(data + 1, size - 1);
         run_raw(&c);
         break;
-    case 1:
-        run_framed(&c);
-        break;
-    default:
-        run_round_trip(&c, data[0] / 3u);
-        break;
+    case 1: run_framed(&c); break;
+    default: run_round_trip(&c, data[0] / 3u); break;
     }
     return 0;
 }

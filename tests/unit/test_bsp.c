@@ -237,8 +237,7 @@ static void check_tree(const view *w)
                 bbox_holds(w->node[i].bbox[c], w->v[g->v2].x, w->v[g->v2].y);
             }
             for (uint32_t k = 0; k < L->num_pverts; k++)
-                bbox_holds(w->node[i].bbox[c], w->pv[L->first_pvert + k].x,
-                           w->pv[L->first_pvert + k].y);
+                bbox_holds(w->node[i].bbox[c], w->pv[L->first_pvert + k].x, w->pv[L->first_pvert + k].y);
         }
     free(st);
     free(path);
@@ -329,8 +328,7 @@ static void check_pieces(const view *w)
     for (size_t k = 0; k < (size_t)w->nln * 2; k++) start[k + 1] += start[k];
     uint32_t *fill = malloc(sizeof *fill * ((size_t)w->nln * 2 + 2));
     memcpy(fill, start, sizeof *fill * ((size_t)w->nln * 2 + 1));
-    for (uint32_t i = 0; i < w->nseg; i++)
-        order[fill[(size_t)w->seg[i].line * 2 + w->seg[i].side]++] = i;
+    for (uint32_t i = 0; i < w->nseg; i++) order[fill[(size_t)w->seg[i].line * 2 + w->seg[i].side]++] = i;
     for (uint32_t l = 0; l < w->nln; l++) {
         const scn_line *L = &w->ln[l];
         for (uint32_t s = 0; s < 2; s++) {
@@ -348,9 +346,11 @@ static void check_pieces(const view *w)
             for (uint32_t k = a; k < b; k++) {
                 const scn_seg *g = &w->seg[order[k]];
                 double t0 = (((double)w->v[g->v1].x - w->v[from].x) * dx +
-                             ((double)w->v[g->v1].y - w->v[from].y) * dy) / len2;
+                             ((double)w->v[g->v1].y - w->v[from].y) * dy) /
+                            len2;
                 double t1 = (((double)w->v[g->v2].x - w->v[from].x) * dx +
-                             ((double)w->v[g->v2].y - w->v[from].y) * dy) / len2;
+                             ((double)w->v[g->v2].y - w->v[from].y) * dy) /
+                            len2;
                 assert_true(t1 > t0); /* runs the way of its side */
                 pc[np++] = (piece){t0, t1, g->v1, g->v2};
                 sum += seglen(w, g->v1, g->v2);
@@ -497,8 +497,8 @@ static void check_blob(const uint8_t *b, size_t len)
 
 /* ------------------------------------------------------------ helpers */
 
-static int compile_text(const char *text, bspc_split split, uint8_t **blob, size_t *len,
-                        bspc_stats *st, char *err, size_t errlen, char **pathout)
+static int compile_text(const char *text, bspc_split split, uint8_t **blob, size_t *len, bspc_stats *st, char *err,
+                        size_t errlen, char **pathout)
 {
     char *path = fixture_write_temp(text);
     bspc_options o = bspc_defaults();
@@ -520,29 +520,28 @@ static int have_freedoom2(void)
 }
 
 /* a room with a diagonal-walled pillar pair and a two-sided diagonal ledge */
-static const char *diag_scene =
-    "# test scene: diagonal walls\n"
-    "sector room floor=0 ceil=128 floor_color=sand:6 ceil_color=grey:8\n"
-    "sector ledge floor=24 ceil=128 floor_color=moss:6 ceil_color=grey:8 light=200\n"
-    "wall 0 0 0 300 room\n"
-    "wall 0 300 300 300 room\n"
-    "wall 300 300 300 0 room\n"
-    "wall 300 0 0 0 room\n"
-    /* diamond pillar */
-    "wall 100 37 137 100 room mid=red:9\n"
-    "wall 137 100 100 163 room mid=red:9\n"
-    "wall 100 163 63 100 room mid=red:9\n"
-    "wall 63 100 100 37 room mid=red:9\n"
-    /* triangular raised ledge (two-sided walls, the ledge on their left) */
-    "wall 170 190 250 230 room ledge\n"
-    "wall 250 230 210 270 room ledge\n"
-    "wall 210 270 170 190 room ledge\n"
-    /* a skewed pillar */
-    "wall 200 40 251 61 room mid=blue:9\n"
-    "wall 251 61 233 113 room mid=blue:9\n"
-    "wall 233 113 190 97 room mid=blue:9\n"
-    "wall 190 97 200 40 room mid=blue:9\n"
-    "player 30 30 45\n";
+static const char *diag_scene = "# test scene: diagonal walls\n"
+                                "sector room floor=0 ceil=128 floor_color=sand:6 ceil_color=grey:8\n"
+                                "sector ledge floor=24 ceil=128 floor_color=moss:6 ceil_color=grey:8 light=200\n"
+                                "wall 0 0 0 300 room\n"
+                                "wall 0 300 300 300 room\n"
+                                "wall 300 300 300 0 room\n"
+                                "wall 300 0 0 0 room\n"
+                                /* diamond pillar */
+                                "wall 100 37 137 100 room mid=red:9\n"
+                                "wall 137 100 100 163 room mid=red:9\n"
+                                "wall 100 163 63 100 room mid=red:9\n"
+                                "wall 63 100 100 37 room mid=red:9\n"
+                                /* triangular raised ledge (two-sided walls, the ledge on their left) */
+                                "wall 170 190 250 230 room ledge\n"
+                                "wall 250 230 210 270 room ledge\n"
+                                "wall 210 270 170 190 room ledge\n"
+                                /* a skewed pillar */
+                                "wall 200 40 251 61 room mid=blue:9\n"
+                                "wall 251 61 233 113 room mid=blue:9\n"
+                                "wall 233 113 190 97 room mid=blue:9\n"
+                                "wall 190 97 200 40 room mid=blue:9\n"
+                                "player 30 30 45\n";
 
 /* ------------------------------------------------------------ tests */
 
@@ -730,39 +729,38 @@ static void test_all_freedoom_maps(void **state)
 
 /* ------------------------------------------------------------ objects and doors */
 
-static const char *objects_scene =
-    "sector room floor=0 ceil=128 floor_color=sand:7\n"
-    "sector dais floor=24 ceil=128\n"
-    "sector door1 floor=0 ceil=0 door=112 floor_color=grey:6 ceil_color=grey:5\n"
-    "wall 0 0 0 256 room\n"
-    "wall 0 256 256 256 room\n"
-    "wall 256 256 256 0 room\n"
-    "wall 256 0 128 0 room\n"
-    "wall 128 0 96 0 room door1\n"
-    "wall 96 0 0 0 room\n"
-    "wall 128 0 128 -16 door1\n"
-    "wall 128 -16 96 -16 door1\n"
-    "wall 96 -16 96 0 door1\n"
-    /* a raised square in the room's north-east: a hole in room, the dais in it */
-    "wall 160 160 160 224 dais room\n"
-    "wall 160 224 224 224 dais room\n"
-    "wall 224 224 224 160 dais room\n"
-    "wall 224 160 160 160 dais room\n"
-    "player 64 128 0\n"
-    "model crate\n"
-    "part box w=32 d=32.00001 h=32 at=1,2,3 color=brown:8 top=brown:10 bottom=1\n"
-    "end\n"
-    "model ship  # two touching parts\n"
-    "part box   w=48 d=16 h=8  at=0,0,0   color=grey:9\n"
-    "part prism sides=3 r=12 h=4 at=30,0,2 color=red:8 top=red:10\n"
-    "end\n"
-    "model gem\n"
-    "part prism sides=7 r=10.3 h=5 at=0.5,-0.25,-2 side=blue:15 color=blue:0\n"
-    "end\n"
-    "object crate 64 64\n"                      /* on the room's floor */
-    "object gem 192 192 yaw=-30\n"              /* on the dais */
-    "object 1 128 128 z=96 yaw=450 path=circle:64:8000\n"
-    "object ship 20 20 z=-16383 path=line:200:-10:4000 spin=-45.5\n";
+static const char *objects_scene = "sector room floor=0 ceil=128 floor_color=sand:7\n"
+                                   "sector dais floor=24 ceil=128\n"
+                                   "sector door1 floor=0 ceil=0 door=112 floor_color=grey:6 ceil_color=grey:5\n"
+                                   "wall 0 0 0 256 room\n"
+                                   "wall 0 256 256 256 room\n"
+                                   "wall 256 256 256 0 room\n"
+                                   "wall 256 0 128 0 room\n"
+                                   "wall 128 0 96 0 room door1\n"
+                                   "wall 96 0 0 0 room\n"
+                                   "wall 128 0 128 -16 door1\n"
+                                   "wall 128 -16 96 -16 door1\n"
+                                   "wall 96 -16 96 0 door1\n"
+                                   /* a raised square in the room's north-east: a hole in room, the dais in it */
+                                   "wall 160 160 160 224 dais room\n"
+                                   "wall 160 224 224 224 dais room\n"
+                                   "wall 224 224 224 160 dais room\n"
+                                   "wall 224 160 160 160 dais room\n"
+                                   "player 64 128 0\n"
+                                   "model crate\n"
+                                   "part box w=32 d=32.00001 h=32 at=1,2,3 color=brown:8 top=brown:10 bottom=1\n"
+                                   "end\n"
+                                   "model ship  # two touching parts\n"
+                                   "part box   w=48 d=16 h=8  at=0,0,0   color=grey:9\n"
+                                   "part prism sides=3 r=12 h=4 at=30,0,2 color=red:8 top=red:10\n"
+                                   "end\n"
+                                   "model gem\n"
+                                   "part prism sides=7 r=10.3 h=5 at=0.5,-0.25,-2 side=blue:15 color=blue:0\n"
+                                   "end\n"
+                                   "object crate 64 64\n"         /* on the room's floor */
+                                   "object gem 192 192 yaw=-30\n" /* on the dais */
+                                   "object 1 128 128 z=96 yaw=450 path=circle:64:8000\n"
+                                   "object ship 20 20 z=-16383 path=line:200:-10:4000 spin=-45.5\n";
 
 static void *sec_copy(const uint8_t *b, size_t len, int k, size_t rec, uint32_t *count)
 {
@@ -784,7 +782,10 @@ static void face_normal(const scn_mvert *v, const uint32_t *idx, int n, double n
     }
 }
 
-static int64_t round_away(double v) { return (int64_t)(v < 0 ? -floor(-v + 0.5) : floor(v + 0.5)); }
+static int64_t round_away(double v)
+{
+    return (int64_t)(v < 0 ? -floor(-v + 0.5) : floor(v + 0.5));
+}
 
 static void test_objects_and_doors(void **state)
 {
@@ -877,8 +878,8 @@ static void test_objects_and_doors(void **state)
     assert_int_equal(f[4].colour, 11 * 16 + 10);
     assert_int_equal(f[5].colour, 1);
     /* crate faces in the documented order */
-    static const uint32_t crate_faces[6][4] = {{0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7},
-                                               {4, 5, 6, 7}, {0, 3, 2, 1}};
+    static const uint32_t crate_faces[6][4] = {{0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6},
+                                               {3, 0, 4, 7}, {4, 5, 6, 7}, {0, 3, 2, 1}};
     for (int k = 0; k < 6; k++) {
         assert_int_equal(f[k].num_index, 4);
         assert_int_equal(f[k].part, 0);
@@ -987,7 +988,8 @@ static int wad_map_lump(const char *wad, const char *map, const char *name, wlum
             for (uint32_t i = 0; i < n && found < 0; i++) {
                 char nm[9] = {0};
                 memcpy(nm, dir + 16 * i + 8, 8);
-                if (strcmp(nm, map) == 0) in_map = 1;
+                if (strcmp(nm, map) == 0)
+                    in_map = 1;
                 else if (in_map && strcmp(nm, name) == 0) {
                     uint32_t pos = dir[16 * i] | dir[16 * i + 1] << 8 | dir[16 * i + 2] << 16 |
                                    (uint32_t)dir[16 * i + 3] << 24;
@@ -1005,7 +1007,10 @@ static int wad_map_lump(const char *wad, const char *map, const char *name, wlum
     return found;
 }
 
-static unsigned u16(const uint8_t *p) { return p[0] | p[1] << 8; }
+static unsigned u16(const uint8_t *p)
+{
+    return p[0] | p[1] << 8;
+}
 
 static void test_freedoom2_map01_objects_and_doors(void **state)
 {
@@ -1154,8 +1159,10 @@ static const bad_case bad[] = {
     {"sector a floor=0\n", 1, "missing ceil"},
     {"sector a floor=0 ceil=64\nsector a floor=0 ceil=64\n", 2, "already used"},
     {"", 0, "no walls"},
-    /* models, objects and doors (docs/objects.md) */
-#define ROOM_ "sector a floor=0 ceil=64\nwall 0 0 0 64 a\nwall 0 64 64 64 a\nwall 64 64 64 0 a\nwall 64 0 0 0 a\nplayer 32 32 0\n"
+/* models, objects and doors (docs/objects.md) */
+#define ROOM_                                                                                                          \
+    "sector a floor=0 ceil=64\nwall 0 0 0 64 a\nwall 0 64 64 64 a\nwall 64 64 64 0 a\nwall 64 0 0 0 a\nplayer 32 32 "  \
+    "0\n"
     {ROOM_ "object crate 10 10\n", 7, "unknown model 'crate'"},
     {ROOM_ "object 0 10 10\n", 7, "unknown model 0"},
     {ROOM_ "model m\nend\n", 8, "has no parts"},
@@ -1275,28 +1282,38 @@ static void test_wad_errors(void **state)
         uint32_t pos, size;
     } dir[6];
     int nd = 0;
-#define LUMP(nm)                       \
-    do {                               \
-        dir[nd].name = nm;             \
-        dir[nd].pos = (uint32_t)at;    \
+#define LUMP(nm)                                                                                                       \
+    do {                                                                                                               \
+        dir[nd].name = nm;                                                                                             \
+        dir[nd].pos = (uint32_t)at;                                                                                    \
     } while (0)
 #define END_LUMP() (dir[nd].size = (uint32_t)at - dir[nd].pos, nd++)
 #define W16(v) (wad[at] = (uint8_t)((v)&255), wad[at + 1] = (uint8_t)(((v) >> 8) & 255), at += 2)
     LUMP("MAP01");
     END_LUMP();
     LUMP("THINGS");
-    W16(32); W16(32); W16(0); W16(1); W16(7);
+    W16(32);
+    W16(32);
+    W16(0);
+    W16(1);
+    W16(7);
     END_LUMP();
     LUMP("LINEDEFS");
     int lines[4][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}};
     for (int i = 0; i < 4; i++) {
-        W16(lines[i][0]); W16(lines[i][1]); W16(1); W16(0); W16(0);
-        W16(i == 1 ? 9999 : i); W16(0xFFFF);
+        W16(lines[i][0]);
+        W16(lines[i][1]);
+        W16(1);
+        W16(0);
+        W16(0);
+        W16(i == 1 ? 9999 : i);
+        W16(0xFFFF);
     }
     END_LUMP();
     LUMP("SIDEDEFS");
     for (int i = 0; i < 4; i++) {
-        W16(0); W16(0);
+        W16(0);
+        W16(0);
         memcpy(wad + at, "-\0\0\0\0\0\0\0-\0\0\0\0\0\0\0STARTAN3", 24);
         at += 24;
         W16(0);
@@ -1305,14 +1322,18 @@ static void test_wad_errors(void **state)
     LUMP("VERTEXES");
     int vs[4][2] = {{0, 0}, {0, 64}, {64, 64}, {64, 0}};
     for (int i = 0; i < 4; i++) {
-        W16(vs[i][0]); W16(vs[i][1]);
+        W16(vs[i][0]);
+        W16(vs[i][1]);
     }
     END_LUMP();
     LUMP("SECTORS");
-    W16(0); W16(64);
+    W16(0);
+    W16(64);
     memcpy(wad + at, "FLOOR4_8CEIL3_5\0", 16);
     at += 16;
-    W16(160); W16(0); W16(0);
+    W16(160);
+    W16(0);
+    W16(0);
     END_LUMP();
     uint32_t dirofs = (uint32_t)at;
     for (int i = 0; i < nd; i++) {

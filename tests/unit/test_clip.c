@@ -102,7 +102,7 @@ static void test_shared_edges_exactly_once(void **state)
         screen_pt pts[12];
         int32_t cx = rnd(40, 280) << 16, cy = rnd(30, 170) << 16;
         int32_t rx = rnd(1, 40) << 16, ry = rnd(1, 30) << 16;
-        static const int32_t cs[12][2] = {{1000, 0}, {866, 500}, {500, 866}, {0, 1000}, {-500, 866}, {-866, 500},
+        static const int32_t cs[12][2] = {{1000, 0},  {866, 500},   {500, 866},   {0, 1000},  {-500, 866}, {-866, 500},
                                           {-1000, 0}, {-866, -500}, {-500, -866}, {0, -1000}, {500, -866}, {866, -500}};
         int step = 12 / n;
         for (int i = 0; i < n; i++) {

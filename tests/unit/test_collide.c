@@ -29,10 +29,13 @@
 
 __extension__ typedef __int128 i128;
 
-#define U(v) ((fx_t)((v) * 65536.0)) /* map units to 16.16 (test values are exact) */
-#define EPS (FX_ONE / 32)            /* slack for "stops at radius" */
+#define U(v) ((fx_t)((v)*65536.0)) /* map units to 16.16 (test values are exact) */
+#define EPS (FX_ONE / 32)          /* slack for "stops at radius" */
 
-static double un(int64_t raw) { return (double)raw / 65536.0; }
+static double un(int64_t raw)
+{
+    return (double)raw / 65536.0;
+}
 
 /* ------------------------------------------------------------ scenes */
 
@@ -57,7 +60,10 @@ static void load_text(loaded *l, const char *text)
     fixture_load_text(text, &l->blob, &l->s);
 }
 
-static void unload(loaded *l) { free(l->blob); }
+static void unload(loaded *l)
+{
+    free(l->blob);
+}
 
 /* n rooms in a row along x, each 256 x 256, room i over x in [256 i, 256 (i+1)];
  * the walls between them two-sided; the player in room 0 at (128, 128) facing east. */
@@ -70,8 +76,8 @@ static void load_chain(loaded *l, int n, const int *floors, const int *ceils)
     at += snprintf(text + at, sizeof text - at, "wall 0 0 0 256 r0\n");
     for (int i = 0; i < n; i++) {
         int x0 = 256 * i, x1 = 256 * (i + 1);
-        at += snprintf(text + at, sizeof text - at, "wall %d 0 %d 0 r%d\nwall %d 256 %d 256 r%d\n", x1, x0, i,
-                       x0, x1, i);
+        at += snprintf(text + at, sizeof text - at, "wall %d 0 %d 0 r%d\nwall %d 256 %d 256 r%d\n", x1, x0, i, x0, x1,
+                       i);
         if (i + 1 < n)
             at += snprintf(text + at, sizeof text - at, "wall %d 256 %d 0 r%d r%d\n", x1, x1, i, i + 1);
         else
@@ -89,7 +95,10 @@ static void load_room(loaded *l) /* one room, floor 0, ceiling 128 */
 
 /* ------------------------------------------------------------ exact checks */
 
-static int sgn128(i128 v) { return (v > 0) - (v < 0); }
+static int sgn128(i128 v)
+{
+    return (v > 0) - (v < 0);
+}
 
 static i128 orient(int64_t ax, int64_t ay, int64_t bx, int64_t by, int64_t px, int64_t py)
 {
@@ -139,7 +148,10 @@ static void walls_of(const scene *s, walls *w)
     w->nall = w->nsolid = 0;
     for (uint32_t i = 0; i < s->nlines; i++) {
         const scn_line *ln = &s->lines[i];
-        tline t = {s->verts[ln->v1].x, s->verts[ln->v1].y, s->verts[ln->v2].x, s->verts[ln->v2].y,
+        tline t = {s->verts[ln->v1].x,
+                   s->verts[ln->v1].y,
+                   s->verts[ln->v2].x,
+                   s->verts[ln->v2].y,
                    {ln->sector[0], ln->sector[1]}};
         w->all[w->nall++] = t;
         if (ln->sector[1] == SCN_NONE) w->solid[w->nsolid++] = t;
@@ -254,7 +266,7 @@ static void test_slide_keeps_parallel_component(void **state)
     x = U(150);
     y = U(160);
     col_move(&l.s, NULL, NULL, &x, &y, &fz, U(100), 0);
-    double d = (384 - un(x) - un(y)) / sqrt(2.0);      /* distance to the diagonal */
+    double d = (384 - un(x) - un(y)) / sqrt(2.0);             /* distance to the diagonal */
     double along = (un(x) - 150 - (un(y) - 160)) / sqrt(2.0); /* motion along it */
     assert_true(d >= 16 - 1.0 / 1024 && d <= 16 + 1.0 / 16);
     assert_true(fabs(along - 100 / sqrt(2.0)) <= 1.0 / 8);
@@ -329,14 +341,13 @@ static void test_low_gaps(void **state)
         int f[2], c[2];
         int pass;
     } cases[] = {
-        {{0, 0}, {128, 55}, 0},   /* a gap lower than 56 */
-        {{0, 0}, {128, 56}, 1},   /* exactly 56 */
-        {{0, 24}, {128, 79}, 0},  /* a step up into a room 55 high */
-        {{0, 24}, {128, 80}, 1},
-        {{0, 0}, {55, 128}, 0},   /* from a room too low for us: the opening is too */
-        {{100, 0}, {300, 120}, 0}, /* down from a ledge under a ceiling only 20 above it */
-        {{100, 0}, {300, 156}, 1}, /* 56 above it: fine, and down any height */
-        {{0, 10}, {128, 10}, 0},  /* a closed door */
+        {{0, 0}, {128, 55}, 0},                            /* a gap lower than 56 */
+        {{0, 0}, {128, 56}, 1},                            /* exactly 56 */
+        {{0, 24}, {128, 79}, 0},                           /* a step up into a room 55 high */
+        {{0, 24}, {128, 80}, 1},   {{0, 0}, {55, 128}, 0}, /* from a room too low for us: the opening is too */
+        {{100, 0}, {300, 120}, 0},                         /* down from a ledge under a ceiling only 20 above it */
+        {{100, 0}, {300, 156}, 1},                         /* 56 above it: fine, and down any height */
+        {{0, 10}, {128, 10}, 0},                           /* a closed door */
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         loaded l;
@@ -490,7 +501,8 @@ static void test_many_walls_big_body(void **state)
         rng = rng * 6364136223846793005ull + 1442695040888963407ull;
         double a = (double)(rng >> 11) / 9007199254740992.0 * 2 * M_PI;
         blocked += (col_move(&l.s, NULL, &big, &x, &y, &fz, (int64_t)(60 * cos(a) * 65536),
-                             (int64_t)(60 * sin(a) * 65536)) & COL_BLOCKED) != 0;
+                             (int64_t)(60 * sin(a) * 65536)) &
+                    COL_BLOCKED) != 0;
         assert_true(solid_dist(&w, x, y) >= 300 - 1.0 / 1024);
     }
     assert_true(blocked > 50);
@@ -522,7 +534,7 @@ static void test_line_of_sight(void **state)
     assert_true(col_line_of_sight(s, NULL, U(128), y, U(96), U(640), y, U(96)));  /* on the lintel */
     assert_true(col_line_of_sight(s, NULL, U(128), y, U(50), U(640), y, U(90)));  /* 60 and 80 at the lines */
     assert_false(col_line_of_sight(s, NULL, U(128), y, U(0), U(640), y, U(120))); /* 30 at the first */
-    assert_false(col_line_of_sight(s, NULL, U(128), y, U(120), U(640), y, U(0)));  /* 90, then 30 */
+    assert_false(col_line_of_sight(s, NULL, U(128), y, U(120), U(640), y, U(0))); /* 90, then 30 */
     /* slopes that pass exactly through an edge of the opening: 0 -> 96 over 512,
      * crossing x=256 at 24 (below) */
     assert_false(col_line_of_sight(s, NULL, U(128), y, U(0), U(640), y, U(96)));
@@ -562,7 +574,8 @@ static void test_line_of_sight(void **state)
         for (int k = 0; k < 6; k++) {
             rng = rng * 6364136223846793005ull + 1442695040888963407ull;
             int64_t range = (k == 2 || k == 5) ? 140 : (k == 0 || k == 3 ? 800 : 280);
-            p[k] = (int64_t)((rng >> 24) % (uint64_t)(range * 4)) * 16384 - (k == 0 || k == 3 ? 16 * 65536 : 12 * 65536);
+            p[k] = (int64_t)((rng >> 24) % (uint64_t)(range * 4)) * 16384 -
+                   (k == 0 || k == 3 ? 16 * 65536 : 12 * 65536);
         }
         /* oracle: x crossings of the walls x = 256, 512 within the rooms' y span */
         int expect = 1;
@@ -619,8 +632,9 @@ static int standing_sound(const scene *s, const walls *w, int64_t x, int64_t y, 
         for (int k = 0; k < 2; k++) {
             const scn_sector *q = &s->sectors[t->sec[k]];
             if (q->floor_h > fz || q->ceil_h - fz < U(56)) {
-                if (!quiet) fprintf(stderr, "line %u: sector %u (%.3f..%.3f) does not fit at %.3f\n", i, t->sec[k],
-                        un(q->floor_h), un(q->ceil_h), un(fz));
+                if (!quiet)
+                    fprintf(stderr, "line %u: sector %u (%.3f..%.3f) does not fit at %.3f\n", i, t->sec[k],
+                            un(q->floor_h), un(q->ceil_h), un(fz));
                 return 0;
             }
         }
@@ -705,8 +719,8 @@ static void random_walk(const char *spec, int moves, int want_sectors)
             visited++;
         }
     }
-    fprintf(stderr, "%s: %d of %u sectors visited, %.0f units travelled, %d blocked, %d up, %d down\n", spec,
-            visited, s->nsectors, travelled, blocked, climbed, dropped);
+    fprintf(stderr, "%s: %d of %u sectors visited, %.0f units travelled, %d blocked, %d up, %d down\n", spec, visited,
+            s->nsectors, travelled, blocked, climbed, dropped);
     assert_true(visited >= want_sectors);
     assert_true(travelled > 4 * moves);
     free(seen);
@@ -788,7 +802,8 @@ static void test_map01_sight(void **state)
                 expect = 0;
                 break;
             }
-            i128 o1 = orient(t->ax, t->ay, t->bx, t->by, p[0], p[1]), o2 = orient(t->ax, t->ay, t->bx, t->by, p[3], p[4]);
+            i128 o1 = orient(t->ax, t->ay, t->bx, t->by, p[0], p[1]),
+                 o2 = orient(t->ax, t->ay, t->bx, t->by, p[3], p[4]);
             if (o1 == o2) continue; /* collinear: rare, skipped */
             i128 num = o1, den = o1 - o2;
             if (den < 0) num = -num, den = -den;
@@ -825,12 +840,12 @@ static void test_camera_walks_and_climbs(void **state)
         cam_move(&twin, &l.s, NULL, HAL_KEY_FORWARD, 28);
         fx_t floor;
         assert_true(col_floor_at(&l.s, cam.view.x, cam.view.y, &floor));
-        assert_true(cam.view.z >= floor + U(17));   /* eased, but never near the floor */
-        assert_true(cam.view.z - prevz <= U(24));  /* and no jump above a step */
-        assert_true(cam.view.z >= prevz);          /* only up here */
+        assert_true(cam.view.z >= floor + U(17)); /* eased, but never near the floor */
+        assert_true(cam.view.z - prevz <= U(24)); /* and no jump above a step */
+        assert_true(cam.view.z >= prevz);         /* only up here */
         prevz = cam.view.z;
     }
-    assert_memory_equal(&cam, &twin, sizeof cam); /* deterministic */
+    assert_memory_equal(&cam, &twin, sizeof cam);        /* deterministic */
     assert_true(fabs(un(cam.view.x) - 496) <= 1.0 / 32); /* stopped by the wall */
     assert_int_equal(cam.view.z, U(24 + 41));
     assert_int_equal(cam.feet, U(24));

@@ -66,15 +66,14 @@ static int setup(void **state)
 {
     (void)state;
     memset(&fk, 0, sizeof fk);
-    hal_perf_set_bus((hal_bus_model){ 8, 1 });
+    hal_perf_set_bus((hal_bus_model){8, 1});
     hal_perf_reset();
     return 0;
 }
 
 static void fill_screen(const hal_surface *s, uint8_t colour)
 {
-    for (int y = 0; y < HAL_HEIGHT; y++)
-        hal_fill_span(s, y, 0, HAL_WIDTH, colour);
+    for (int y = 0; y < HAL_HEIGHT; y++) hal_fill_span(s, y, 0, HAL_WIDTH, colour);
 }
 
 static void check_page(int page, uint8_t colour)

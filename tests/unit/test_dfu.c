@@ -46,8 +46,7 @@ static uint8_t *payload_make(size_t n, uint32_t seed)
 {
     uint8_t *p = malloc(n ? n : 1);
     rng_state = seed;
-    for (size_t i = 0; i < n; i++)
-        p[i] = (uint8_t)rng();
+    for (size_t i = 0; i < n; i++) p[i] = (uint8_t)rng();
     return p;
 }
 
@@ -86,8 +85,7 @@ static void lb_open(const dfu_dev_config_t *cfg, uint32_t flash_size, uint32_t p
 
 static void lb_default(void)
 {
-    dfu_dev_config_t c = config(256, DFU_ATTR_CAN_DNLOAD | DFU_ATTR_CAN_UPLOAD |
-                                         DFU_ATTR_MANIFEST_TOLERANT);
+    dfu_dev_config_t c = config(256, DFU_ATTR_CAN_DNLOAD | DFU_ATTR_CAN_UPLOAD | DFU_ATTR_MANIFEST_TOLERANT);
     lb_open(&c, FLASH_SIZE, PAGE);
 }
 
@@ -186,10 +184,10 @@ static void test_suffix_crc_convention(void **state)
     uint8_t *f = image_make(p, 1000, VID, PID, &len);
     assert_int_equal(len, 1016);
     const uint8_t *s = f + 1000;
-    assert_int_equal(s[0] | s[1] << 8, 0x0102);     /* bcdDevice */
+    assert_int_equal(s[0] | s[1] << 8, 0x0102); /* bcdDevice */
     assert_int_equal(s[2] | s[3] << 8, PID);
     assert_int_equal(s[4] | s[5] << 8, VID);
-    assert_int_equal(s[6] | s[7] << 8, 0x0100);     /* bcdDFU */
+    assert_int_equal(s[6] | s[7] << 8, 0x0100); /* bcdDFU */
     assert_memory_equal(s + 8, "UFD", 3);
     assert_int_equal(s[11], 16);
     uint32_t stored = (uint32_t)s[12] | (uint32_t)s[13] << 8 | (uint32_t)s[14] << 16 | (uint32_t)s[15] << 24;
@@ -225,8 +223,7 @@ static void test_parser_rejects_damage(void **state)
     dfu_image_t img;
 
     /* every truncation */
-    for (size_t n = 0; n < len; n++)
-        assert_int_not_equal(dfu_image_parse(f, n, &img), DFU_IMAGE_OK);
+    for (size_t n = 0; n < len; n++) assert_int_not_equal(dfu_image_parse(f, n, &img), DFU_IMAGE_OK);
     assert_int_equal(dfu_image_parse(NULL, 0, &img), DFU_IMAGE_TOO_SHORT);
     assert_int_equal(dfu_image_parse(f, 15, &img), DFU_IMAGE_TOO_SHORT);
     assert_int_equal(dfu_image_parse(f, len - 1, &img), DFU_IMAGE_NO_SIGNATURE);
@@ -243,16 +240,16 @@ static void test_parser_rejects_damage(void **state)
     assert_int_equal(dfu_image_parse(f, len, &img), DFU_IMAGE_BAD_CRC);
     assert_int_not_equal(img.crc_stored, img.crc_computed);
     f[10] ^= 0x40;
-    f[len - 7] = 'X';                                /* "UFD" -> "UXD" */
+    f[len - 7] = 'X'; /* "UFD" -> "UXD" */
     assert_int_equal(dfu_image_parse(f, len, &img), DFU_IMAGE_NO_SIGNATURE);
     f[len - 7] = 'F';
     assert_int_equal(dfu_image_parse(f, len, &img), DFU_IMAGE_OK);
 
     /* fields damaged with the CRC made right: the field checks themselves */
-    f[len - 5] = 15;                                 /* bLength below 16 */
+    f[len - 5] = 15; /* bLength below 16 */
     recrc(f, len);
     assert_int_equal(dfu_image_parse(f, len, &img), DFU_IMAGE_BAD_LENGTH);
-    f[len - 5] = 255;                                /* fits, but would eat firmware bytes */
+    f[len - 5] = 255; /* fits, but would eat firmware bytes */
     recrc(f, len);
     assert_int_equal(dfu_image_parse(f, len, &img), DFU_IMAGE_BAD_LENGTH);
     assert_int_equal(img.payload_len, 0);
@@ -260,7 +257,7 @@ static void test_parser_rejects_damage(void **state)
     recrc(f, len);
     assert_int_equal(dfu_image_parse(f, len, &img), DFU_IMAGE_BAD_LENGTH);
     f[len - 5] = 16;
-    f[len - 10] = 0x1A;                              /* bcdDFU 0x011A: DfuSe */
+    f[len - 10] = 0x1A; /* bcdDFU 0x011A: DfuSe */
     f[len - 9] = 0x01;
     recrc(f, len);
     assert_int_equal(dfu_image_parse(f, len, &img), DFU_IMAGE_BAD_VERSION);
@@ -299,15 +296,14 @@ static void test_download_succeeds_all_transfer_sizes(void **state)
             uint8_t *p = payload_make(n, (uint32_t)(si * 100 + li));
             dfu_host_report r;
             dfu_host_err e = flash_payload(p, n, 0, &r);
-            if (e != DFU_HOST_OK)
-                fail_msg("ts %u len %zu: %s", ts, n, r.msg);
+            if (e != DFU_HOST_OK) fail_msg("ts %u len %zu: %s", ts, n, r.msg);
             assert_app_is(p, n);
             uint32_t blocks = (uint32_t)((n + ts - 1) / ts);
             assert_int_equal(r.blocks_total, blocks);
             assert_int_equal(r.blocks_done, blocks);
             assert_int_equal(r.transfer_size, ts);
             assert_int_equal(r.payload_crc, crc_update(0, p, n));
-            assert_int_equal(lb.by_request[DFU_REQ_DNLOAD], blocks + 1);  /* + the empty one */
+            assert_int_equal(lb.by_request[DFU_REQ_DNLOAD], blocks + 1); /* + the empty one */
             assert_int_equal(lb.stalls, 0);
             assert_true(r.manifested);
             assert_int_equal(r.reenumerated, 1);
@@ -321,7 +317,7 @@ static void test_download_succeeds_all_transfer_sizes(void **state)
 static void test_host_transfer_size_option(void **state)
 {
     (void)state;
-    lb_default();     /* the device takes 256 */
+    lb_default(); /* the device takes 256 */
     uint8_t *p = payload_make(3000, 3);
     dfu_host_report r;
     assert_int_equal(flash_payload(p, 3000, 64, &r), DFU_HOST_OK);
@@ -345,7 +341,7 @@ static void test_manifestation_not_tolerant(void **state)
     uint8_t *p = payload_make(9000, 4);
     dfu_host_report r;
     assert_int_equal(flash_payload(p, 9000, 0, &r), DFU_HOST_OK);
-    assert_true(r.manifested);        /* the device said dfuMANIFEST-WAIT-RESET */
+    assert_true(r.manifested); /* the device said dfuMANIFEST-WAIT-RESET */
     assert_int_equal(lb.resets, 1);
     assert_int_equal(r.final_state, DFU_STATE_APP_IDLE);
     assert_app_is(p, 9000);
@@ -359,16 +355,15 @@ static void test_detach_from_runtime(void **state)
     uint8_t *old = payload_make(4000, 5), *neu = payload_make(7000, 6);
     dfu_host_report r;
     assert_int_equal(flash_payload(old, 4000, 0, &r), DFU_HOST_OK);
-    assert_int_equal(dfu_dev_state(&lb.dev), DFU_STATE_APP_IDLE);   /* runs the application */
+    assert_int_equal(dfu_dev_state(&lb.dev), DFU_STATE_APP_IDLE); /* runs the application */
     unsigned long resets = lb.resets;
     assert_int_equal(flash_payload(neu, 7000, 0, &r), DFU_HOST_OK);
     assert_int_equal(lb.by_request[DFU_REQ_DETACH], 1);
-    assert_int_equal(lb.resets - resets, 2);                          /* enter DFU + run */
+    assert_int_equal(lb.resets - resets, 2); /* enter DFU + run */
     assert_app_is(neu, 7000);
 
     /* bitWillDetach: the device re-attaches by itself, the host does not reset it */
-    dfu_dev_config_t c = config(256, DFU_ATTR_CAN_DNLOAD | DFU_ATTR_MANIFEST_TOLERANT |
-                                         DFU_ATTR_WILL_DETACH);
+    dfu_dev_config_t c = config(256, DFU_ATTR_CAN_DNLOAD | DFU_ATTR_MANIFEST_TOLERANT | DFU_ATTR_WILL_DETACH);
     lb_open(&c, FLASH_SIZE, PAGE);
     assert_int_equal(flash_payload(old, 4000, 0, &r), DFU_HOST_OK);
     resets = lb.resets;
@@ -424,9 +419,9 @@ static void test_damaged_image_sends_nothing(void **state)
 
 typedef struct fault {
     dfu_loop_op op;
-    long nth;                 /* the nth operation of that kind (0-based) */
-    int action;               /* DFU_LOOP_FAIL or DFU_LOOP_CORRUPT */
-    uint32_t at_offset;       /* or: the first op at this offset (nth < 0) */
+    long nth;           /* the nth operation of that kind (0-based) */
+    int action;         /* DFU_LOOP_FAIL or DFU_LOOP_CORRUPT */
+    uint32_t at_offset; /* or: the first op at this offset (nth < 0) */
     long seen;
 } fault;
 
@@ -435,10 +430,8 @@ static int fault_hook(void *user, dfu_loop_op op, uint32_t off, const uint8_t *s
     (void)src;
     (void)n;
     fault *f = user;
-    if (op != f->op)
-        return DFU_LOOP_PASS;
-    if (f->nth >= 0 ? f->seen++ == f->nth : off == f->at_offset)
-        return f->action;
+    if (op != f->op) return DFU_LOOP_PASS;
+    if (f->nth >= 0 ? f->seen++ == f->nth : off == f->at_offset) return f->action;
     return DFU_LOOP_PASS;
 }
 
@@ -458,8 +451,8 @@ static void device_error_case(dfu_loop_op op, long nth, uint32_t at, int action,
     assert_non_null(strstr(r.msg, dfu_status_name(want_status)));
     assert_non_null(strstr(r.msg, "CLRSTATUS"));
     assert_int_equal(lb.by_request[DFU_REQ_CLRSTATUS], clr + 1);
-    assert_int_equal(dfu_dev_state(&lb.dev), DFU_STATE_IDLE);   /* cleaned up */
-    assert_false(app_valid());          /* the old application was invalidated first */
+    assert_int_equal(dfu_dev_state(&lb.dev), DFU_STATE_IDLE); /* cleaned up */
+    assert_false(app_valid());                                /* the old application was invalidated first */
     /* after a reset the device stays in DFU mode */
     dfu_dev_bus_reset(&lb.dev, lb.now_ms);
     assert_int_equal(dfu_dev_state(&lb.dev), DFU_STATE_ERROR);
@@ -499,7 +492,7 @@ static void test_image_too_large(void **state)
 {
     (void)state;
     lb_default();
-    size_t n = FLASH_SIZE - PAGE + 1;           /* one byte more than the region takes */
+    size_t n = FLASH_SIZE - PAGE + 1; /* one byte more than the region takes */
     uint8_t *p = payload_make(n, 10);
     dfu_host_report r;
     /* an old application, then an oversized image: refused before any request, so
@@ -551,8 +544,8 @@ static void test_transfer_error_then_abort(void **state)
 
 /* After whatever happened, power-cycle and check: a valid application is exactly the
  * old or the new image; otherwise the device is in DFU mode. Then retry. */
-static void check_after_interruption(const uint8_t *old, size_t old_n, const uint8_t *neu,
-                                     size_t neu_n, int *saw_invalid, int *saw_old, int *saw_new)
+static void check_after_interruption(const uint8_t *old, size_t old_n, const uint8_t *neu, size_t neu_n,
+                                     int *saw_invalid, int *saw_old, int *saw_new)
 {
     dfu_loop_power_cycle(&lb, 0);
     dfu_app_info_t info;
@@ -581,8 +574,7 @@ static void interrupt_all(int with_old, int timeout)
     dfu_host_report r;
     /* how many requests a whole download takes */
     lb_default();
-    if (with_old)
-        assert_int_equal(flash_payload(old, 3000, 0, &r), DFU_HOST_OK);
+    if (with_old) assert_int_equal(flash_payload(old, 3000, 0, &r), DFU_HOST_OK);
     unsigned long before = lb.requests;
     assert_int_equal(flash_payload(neu, 6000, 0, &r), DFU_HOST_OK);
     long total = (long)(lb.requests - before);
@@ -590,8 +582,7 @@ static void interrupt_all(int with_old, int timeout)
     int inval = 0, sold = 0, snew = 0;
     for (long k = 0; k <= total; k++) {
         lb_default();
-        if (with_old)
-            assert_int_equal(flash_payload(old, 3000, 0, &r), DFU_HOST_OK);
+        if (with_old) assert_int_equal(flash_payload(old, 3000, 0, &r), DFU_HOST_OK);
         if (timeout)
             lb.timeout_after = (long)lb.requests + k;
         else
@@ -608,19 +599,16 @@ static void interrupt_all(int with_old, int timeout)
                 assert_int_equal(e, DFU_HOST_TIMEOUT);
             else
                 assert_int_equal(e, DFU_HOST_NO_DEVICE);
-            if (e != DFU_HOST_OK && !timeout && !waiting)
-                assert_non_null(strstr(r.msg, "vanished"));
-            if (e != DFU_HOST_OK && timeout)
-                assert_non_null(strstr(r.msg, "did not answer"));
+            if (e != DFU_HOST_OK && !timeout && !waiting) assert_non_null(strstr(r.msg, "vanished"));
+            if (e != DFU_HOST_OK && timeout) assert_non_null(strstr(r.msg, "did not answer"));
         } else {
             assert_int_equal(e, DFU_HOST_OK);
         }
         check_after_interruption(with_old ? old : NULL, 3000, neu, 6000, &inval, &sold, &snew);
     }
-    assert_true(inval > 20);   /* most interruptions: nothing valid, in the bootloader */
-    assert_true(snew >= 1);    /* interrupted after the commit: the new image */
-    if (with_old)
-        assert_true(sold >= 1);  /* interrupted before the first block: the old image */
+    assert_true(inval > 20);              /* most interruptions: nothing valid, in the bootloader */
+    assert_true(snew >= 1);               /* interrupted after the commit: the new image */
+    if (with_old) assert_true(sold >= 1); /* interrupted before the first block: the old image */
     free(old);
     free(neu);
 }
@@ -656,15 +644,12 @@ typedef struct cut {
 static int cut_hook(void *user, dfu_loop_op op, uint32_t off, const uint8_t *src, uint32_t n)
 {
     cut *c = user;
-    if (op == DFU_LOOP_READ)
-        return DFU_LOOP_PASS;
+    if (op == DFU_LOOP_READ) return DFU_LOOP_PASS;
     if (c->seen++ == c->target) {
         memcpy(c->snap, lb.mem, FLASH_SIZE);
-        if (c->torn && op == DFU_LOOP_ERASE)
-            memset(c->snap + off, 0xFF, PAGE / 2);
+        if (c->torn && op == DFU_LOOP_ERASE) memset(c->snap + off, 0xFF, PAGE / 2);
         if (c->torn && op == DFU_LOOP_PROGRAM)
-            for (uint32_t i = 0; i < n / 2; i++)
-                c->snap[off + i] &= src[i];
+            for (uint32_t i = 0; i < n / 2; i++) c->snap[off + i] &= src[i];
         c->taken = 1;
     }
     return DFU_LOOP_PASS;
@@ -712,8 +697,7 @@ static void test_power_cut_at_every_flash_operation(void **state)
             lb.flash_hook = cut_hook;
             lb.hook_user = &c;
             assert_int_equal(flash_payload(neu, 4500, 0, &r), DFU_HOST_OK);
-            if (!c.taken)
-                break;
+            if (!c.taken) break;
             dfu_app_info_t info;
             if (dfu_app_check(&sf, &info)) {
                 if (info.length == 2500 && memcmp(c.snap, old, 2500) == 0) {
@@ -730,14 +714,13 @@ static void test_power_cut_at_every_flash_operation(void **state)
             dfu_dev_t *d = malloc(sizeof *d);
             dfu_dev_config_t cfg = dfu_loop_default_config();
             assert_int_equal(dfu_dev_init(d, &cfg, &sf, 0, 0), 0);
-            assert_int_equal(dfu_dev_state(d), dfu_app_check(&sf, NULL) ? DFU_STATE_APP_IDLE
-                                                                         : DFU_STATE_ERROR);
+            assert_int_equal(dfu_dev_state(d), dfu_app_check(&sf, NULL) ? DFU_STATE_APP_IDLE : DFU_STATE_ERROR);
             free(d);
         }
     }
     assert_true(inval > 10);
-    assert_int_equal(sold, 1);  /* cut before the valid mark was erased */
-    assert_int_equal(snew, 0);  /* the last operation is the valid mark: never before it */
+    assert_int_equal(sold, 1); /* cut before the valid mark was erased */
+    assert_int_equal(snew, 0); /* the last operation is the valid mark: never before it */
     free(c.snap);
     free(old);
     free(neu);
@@ -753,7 +736,7 @@ static void test_poll_timeouts_honoured(void **state)
     c.erase_ms = 200;
     c.manifest_ms = 1700;
     lb_open(&c, FLASH_SIZE, PAGE);
-    size_t n = 10000;       /* 20 blocks of 512; 10 pages of 1024 */
+    size_t n = 10000; /* 20 blocks of 512; 10 pages of 1024 */
     uint8_t *p = payload_make(n, 15);
     dfu_host_report r;
     assert_int_equal(flash_payload(p, n, 0, &r), DFU_HOST_OK);
@@ -778,14 +761,14 @@ static void test_early_poll_stalls(void **state)
     c.program_ms = 30;
     c.erase_ms = 100;
     lb_open(&c, FLASH_SIZE, PAGE);
-    assert_int_equal(rq(DFU_REQTYPE_OUT, DFU_REQ_CLRSTATUS, 0, NULL, 0), 0);  /* out of errFIRMWARE */
+    assert_int_equal(rq(DFU_REQTYPE_OUT, DFU_REQ_CLRSTATUS, 0, NULL, 0), 0); /* out of errFIRMWARE */
     uint8_t blk[256];
     memset(blk, 0x5A, sizeof blk);
     assert_int_equal(rq(DFU_REQTYPE_OUT, DFU_REQ_DNLOAD, 0, blk, 256), 256);
     st s = getstatus();
     assert_int_equal(s.state, DFU_STATE_DNBUSY);
-    assert_int_equal(s.poll, 30 + 2 * 100);      /* program + erase page and valid mark */
-    advance(s.poll - 1);                          /* one millisecond early */
+    assert_int_equal(s.poll, 30 + 2 * 100); /* program + erase page and valid mark */
+    advance(s.poll - 1);                    /* one millisecond early */
     assert_int_equal(rq(DFU_REQTYPE_IN, DFU_REQ_GETSTATUS, 0, blk, 6), DFU_XFER_STALL);
     s = getstatus();
     assert_int_equal(s.state, DFU_STATE_ERROR);
@@ -803,15 +786,26 @@ static void test_early_poll_stalls(void **state)
 
 /* ---- the state machine ---------------------------------------------------------------------- */
 
-enum { S_APP_IDLE, S_APP_DETACH, S_IDLE, S_DNLOAD_SYNC, S_DNBUSY, S_DNLOAD_IDLE, S_MANIFEST_SYNC,
-       S_MANIFEST, S_WAIT_RESET, S_UPLOAD_IDLE, S_ERROR, S_COUNT };
+enum {
+    S_APP_IDLE,
+    S_APP_DETACH,
+    S_IDLE,
+    S_DNLOAD_SYNC,
+    S_DNBUSY,
+    S_DNLOAD_IDLE,
+    S_MANIFEST_SYNC,
+    S_MANIFEST,
+    S_WAIT_RESET,
+    S_UPLOAD_IDLE,
+    S_ERROR,
+    S_COUNT
+};
 
 /* A fresh device in the given state (transfer size 256, valid app of 3000 bytes for
  * the states that need one). */
 static void drive(int s)
 {
-    uint8_t attrs = DFU_ATTR_CAN_DNLOAD | DFU_ATTR_CAN_UPLOAD |
-                    (s == S_WAIT_RESET ? 0 : DFU_ATTR_MANIFEST_TOLERANT);
+    uint8_t attrs = DFU_ATTR_CAN_DNLOAD | DFU_ATTR_CAN_UPLOAD | (s == S_WAIT_RESET ? 0 : DFU_ATTR_MANIFEST_TOLERANT);
     dfu_dev_config_t c = config(256, attrs);
     c.program_ms = 10;
     c.erase_ms = 10;
@@ -825,10 +819,9 @@ static void drive(int s)
         assert_int_equal(flash_payload(p, 3000, 0, &r), DFU_HOST_OK);
         free(p);
         assert_int_equal(getstate(), DFU_STATE_APP_IDLE);
-        if (s == S_APP_DETACH)
-            assert_int_equal(rq(DFU_REQTYPE_OUT, DFU_REQ_DETACH, 500, NULL, 0), 0);
+        if (s == S_APP_DETACH) assert_int_equal(rq(DFU_REQTYPE_OUT, DFU_REQ_DETACH, 500, NULL, 0), 0);
         if (s == S_UPLOAD_IDLE) {
-            dfu_dev_bus_reset(&lb.dev, lb.now_ms);   /* app -> stays app: enter DFU via detach */
+            dfu_dev_bus_reset(&lb.dev, lb.now_ms); /* app -> stays app: enter DFU via detach */
             assert_int_equal(rq(DFU_REQTYPE_OUT, DFU_REQ_DETACH, 500, NULL, 0), 0);
             dfu_dev_bus_reset(&lb.dev, lb.now_ms);
             assert_int_equal(getstate(), DFU_STATE_IDLE);
@@ -846,8 +839,7 @@ static void drive(int s)
                     assert_int_equal(getstatus().state, DFU_STATE_DNLOAD_IDLE);
                 }
             }
-            if (s >= S_MANIFEST_SYNC)
-                assert_int_equal(rq(DFU_REQTYPE_OUT, DFU_REQ_DNLOAD, 1, NULL, 0), 0);
+            if (s >= S_MANIFEST_SYNC) assert_int_equal(rq(DFU_REQTYPE_OUT, DFU_REQ_DNLOAD, 1, NULL, 0), 0);
             if (s >= S_MANIFEST) {
                 st x = getstatus();
                 assert_int_equal(x.state, DFU_STATE_MANIFEST);
@@ -858,10 +850,10 @@ static void drive(int s)
             }
         }
     }
-    static const uint8_t want[S_COUNT] = {
-        DFU_STATE_APP_IDLE, DFU_STATE_APP_DETACH, DFU_STATE_IDLE, DFU_STATE_DNLOAD_SYNC,
-        DFU_STATE_DNBUSY, DFU_STATE_DNLOAD_IDLE, DFU_STATE_MANIFEST_SYNC, DFU_STATE_MANIFEST,
-        DFU_STATE_MANIFEST_WAIT_RESET, DFU_STATE_UPLOAD_IDLE, DFU_STATE_ERROR};
+    static const uint8_t want[S_COUNT] = {DFU_STATE_APP_IDLE,      DFU_STATE_APP_DETACH, DFU_STATE_IDLE,
+                                          DFU_STATE_DNLOAD_SYNC,   DFU_STATE_DNBUSY,     DFU_STATE_DNLOAD_IDLE,
+                                          DFU_STATE_MANIFEST_SYNC, DFU_STATE_MANIFEST,   DFU_STATE_MANIFEST_WAIT_RESET,
+                                          DFU_STATE_UPLOAD_IDLE,   DFU_STATE_ERROR};
     assert_int_equal(dfu_dev_state(&lb.dev), want[s]);
 }
 
@@ -883,11 +875,10 @@ static void test_invalid_requests_stall(void **state)
         [S_UPLOAD_IDLE] = "UPLOAD GETSTATUS GETSTATE ABORT",
         [S_ERROR] = "GETSTATUS CLRSTATUS GETSTATE",
     };
-    static const char *const rname[R_N] = {"DETACH", "DNLOAD", "D0", "UPLOAD", "GETSTATUS",
-                                           "CLRSTATUS", "GETSTATE", "ABORT"};
-    static const uint8_t breq[R_N] = {DFU_REQ_DETACH, DFU_REQ_DNLOAD, DFU_REQ_DNLOAD,
-                                      DFU_REQ_UPLOAD, DFU_REQ_GETSTATUS, DFU_REQ_CLRSTATUS,
-                                      DFU_REQ_GETSTATE, DFU_REQ_ABORT};
+    static const char *const rname[R_N] = {"DETACH",    "DNLOAD",    "D0",       "UPLOAD",
+                                           "GETSTATUS", "CLRSTATUS", "GETSTATE", "ABORT"};
+    static const uint8_t breq[R_N] = {DFU_REQ_DETACH,    DFU_REQ_DNLOAD,    DFU_REQ_DNLOAD,   DFU_REQ_UPLOAD,
+                                      DFU_REQ_GETSTATUS, DFU_REQ_CLRSTATUS, DFU_REQ_GETSTATE, DFU_REQ_ABORT};
     int stalls = 0, acks = 0;
     for (int s = 0; s < S_COUNT; s++) {
         for (int q = 0; q < R_N; q++) {
@@ -895,29 +886,23 @@ static void test_invalid_requests_stall(void **state)
             uint8_t before = dfu_dev_state(&lb.dev);
             uint8_t buf[256];
             memset(buf, 0x3C, sizeof buf);
-            int in = breq[q] == DFU_REQ_UPLOAD || breq[q] == DFU_REQ_GETSTATUS ||
-                     breq[q] == DFU_REQ_GETSTATE;
-            uint16_t len = q == R_DNLOAD || q == R_UPLOAD ? 256 : q == R_GETSTATUS ? 6
-                           : q == R_GETSTATE ? 1 : 0;
+            int in = breq[q] == DFU_REQ_UPLOAD || breq[q] == DFU_REQ_GETSTATUS || breq[q] == DFU_REQ_GETSTATE;
+            uint16_t len = q == R_DNLOAD || q == R_UPLOAD ? 256 : q == R_GETSTATUS ? 6 : q == R_GETSTATE ? 1 : 0;
             uint16_t value = q == R_DNLOAD || q == R_D0 ? 1 : q == R_DETACH ? 500 : 0;
             int x = rq(in ? DFU_REQTYPE_IN : DFU_REQTYPE_OUT, breq[q], value, buf, len);
             /* does the name appear as a whole word in the valid list? */
             const char *v = valid[s], *hit = strstr(v, rname[q]);
-            while (hit && ((hit > v && hit[-1] != ' ') ||
-                           (hit[strlen(rname[q])] != ' ' && hit[strlen(rname[q])] != 0)))
+            while (hit && ((hit > v && hit[-1] != ' ') || (hit[strlen(rname[q])] != ' ' && hit[strlen(rname[q])] != 0)))
                 hit = strstr(hit + 1, rname[q]);
             if (hit) {
-                if (x < 0)
-                    fail_msg("state %s: %s should be accepted", dfu_state_name(before), rname[q]);
+                if (x < 0) fail_msg("state %s: %s should be accepted", dfu_state_name(before), rname[q]);
                 acks++;
                 continue;
             }
-            if (x != DFU_XFER_STALL)
-                fail_msg("state %s: %s should stall, got %d", dfu_state_name(before), rname[q], x);
+            if (x != DFU_XFER_STALL) fail_msg("state %s: %s should stall, got %d", dfu_state_name(before), rname[q], x);
             stalls++;
             uint8_t after = dfu_dev_state(&lb.dev);
-            if (before == DFU_STATE_APP_IDLE || before == DFU_STATE_MANIFEST_WAIT_RESET ||
-                before == DFU_STATE_ERROR) {
+            if (before == DFU_STATE_APP_IDLE || before == DFU_STATE_MANIFEST_WAIT_RESET || before == DFU_STATE_ERROR) {
                 assert_int_equal(after, before);
             } else if (before == DFU_STATE_APP_DETACH) {
                 assert_int_equal(after, DFU_STATE_APP_IDLE);
@@ -970,7 +955,7 @@ static void test_abort_and_reset_leave_no_valid_app(void **state)
     st s = getstatus();
     advance(s.poll);
     assert_int_equal(getstatus().state, DFU_STATE_DNLOAD_IDLE);
-    assert_false(app_valid());                 /* the valid mark went first */
+    assert_false(app_valid()); /* the valid mark went first */
     assert_int_equal(rq(DFU_REQTYPE_OUT, DFU_REQ_ABORT, 0, NULL, 0), 0);
     assert_int_equal(getstate(), DFU_STATE_IDLE);
     assert_false(app_valid());
@@ -999,12 +984,11 @@ static void test_host_recovers_leftover_states(void **state)
     (void)state;
     uint8_t *p = payload_make(5000, 17);
     dfu_host_report r;
-    static const int from[] = {S_ERROR, S_IDLE, S_DNLOAD_SYNC, S_DNLOAD_IDLE, S_MANIFEST_SYNC,
-                               S_UPLOAD_IDLE, S_WAIT_RESET, S_APP_IDLE, S_APP_DETACH};
+    static const int from[] = {S_ERROR,       S_IDLE,       S_DNLOAD_SYNC, S_DNLOAD_IDLE, S_MANIFEST_SYNC,
+                               S_UPLOAD_IDLE, S_WAIT_RESET, S_APP_IDLE,    S_APP_DETACH};
     for (size_t i = 0; i < sizeof from / sizeof from[0]; i++) {
         drive(from[i]);
-        if (flash_payload(p, 5000, 0, &r) != DFU_HOST_OK)
-            fail_msg("from state %d: %s", from[i], r.msg);
+        if (flash_payload(p, 5000, 0, &r) != DFU_HOST_OK) fail_msg("from state %d: %s", from[i], r.msg);
         assert_app_is(p, 5000);
     }
     free(p);
@@ -1013,22 +997,21 @@ static void test_host_recovers_leftover_states(void **state)
 static void test_upload_reads_back(void **state)
 {
     (void)state;
-    drive(S_UPLOAD_IDLE);           /* 256 bytes of the 3000-byte application read */
+    drive(S_UPLOAD_IDLE); /* 256 bytes of the 3000-byte application read */
     uint8_t *p = payload_make(3000, 16);
     uint8_t *got = malloc(3000 + 256);
     size_t n = 0;
-    memcpy(got, lb.mem, 256);       /* the first frame, as drive() read it */
+    memcpy(got, lb.mem, 256); /* the first frame, as drive() read it */
     n = 256;
     for (;;) {
         int x = rq(DFU_REQTYPE_IN, DFU_REQ_UPLOAD, 0, got + n, 256);
         assert_true(x >= 0);
         n += (size_t)x;
-        if (x < 256)
-            break;
+        if (x < 256) break;
     }
     assert_int_equal(n, 3000);
     assert_memory_equal(got, p, 3000);
-    assert_int_equal(getstate(), DFU_STATE_IDLE);   /* the short frame ended it */
+    assert_int_equal(getstate(), DFU_STATE_IDLE); /* the short frame ended it */
     free(got);
     free(p);
 }
@@ -1036,8 +1019,7 @@ static void test_upload_reads_back(void **state)
 static void test_messages(void **state)
 {
     (void)state;
-    for (unsigned s = 0; s <= 10; s++)
-        assert_string_not_equal(dfu_state_name(s), "unknown state");
+    for (unsigned s = 0; s <= 10; s++) assert_string_not_equal(dfu_state_name(s), "unknown state");
     for (unsigned s = 0; s <= 15; s++) {
         assert_string_not_equal(dfu_status_name(s), "unknown status");
         assert_true(strlen(dfu_status_text(s)) > 5);
@@ -1049,7 +1031,7 @@ static void test_messages(void **state)
     dfu_dev_t *d = malloc(sizeof *d);
     dfu_dev_config_t c = dfu_loop_default_config();
     dfu_flash_t f = {NULL, 1024, 1024, snap_never, snap_never_prog, snap_read};
-    assert_int_equal(dfu_dev_init(d, &c, &f, 0, 0), -1);       /* one page only */
+    assert_int_equal(dfu_dev_init(d, &c, &f, 0, 0), -1); /* one page only */
     f.size = 4096;
     c.transfer_size = DFU_MAX_TRANSFER + 1;
     assert_int_equal(dfu_dev_init(d, &c, &f, 0, 0), -1);

@@ -13,9 +13,30 @@
  * their neighbours, the extremes, and a pseudo-random spread. */
 static int32_t sample(uint32_t i)
 {
-    static const int32_t edges[] = {0, 1, -1, 2, -2, 65535, 65536, 65537, -65536, -65537, 32768, -32768,
-                                    INT32_MAX, INT32_MIN, INT32_MAX - 1, INT32_MIN + 1, 46340 << 16, 181 << 16,
-                                    -(181 << 16), 0x7FFF0000, -0x7FFF0000, 0x00010001, 3, 100};
+    static const int32_t edges[] = {0,
+                                    1,
+                                    -1,
+                                    2,
+                                    -2,
+                                    65535,
+                                    65536,
+                                    65537,
+                                    -65536,
+                                    -65537,
+                                    32768,
+                                    -32768,
+                                    INT32_MAX,
+                                    INT32_MIN,
+                                    INT32_MAX - 1,
+                                    INT32_MIN + 1,
+                                    46340 << 16,
+                                    181 << 16,
+                                    -(181 << 16),
+                                    0x7FFF0000,
+                                    -0x7FFF0000,
+                                    0x00010001,
+                                    3,
+                                    100};
     uint32_t n = sizeof edges / sizeof edges[0];
     if (i < n) return edges[i];
     uint32_t x = i * 2654435761u;
@@ -23,9 +44,9 @@ static int32_t sample(uint32_t i)
     x *= 2246822519u;
     x ^= x >> 13;
     switch (i % 4) {
-    case 0: return (int32_t)x;                 /* anywhere */
-    case 1: return (int32_t)x >> 8;            /* |v| < 128 */
-    case 2: return (int32_t)x >> 16;           /* |v| < 1/2 */
+    case 0: return (int32_t)x;       /* anywhere */
+    case 1: return (int32_t)x >> 8;  /* |v| < 128 */
+    case 2: return (int32_t)x >> 16; /* |v| < 1/2 */
     default: return (int32_t)(1u << (x % 31)) * ((x & 1u) ? -1 : 1);
     }
 }
@@ -70,10 +91,10 @@ static void test_recip(void **state)
     assert_int_equal(fx_recip(FX_ONE), FX_ONE);
     assert_int_equal(fx_recip(2 * FX_ONE), FX_HALF);
     assert_int_equal(fx_recip(0), FX_MAX);
-    assert_int_equal(fx_recip(1), FX_MAX);  /* 65536: saturates */
+    assert_int_equal(fx_recip(1), FX_MAX); /* 65536: saturates */
     assert_int_equal(fx_recip(-1), FX_MIN);
     assert_int_equal(fx_recip(INT32_MIN), -2); /* 1 / -32768 = -2^-15 = -2 raw */
-    assert_int_equal(fx_recip(2), FX_MAX);    /* 2^31 does not fit */
+    assert_int_equal(fx_recip(2), FX_MAX);     /* 2^31 does not fit */
     for (uint32_t i = 0; i < 100000; i++) {
         int32_t a = sample(i);
         if (a == 0) continue;
@@ -186,8 +207,10 @@ static void test_angles(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_mul),    cmocka_unit_test(test_div),   cmocka_unit_test(test_recip),
-        cmocka_unit_test(test_floor_and_shift), cmocka_unit_test(test_udiv64_32), cmocka_unit_test(test_trig), cmocka_unit_test(test_angles),
+        cmocka_unit_test(test_mul),       cmocka_unit_test(test_div),
+        cmocka_unit_test(test_recip),     cmocka_unit_test(test_floor_and_shift),
+        cmocka_unit_test(test_udiv64_32), cmocka_unit_test(test_trig),
+        cmocka_unit_test(test_angles),
     };
     return cmocka_run_group_tests_name("fixed", tests, NULL, NULL);
 }

@@ -26,7 +26,7 @@
 
 #define NF 48 /* frames of the walk */
 
-static uint8_t *walk;           /* NF frames */
+static uint8_t *walk; /* NF frames */
 static uint32_t walk_crc[NF];
 static fl_frame_info walk_info[NF];
 
@@ -66,7 +66,7 @@ typedef struct {
     uint32_t shown, dropped, keyreqs, bad, wrong;
     int have_first;
     uint32_t first_seen, last_seen, last_shown;
-    uint32_t log_hash;        /* of every event's kind, frame number and reason */
+    uint32_t log_hash; /* of every event's kind, frame number and reason */
 } watch;
 
 static void on_event(void *ctx, const fl_event *ev)
@@ -182,8 +182,9 @@ static int setup(void **state)
         eng_step(&e, keys, 50);
         /* flip mode: the frame just drawn is shown, the one before is on the other page */
         assert_true(hal_shown_page() == hal_target_vram(hal_target_display_start()));
-        if (k) assert_memory_equal(hal_target_vram(1 - hal_target_display_start()), walk + (size_t)(k - 1) * FL_FRAME_BYTES,
-                                   FL_FRAME_BYTES);
+        if (k)
+            assert_memory_equal(hal_target_vram(1 - hal_target_display_start()),
+                                walk + (size_t)(k - 1) * FL_FRAME_BYTES, FL_FRAME_BYTES);
         memcpy(walk + (size_t)k * FL_FRAME_BYTES, hal_shown_page(), FL_FRAME_BYTES);
         const camera *c = &e.cam.view;
         walk_info[k] = info_for(hal_shown_page(), (uint32_t)k);
@@ -553,15 +554,15 @@ static void test_synthetic_pictures(void **state)
             for (int x = 0; x < FL_W; x++) {
                 uint8_t v;
                 switch (s) {
-                case 0: v = 0; break;                                  /* empty */
-                case 1: v = 255; break;                                /* one colour */
-                case 2: v = (uint8_t)(x & 1); break;                   /* a transition at every pixel */
-                case 3: v = (uint8_t)((x + y) & 1); break;             /* checkerboard */
-                case 4: v = (uint8_t)(x * 7 / 320 + y / 50); break;    /* blocks */
-                case 5: v = (uint8_t)(x > y * 3 / 2 ? 3 : 9); break;   /* a slanted edge */
+                case 0: v = 0; break;                                                 /* empty */
+                case 1: v = 255; break;                                               /* one colour */
+                case 2: v = (uint8_t)(x & 1); break;                                  /* a transition at every pixel */
+                case 3: v = (uint8_t)((x + y) & 1); break;                            /* checkerboard */
+                case 4: v = (uint8_t)(x * 7 / 320 + y / 50); break;                   /* blocks */
+                case 5: v = (uint8_t)(x > y * 3 / 2 ? 3 : 9); break;                  /* a slanted edge */
                 case 6: v = (uint8_t)(x > 160 + (y % 40) - 20 ? x / 40 : 200); break; /* zig-zag */
-                case 7: v = (uint8_t)rnd(); break;                     /* noise */
-                default: v = (uint8_t)(x == 319 || y == 199 ? 17 : 4); break; /* edges at the borders */
+                case 7: v = (uint8_t)rnd(); break;                                    /* noise */
+                default: v = (uint8_t)(x == 319 || y == 199 ? 17 : 4); break;         /* edges at the borders */
                 }
                 p[y * FL_W + x] = v;
             }
@@ -763,8 +764,8 @@ static void test_forged_pictures(void **state)
         uint8_t payload[FL_FRAME_PRE + 5 + 200];
         uint32_t n = FL_FRAME_PRE + 1 + rnd() % 200;
         for (uint32_t i = 0; i < n; i++) payload[i] = (uint8_t)rnd();
-        payload[FL_INFO_BYTES] = (uint8_t)(rnd() & 1);  /* flags */
-        payload[FL_FRAME_PRE] = FL_METHOD_EDGE;          /* keyframe: method after the check */
+        payload[FL_INFO_BYTES] = (uint8_t)(rnd() & 1); /* flags */
+        payload[FL_FRAME_PRE] = FL_METHOD_EDGE;        /* keyframe: method after the check */
         s.len = 0;
         fl_writer_message(&enc.w, FL_MSG_KEYFRAME, (uint32_t)t, payload, n);
         fl_dec_feed(&r->dec, s.p, (uint32_t)s.len);
@@ -783,14 +784,16 @@ static void test_framing(void **state)
     static uint8_t msg[2000], got[4096];
     for (uint32_t len = 0; len < 800; len += (len < 520 ? 1 : 37)) {
         for (int pat = 0; pat < 3; pat++) {
-            for (uint32_t i = 0; i < len; i++) msg[i] = pat == 0 ? (uint8_t)(i % 255 + 1) : pat == 1 ? 0 : (uint8_t)(i % 3 ? 5 : 0);
+            for (uint32_t i = 0; i < len; i++)
+                msg[i] = pat == 0 ? (uint8_t)(i % 255 + 1) : pat == 1 ? 0 : (uint8_t)(i % 3 ? 5 : 0);
             buf s = {0};
             fl_writer w;
             fl_writer_init(&w, buf_put, &s);
             fl_writer_message(&w, FL_MSG_PALETTE, len, msg, len);
             for (size_t i = 0; i + 1 < s.len; i++) assert_int_not_equal(s.p[i], 0);
             assert_int_equal(s.p[s.len - 1], 0);
-            assert_true(s.len <= len + FL_HEADER_BYTES + FL_CRC_BYTES + 2 + (len + 13) / 254 + 1); /* bounded overhead */
+            assert_true(s.len <=
+                        len + FL_HEADER_BYTES + FL_CRC_BYTES + 2 + (len + 13) / 254 + 1); /* bounded overhead */
             fl_reader rd;
             fl_reader_init(&rd, got, sizeof got);
             int res = 0;
@@ -836,7 +839,10 @@ static void cobs_message(buf *out, const uint8_t *p, uint32_t n)
 static void pattern(uint8_t *p, uint32_t n, int pat)
 {
     for (uint32_t i = 0; i < n; i++)
-        p[i] = pat == 0 ? (uint8_t)(i % 255 + 1) : pat == 1 ? 0 : pat == 2 ? (uint8_t)(i % 3 ? i : 0) : (uint8_t)(i + 1 < n ? 7 : 0);
+        p[i] = pat == 0   ? (uint8_t)(i % 255 + 1)
+               : pat == 1 ? 0
+               : pat == 2 ? (uint8_t)(i % 3 ? i : 0)
+                          : (uint8_t)(i + 1 < n ? 7 : 0);
 }
 
 /* fl_reader over a buffer of exactly cap bytes (malloc'd, so that ASan sees a
@@ -914,8 +920,10 @@ static void test_decoder_message_bound(void **state)
     receiver *r = receiver_new(NULL, 0);
     for (int flip = 0; flip < 2; flip++) {
         fl_decoder *d = flip ? &r->dec : malloc(sizeof *d);
-        if (flip) fl_dec_init_pages(d, pages, pages + FL_FRAME_BYTES, work, note_event, NULL, NULL, NULL);
-        else fl_dec_init(d, r->frame, r->work, note_event, NULL, NULL, NULL);
+        if (flip)
+            fl_dec_init_pages(d, pages, pages + FL_FRAME_BYTES, work, note_event, NULL, NULL, NULL);
+        else
+            fl_dec_init(d, r->frame, r->work, note_event, NULL, NULL, NULL);
         for (uint32_t len = FL_MSG_MAX - 1; len <= FL_MSG_MAX + 1; len++) {
             buf s = {0};
             message_of(&s, len, FL_MSG_KEYFRAME);
@@ -1089,8 +1097,10 @@ static void test_direct_stuffing(void **state)
     rng_state = 5;
     for (int pat = 0; pat < 4; pat++) {
         for (uint32_t i = 0; i < sizeof data; i++)
-            data[i] = pat == 0 ? (uint8_t)(i % 255 + 1) : pat == 1 ? 0 : pat == 2 ? (uint8_t)(i % 7 ? 9 : 0)
-                                                                              : (uint8_t)(rnd() % 3 ? rnd() : 0);
+            data[i] = pat == 0   ? (uint8_t)(i % 255 + 1)
+                      : pat == 1 ? 0
+                      : pat == 2 ? (uint8_t)(i % 7 ? 9 : 0)
+                                 : (uint8_t)(rnd() % 3 ? rnd() : 0);
         for (uint32_t head = 0; head < 260; head += (head < 8 ? 1 : 61)) {
             for (uint32_t off = 0; off < 4; off++) {
                 for (uint32_t len = 0; len < 1100; len += (len < 520 ? 1 : 97)) {
@@ -1194,17 +1204,17 @@ static void test_hello_scene(void **state)
     assert_string_equal(r->dec.hello.scene_name, "abc");
     assert_int_equal(r->dec.hello.scene_crc, 0x12345678u);
     uint32_t bad = r->dec.count.msgs_bad;
-    assert_false(feed_hello(r, pl, 17));  /* shorter than its length byte says */
-    assert_false(feed_hello(r, pl, 19));  /* longer */
-    assert_false(feed_hello(r, pl, 11));  /* between the two layouts */
+    assert_false(feed_hello(r, pl, 17)); /* shorter than its length byte says */
+    assert_false(feed_hello(r, pl, 19)); /* longer */
+    assert_false(feed_hello(r, pl, 11)); /* between the two layouts */
     assert_false(feed_hello(r, pl, 14));
-    pl[16] = 0;                           /* a NUL in the name */
+    pl[16] = 0; /* a NUL in the name */
     assert_false(feed_hello(r, pl, 18));
-    pl[16] = 0x7F;                        /* not printable */
+    pl[16] = 0x7F; /* not printable */
     assert_false(feed_hello(r, pl, 18));
     pl[16] = 0x80;
     assert_false(feed_hello(r, pl, 18));
-    pl[14] = FL_SCENE_NAME_MAX + 1;       /* too long, though consistent */
+    pl[14] = FL_SCENE_NAME_MAX + 1; /* too long, though consistent */
     memset(pl + 15, 'x', FL_SCENE_NAME_MAX + 1);
     assert_false(feed_hello(r, pl, FL_HELLO_MIN + FL_SCENE_NAME_MAX + 1));
     assert_int_equal(r->dec.count.msgs_bad, bad + 8);
@@ -1219,15 +1229,24 @@ static void test_hello_scene(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_walk_round_trip),   cmocka_unit_test(test_any_chunking),
-        cmocka_unit_test(test_fault_injection),   cmocka_unit_test(test_keyframe_request),
-        cmocka_unit_test(test_flow_control),      cmocka_unit_test(test_synthetic_pictures),
-        cmocka_unit_test(test_raw_fallback),      cmocka_unit_test(test_wrong_base),
-        cmocka_unit_test(test_bad_input),         cmocka_unit_test(test_forged_pictures),
-        cmocka_unit_test(test_framing),           cmocka_unit_test(test_single_pixel_detected),
-        cmocka_unit_test(test_direct_stuffing),   cmocka_unit_test(test_page_flipping),
-        cmocka_unit_test(test_hello_scene),       cmocka_unit_test(test_reader_bound),
-        cmocka_unit_test(test_decoder_message_bound), cmocka_unit_test(test_encoder_back_bound),
+        cmocka_unit_test(test_walk_round_trip),
+        cmocka_unit_test(test_any_chunking),
+        cmocka_unit_test(test_fault_injection),
+        cmocka_unit_test(test_keyframe_request),
+        cmocka_unit_test(test_flow_control),
+        cmocka_unit_test(test_synthetic_pictures),
+        cmocka_unit_test(test_raw_fallback),
+        cmocka_unit_test(test_wrong_base),
+        cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_forged_pictures),
+        cmocka_unit_test(test_framing),
+        cmocka_unit_test(test_single_pixel_detected),
+        cmocka_unit_test(test_direct_stuffing),
+        cmocka_unit_test(test_page_flipping),
+        cmocka_unit_test(test_hello_scene),
+        cmocka_unit_test(test_reader_bound),
+        cmocka_unit_test(test_decoder_message_bound),
+        cmocka_unit_test(test_encoder_back_bound),
     };
     return cmocka_run_group_tests_name("framelink", tests, setup, teardown);
 }

@@ -16,7 +16,7 @@
 #include "perf_internal.h"
 #include "null/hal_null.h"
 
-static const hal_bus_model default_bus = { 8, 1 };
+static const hal_bus_model default_bus = {8, 1};
 
 static int setup(void **state)
 {
@@ -31,16 +31,14 @@ static int setup(void **state)
 
 static void fill_screen(const hal_surface *s, uint8_t colour)
 {
-    for (int y = 0; y < HAL_HEIGHT; y++)
-        hal_fill_span(s, y, 0, HAL_WIDTH, colour);
+    for (int y = 0; y < HAL_HEIGHT; y++) hal_fill_span(s, y, 0, HAL_WIDTH, colour);
 }
 
 /* A recognisable, non-uniform frame in the system-memory buffer (not counted). */
 static void pattern_sysmem(void)
 {
     uint8_t *p = hal_target_sysmem();
-    for (uint32_t i = 0; i < HAL_PAGE_BYTES; i++)
-        p[i] = (uint8_t)(i * 7u + i / 320u);
+    for (uint32_t i = 0; i < HAL_PAGE_BYTES; i++) p[i] = (uint8_t)(i * 7u + i / 320u);
 }
 
 static void check_copy(hal_present_mode m, uint64_t writes, unsigned width)
@@ -98,8 +96,7 @@ static void test_flip_counts_no_copy(void **state)
     assert_int_equal(hal_perf_tsc(), 16000u * 8u);
     hal_perf_reset();
     hal_present(HAL_PRESENT_FLIP);
-    for (int e = 0; e < HAL_EV_COUNT; e++)
-        assert_int_equal(hal_perf_event((hal_event)e), 0);
+    for (int e = 0; e < HAL_EV_COUNT; e++) assert_int_equal(hal_perf_event((hal_event)e), 0);
     assert_int_equal(hal_perf_tsc(), 0);
     assert_ptr_equal(hal_shown_page(), s.pixels);
 }
@@ -120,11 +117,9 @@ static void test_fullscreen_sysmem_fill(void **state)
     assert_int_equal(hal_perf_event(HAL_EV_BYTES), 64000);
     assert_int_equal(hal_perf_tsc(), 16000);
     const uint8_t *p = hal_target_sysmem();
-    for (uint32_t i = 0; i < HAL_PAGE_BYTES; i++)
-        assert_int_equal(p[i], 0xa5);
+    for (uint32_t i = 0; i < HAL_PAGE_BYTES; i++) assert_int_equal(p[i], 0xa5);
     /* nothing reached VRAM */
-    for (uint32_t i = 0; i < HAL_PAGE_BYTES; i++)
-        assert_int_equal(hal_target_vram(0)[i] | hal_target_vram(1)[i], 0);
+    for (uint32_t i = 0; i < HAL_PAGE_BYTES; i++) assert_int_equal(hal_target_vram(0)[i] | hal_target_vram(1)[i], 0);
 }
 
 /* Reference: greedy naturally aligned decomposition, one address at a time. */
@@ -151,11 +146,9 @@ static void ref_counts(uintptr_t addr, int len, uint64_t *n8, uint64_t *n16, uin
 /* Reference byte loop with the documented clipping. */
 static void ref_fill(uint8_t *buf, int y, int x, int len, uint8_t c)
 {
-    if (y < 0 || y >= HAL_HEIGHT)
-        return;
+    if (y < 0 || y >= HAL_HEIGHT) return;
     for (long long i = x; i < (long long)x + len; i++)
-        if (i >= 0 && i < HAL_WIDTH)
-            buf[y * HAL_WIDTH + i] = c;
+        if (i >= 0 && i < HAL_WIDTH) buf[y * HAL_WIDTH + i] = c;
 }
 
 static uint8_t ref_buf[HAL_PAGE_BYTES];
@@ -167,7 +160,7 @@ static void test_fill_span_unaligned(void **state)
     memset(ref_buf, 0, sizeof ref_buf);
     uint8_t colour = 1;
     int y = 0;
-    static const int xs[] = { 0, 1, 2, 3, 4, 5, 6, 7, 101, 157, 290, 303, 310, 315, 316, 317, 318, 319 };
+    static const int xs[] = {0, 1, 2, 3, 4, 5, 6, 7, 101, 157, 290, 303, 310, 315, 316, 317, 318, 319};
     for (size_t xi = 0; xi < sizeof xs / sizeof xs[0]; xi++) {
         for (int len = 1; len <= 23 && xs[xi] + len <= HAL_WIDTH; len++) {
             int x = xs[xi];
@@ -212,30 +205,44 @@ static void test_fill_span_clipping(void **state)
     (void)state;
     static const int cases[][3] = {
         /* y, x, len */
-        { -1, 0, 320 },       { 200, 0, 320 },     { INT_MIN, 0, 320 }, { INT_MAX, 0, 320 },
-        { 5, -10, 5 },        { 5, -10, 10 },      { 6, -10, 11 },      { 7, -10, 20 },
-        { 8, -1000, 5000 },   { 9, 315, 100 },     { 10, 319, 2 },      { 11, 320, 1 },
-        { 12, 400, 10 },      { 13, 0, 0 },        { 14, 10, -5 },      { 15, INT_MIN, INT_MAX },
-        { 16, INT_MAX, INT_MAX }, { 17, 0, INT_MAX }, { 18, -3, INT_MAX }, { 19, 100, INT_MIN },
-        { 199, 318, 7 },      { 0, -2, 3 },
+        {-1, 0, 320},
+        {200, 0, 320},
+        {INT_MIN, 0, 320},
+        {INT_MAX, 0, 320},
+        {5, -10, 5},
+        {5, -10, 10},
+        {6, -10, 11},
+        {7, -10, 20},
+        {8, -1000, 5000},
+        {9, 315, 100},
+        {10, 319, 2},
+        {11, 320, 1},
+        {12, 400, 10},
+        {13, 0, 0},
+        {14, 10, -5},
+        {15, INT_MIN, INT_MAX},
+        {16, INT_MAX, INT_MAX},
+        {17, 0, INT_MAX},
+        {18, -3, INT_MAX},
+        {19, 100, INT_MIN},
+        {199, 318, 7},
+        {0, -2, 3},
     };
     memset(guarded, 0xee, sizeof guarded);
     memset(ref_buf, 0xee, sizeof ref_buf);
-    hal_surface s = { guarded + GUARD, 0 };
+    hal_surface s = {guarded + GUARD, 0};
     uint8_t colour = 0x11;
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         int y = cases[i][0], x = cases[i][1], len = cases[i][2];
         long long lo = x < 0 ? 0 : x, hi = (long long)x + len;
-        if (hi > HAL_WIDTH)
-            hi = HAL_WIDTH;
+        if (hi > HAL_WIDTH) hi = HAL_WIDTH;
         long long expect = (y >= 0 && y < HAL_HEIGHT && hi > lo) ? hi - lo : 0;
         hal_perf_reset();
         hal_fill_span(&s, y, x, len, colour);
         ref_fill(ref_buf, y, x, len, colour);
         assert_int_equal(hal_perf_event(HAL_EV_PIXELS), expect);
         assert_int_equal(hal_perf_event(HAL_EV_BYTES), expect);
-        if (expect == 0)
-            assert_int_equal(hal_perf_event(HAL_EV_WRITES), 0);
+        if (expect == 0) assert_int_equal(hal_perf_event(HAL_EV_WRITES), 0);
         assert_memory_equal(s.pixels, ref_buf, HAL_PAGE_BYTES);
         colour++;
     }
@@ -244,7 +251,7 @@ static void test_fill_span_clipping(void **state)
         assert_int_equal(guarded[GUARD + HAL_PAGE_BYTES + i], 0xee);
     }
     /* a NULL surface or pixel pointer is ignored */
-    hal_surface none = { NULL, 1 };
+    hal_surface none = {NULL, 1};
     hal_perf_reset();
     hal_fill_span(&none, 0, 0, 320, 1);
     hal_fill_span(NULL, 0, 0, 320, 1);
@@ -299,14 +306,14 @@ static void test_bus_model_cycles(void **state)
     hal_bus_model b = hal_perf_bus();
     assert_int_equal(b.vram_cycles, 8);
     assert_int_equal(b.sysmem_cycles, 1);
-    hal_bus_model m = { 13, 3 };
+    hal_bus_model m = {13, 3};
     hal_perf_set_bus(m);
     b = hal_perf_bus();
     assert_int_equal(b.vram_cycles, 13);
     assert_int_equal(b.sysmem_cycles, 3);
     hal_surface v = hal_begin_frame(HAL_PRESENT_FLIP);
     hal_surface sm = hal_begin_frame(HAL_PRESENT_COPY16);
-    hal_fill_span(&v, 0, 1, 10, 1);   /* byte, word, dword, word, byte */
+    hal_fill_span(&v, 0, 1, 10, 1); /* byte, word, dword, word, byte */
     hal_fill_span(&sm, 0, 3, 300, 1);
     hal_fill_span(&sm, 1, 0, 320, 1);
     uint64_t vw = hal_perf_event(HAL_EV_VRAM_WRITES);
@@ -349,7 +356,7 @@ static void test_span_sums_fold(void **state)
     (void)state;
     hal_surface v = hal_begin_frame(HAL_PRESENT_FLIP);
     hal_fill_span(&v, 0, 1, 10, 1); /* byte, word, dword, word, byte: 5 transactions */
-    hal_bus_model m = { 13, 3 };
+    hal_bus_model m = {13, 3};
     hal_perf_set_bus(m);
     hal_perf_select(0, HAL_EV_WRITES32);
     hal_fill_span(&v, 1, 0, 320, 1); /* 80 dwords */
@@ -360,8 +367,7 @@ static void test_span_sums_fold(void **state)
     hal_perf_set_bus(default_bus);
     hal_perf_reset();
     const uint64_t spans = 13500000; /* 320 pixels each: 4.32e9 > 2^32 */
-    for (uint64_t i = 0; i < spans; i++)
-        hal_perf_add_span(HAL_DEST_SYSMEM, 0, 0, 80, 320, 320);
+    for (uint64_t i = 0; i < spans; i++) hal_perf_add_span(HAL_DEST_SYSMEM, 0, 0, 80, 320, 320);
     assert_int_equal(hal_perf_event(HAL_EV_PIXELS), spans * 320u);
     assert_int_equal(hal_perf_event(HAL_EV_BYTES), spans * 320u);
     assert_int_equal(hal_perf_event(HAL_EV_WRITES32), spans * 80u);
@@ -408,8 +414,7 @@ static void test_palette_round_trip(void **state)
 {
     (void)state;
     uint8_t pal[HAL_PALETTE_BYTES];
-    for (int i = 0; i < HAL_PALETTE_BYTES; i++)
-        pal[i] = (uint8_t)(255 - i * 3);
+    for (int i = 0; i < HAL_PALETTE_BYTES; i++) pal[i] = (uint8_t)(255 - i * 3);
     hal_set_palette(pal);
     assert_memory_equal(hal_get_palette(), pal, HAL_PALETTE_BYTES);
     pal[0] ^= 0xff; /* a copy, not an alias */
@@ -424,13 +429,12 @@ static void test_palette_round_trip(void **state)
 static void test_names(void **state)
 {
     (void)state;
-    static const char *const ev[] = { "writes", "bytes", "writes8", "writes16", "writes32",
-                                      "vram_writes", "sysmem_writes", "pixels", "copy_writes" };
+    static const char *const ev[] = {"writes",      "bytes",         "writes8", "writes16",   "writes32",
+                                     "vram_writes", "sysmem_writes", "pixels",  "copy_writes"};
     assert_int_equal(sizeof ev / sizeof ev[0], HAL_EV_COUNT);
-    for (int e = 0; e < HAL_EV_COUNT; e++)
-        assert_string_equal(hal_event_name((hal_event)e), ev[e]);
+    for (int e = 0; e < HAL_EV_COUNT; e++) assert_string_equal(hal_event_name((hal_event)e), ev[e]);
     assert_string_equal(hal_event_name(HAL_EV_COUNT), "unknown");
-    static const char *const pm[] = { "flip", "copy8", "copy16", "copy32" };
+    static const char *const pm[] = {"flip", "copy8", "copy16", "copy32"};
     for (int m = 0; m < HAL_PRESENT_COUNT; m++) {
         assert_string_equal(hal_present_name((hal_present_mode)m), pm[m]);
         assert_int_equal(hal_present_parse(pm[m]), m);
@@ -449,11 +453,9 @@ static void test_null_clock_and_input(void **state)
     assert_int_equal(hal_ticks_ms(), 0);
     hal_frame_done();
     assert_int_equal(hal_ticks_ms(), 28); /* 1000/35 = 28.57 */
-    for (int i = 1; i < 35; i++)
-        hal_frame_done();
+    for (int i = 1; i < 35; i++) hal_frame_done();
     assert_int_equal(hal_ticks_ms(), 1000);
-    for (int i = 0; i < 35 * 9; i++)
-        hal_frame_done();
+    for (int i = 0; i < 35 * 9; i++) hal_frame_done();
     assert_int_equal(hal_ticks_ms(), 10000);
     assert_int_equal(hal_null_frames(), 350);
     hal_null_set_ticks(12345);

@@ -33,7 +33,7 @@
 #include "scene.h"
 #include "scene_fixture.h"
 
-#define U(v) ((fx_t)((v) * 65536.0)) /* map units to 16.16 (test values are exact) */
+#define U(v) ((fx_t)((v)*65536.0)) /* map units to 16.16 (test values are exact) */
 #define PI 3.14159265358979323846
 
 /* ------------------------------------------------------------ scenes */
@@ -49,7 +49,10 @@ static void load_text(loaded *l, const char *text)
     l->len = fixture_load_text(text, &l->blob, &l->s);
 }
 
-static void unload(loaded *l) { free(l->blob); }
+static void unload(loaded *l)
+{
+    free(l->blob);
+}
 
 /* One room 512 x 512, floor 0, ceiling 128. */
 static const char ROOM[] = "sector room floor=0 ceil=128 floor_color=sand:7 ceil_color=grey:6\n"
@@ -129,7 +132,10 @@ static scn_face faces[MAXF];
 static uint32_t findex[MAXF * 16];
 static uint32_t nmodels, nmverts, nfaces, nfindex;
 
-static void models_reset(void) { nmodels = nmverts = nfaces = nfindex = 0; }
+static void models_reset(void)
+{
+    nmodels = nmverts = nfaces = nfindex = 0;
+}
 
 static uint32_t model_begin(void)
 {
@@ -231,7 +237,7 @@ static int count_kind(uint32_t kind)
 /* ------------------------------------------------------------ the analytic boxes */
 
 typedef struct {
-    double ox, oy, oz, yaw; /* degrees */
+    double ox, oy, oz, yaw;        /* degrees */
     double x0, x1, y0, y1, z0, z1; /* model space */
 } abox;
 
@@ -369,8 +375,8 @@ static void test_resting_on_floor(void **state)
     place(&p, 1, crate, 200, 180, 0, 30, 32, 32, 32);
     place(&p, 2, slab, 320, 160, 0, 17.5, 96, 16, 8);
     place(&p, 3, crate, 380, 300, 0, 45, 32, 32, 32);
-    static const double views[][5] = {{256, 64, 41, 90, 0},    {100, 100, 41, 45, 0},   {256, 120, 41, 90, -60},
-                                      {400, 60, 20, 120, 0},   {250, 200, 5, 60, 0},    {60, 300, 41, 0, 0},
+    static const double views[][5] = {{256, 64, 41, 90, 0},       {100, 100, 41, 45, 0},   {256, 120, 41, 90, -60},
+                                      {400, 60, 20, 120, 0},      {250, 200, 5, 60, 0},    {60, 300, 41, 0, 0},
                                       {300, 100, 100, 100, -100}, {450, 450, 41, 225, 30}, {256, 200, 41, 90, 0}};
     for (size_t i = 0; i < sizeof views / sizeof views[0]; i++) {
         camera c = cam_at(views[i][0], views[i][1], views[i][2], views[i][3], (int)views[i][4]);
@@ -588,13 +594,13 @@ static void test_interpenetrating(void **state)
     place(&p, 1, m, 512, 300, 0, 45, 40, 40, 24);  /* a corner through the east wall */
     place(&p, 2, bar, 300, 320, 0, 0, 80, 12, 40); /* a cross of two bars */
     place(&p, 3, bar, 300, 320, 4, 70, 80, 12, 40);
-    place(&p, 4, m, 0, 0, 0, 0, 40, 40, 24);       /* in the corner, three quarters in the walls */
+    place(&p, 4, m, 0, 0, 0, 0, 40, 40, 24); /* in the corner, three quarters in the walls */
     room_box_set = 1;
     const double rb[6] = {0, 512, 0, 512, 0, 128};
     memcpy(room_box, rb, sizeof rb);
-    static const double views[][5] = {{200, 300, 41, 90, 0},  {150, 420, 30, 60, 0},  {400, 250, 41, 30, 0},
-                                      {300, 150, 41, 90, 0},  {420, 420, 60, 225, -30}, {200, 200, 41, 0, 0},
-                                      {60, 120, 41, 250, 0},  {300, 200, 90, 90, -100}};
+    static const double views[][5] = {{200, 300, 41, 90, 0}, {150, 420, 30, 60, 0},    {400, 250, 41, 30, 0},
+                                      {300, 150, 41, 90, 0}, {420, 420, 60, 225, -30}, {200, 200, 41, 0, 0},
+                                      {60, 120, 41, 250, 0}, {300, 200, 90, 90, -100}};
     for (int i = 0; i < 8; i++) {
         camera c = cam_at(views[i][0], views[i][1], views[i][2], views[i][3], (int)views[i][4]);
         draw_exact(&l.s, &p.w, &c);
@@ -610,8 +616,18 @@ static void test_wide_products(void **state)
 {
     (void)state;
     __extension__ typedef __int128 i128;
-    const int64_t edge[] = {0, 1, -1, 2, (int64_t)1 << 31, -((int64_t)1 << 31), ((int64_t)1 << 32) - 1,
-                            (int64_t)1 << 41, ((int64_t)1 << 62) - 1, -((int64_t)1 << 62), INT64_MAX, INT64_MIN + 1};
+    const int64_t edge[] = {0,
+                            1,
+                            -1,
+                            2,
+                            (int64_t)1 << 31,
+                            -((int64_t)1 << 31),
+                            ((int64_t)1 << 32) - 1,
+                            (int64_t)1 << 41,
+                            ((int64_t)1 << 62) - 1,
+                            -((int64_t)1 << 62),
+                            INT64_MAX,
+                            INT64_MIN + 1};
     int n = sizeof edge / sizeof edge[0];
     uint64_t r = 12345;
     for (int i = 0; i < 200000; i++) {
@@ -671,9 +687,9 @@ static void test_inverse_depth_order(void **state)
  * a floor H below the eye and a wall facing the eye at Z = 320 H meet on that
  * ray, so there both depths are exactly 320 H and the two tie. Every answer
  * below comes from where the surfaces lie, not from the function. */
-#define TIE_H 1024                 /* view units below the eye */
-#define TIE_Z (320 * TIE_H)        /* the wall's depth, where the floor meets the ray */
-#define TIE_N ((int32_t)1 << 29)   /* a normal's length */
+#define TIE_H 1024               /* view units below the eye */
+#define TIE_Z (320 * TIE_H)      /* the wall's depth, where the floor meets the ray */
+#define TIE_N ((int32_t)1 << 29) /* a normal's length */
 #define TIE_PX (VIEW_W / 2)
 #define TIE_PY VIEW_CY
 
@@ -1085,15 +1101,23 @@ static void test_engine(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_resting_on_floor),  cmocka_unit_test(test_object_hides_wall),
-        cmocka_unit_test(test_object_behind_wall), cmocka_unit_test(test_two_objects_overlap),
-        cmocka_unit_test(test_straddle),          cmocka_unit_test(test_near_and_offscreen),
-        cmocka_unit_test(test_interpenetrating),  cmocka_unit_test(test_wide_products),
-        cmocka_unit_test(test_inverse_depth_order), cmocka_unit_test(test_abutting_ties),
+        cmocka_unit_test(test_resting_on_floor),
+        cmocka_unit_test(test_object_hides_wall),
+        cmocka_unit_test(test_object_behind_wall),
+        cmocka_unit_test(test_two_objects_overlap),
+        cmocka_unit_test(test_straddle),
+        cmocka_unit_test(test_near_and_offscreen),
+        cmocka_unit_test(test_interpenetrating),
+        cmocka_unit_test(test_wide_products),
+        cmocka_unit_test(test_inverse_depth_order),
+        cmocka_unit_test(test_abutting_ties),
         cmocka_unit_test(test_painter),
-        cmocka_unit_test(test_work_bound),        cmocka_unit_test(test_paths),
-        cmocka_unit_test(test_door_motion),       cmocka_unit_test(test_door_slots),
-        cmocka_unit_test(test_door_collision),    cmocka_unit_test(test_engine),
+        cmocka_unit_test(test_work_bound),
+        cmocka_unit_test(test_paths),
+        cmocka_unit_test(test_door_motion),
+        cmocka_unit_test(test_door_slots),
+        cmocka_unit_test(test_door_collision),
+        cmocka_unit_test(test_engine),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

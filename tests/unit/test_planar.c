@@ -57,12 +57,12 @@ static struct {
     _Alignas(4) uint8_t sysmem[HAL_PAGE_BYTES];
     _Alignas(4) uint8_t palette[HAL_PALETTE_BYTES];
     int display_start;
-    unsigned mask;       /* the map mask in force */
-    int win_page;        /* commit scans cpu[win_page][win_lo, win_hi); -1: both pages, whole */
+    unsigned mask; /* the map mask in force */
+    int win_page;  /* commit scans cpu[win_page][win_lo, win_hi); -1: both pages, whole */
     uint32_t win_lo, win_hi;
-    uint32_t committed;  /* CPU bytes moved into the planes */
-    uint32_t lost;       /* CPU bytes written while the mask enabled no plane */
-    uint32_t bad_masks;  /* hal_target_plane_mask calls with bits above plane 3 */
+    uint32_t committed; /* CPU bytes moved into the planes */
+    uint32_t lost;      /* CPU bytes written while the mask enabled no plane */
+    uint32_t bad_masks; /* hal_target_plane_mask calls with bits above plane 3 */
     uint32_t mask_calls;
 } fk;
 
@@ -71,13 +71,10 @@ static void commit_range(int page, uint32_t lo, uint32_t hi)
     uint8_t *cpu = fk.cpu[page];
     for (uint32_t i = lo; i < hi; i++) {
         uint8_t v = cpu[i];
-        if (v == SENTINEL)
-            continue;
-        if ((fk.mask & 0xFu) == 0)
-            fk.lost++;
+        if (v == SENTINEL) continue;
+        if ((fk.mask & 0xFu) == 0) fk.lost++;
         for (int p = 0; p < 4; p++)
-            if (fk.mask & (1u << p))
-                fk.plane[page][p][i] = v;
+            if (fk.mask & (1u << p)) fk.plane[page][p][i] = v;
         cpu[i] = SENTINEL;
         fk.committed++;
     }
@@ -151,8 +148,7 @@ int hal_target_vram_planar(void)
 void hal_target_plane_mask(unsigned planes)
 {
     fake_commit(); /* the bytes written so far went to the old mask's planes */
-    if (planes & ~0xFu)
-        fk.bad_masks++;
+    if (planes & ~0xFu) fk.bad_masks++;
     fk.mask = planes & 0xFu;
     fk.mask_calls++;
 }
@@ -165,8 +161,7 @@ static uint8_t pixel(int page, int x, int y)
 
 static void row_to_background(int page, int y)
 {
-    for (int p = 0; p < 4; p++)
-        memset(&fk.plane[page][p][(uint32_t)y * ROW_BYTES], BACKGROUND, ROW_BYTES);
+    for (int p = 0; p < 4; p++) memset(&fk.plane[page][p][(uint32_t)y * ROW_BYTES], BACKGROUND, ROW_BYTES);
 }
 
 /* Every CPU-visible byte of both pages must be the sentinel: nothing was
@@ -176,15 +171,15 @@ static void assert_no_stray_writes(void)
     for (int page = 0; page < 2; page++)
         for (uint32_t i = 0; i < PLANE_BYTES; i++)
             if (fk.cpu[page][i] != SENTINEL)
-                fail_msg("stray write: page %d byte %u (row %u, group %u) = 0x%02x",
-                         page, i, i / ROW_BYTES, i % ROW_BYTES, fk.cpu[page][i]);
+                fail_msg("stray write: page %d byte %u (row %u, group %u) = 0x%02x", page, i, i / ROW_BYTES,
+                         i % ROW_BYTES, fk.cpu[page][i]);
 }
 
 /* ---- expected counts -------------------------------------------------------- */
 typedef struct {
-    uint32_t groups;  /* 4-pixel groups (bytes) the span covers */
-    uint32_t max8;    /* partial groups + the run's odd head and odd tail */
-    uint32_t dwords;  /* aligned dwords inside the run of whole groups */
+    uint32_t groups; /* 4-pixel groups (bytes) the span covers */
+    uint32_t max8;   /* partial groups + the run's odd head and odd tail */
+    uint32_t dwords; /* aligned dwords inside the run of whole groups */
 } expect_counts;
 
 /* For an already clipped span [x, x + len), len >= 1. Rows start 4-aligned
@@ -192,7 +187,7 @@ typedef struct {
  * alignment of its address. */
 static expect_counts expected(int x, int len)
 {
-    expect_counts e = { 0, 0, 0 };
+    expect_counts e = {0, 0, 0};
     int g0 = x / 4, g1 = (x + len - 1) / 4;
     int a = g0, b = g1; /* the run of whole groups, inclusive */
     e.groups = (uint32_t)(g1 - g0 + 1);
@@ -231,38 +226,25 @@ static const char *counts_problem(int x, int len)
     uint64_t w8 = hal_perf_event(HAL_EV_WRITES8), w16 = hal_perf_event(HAL_EV_WRITES16);
     uint64_t w32 = hal_perf_event(HAL_EV_WRITES32), writes = hal_perf_event(HAL_EV_WRITES);
     uint64_t bytes = hal_perf_event(HAL_EV_BYTES);
-    if (fk.lost != 0)
-        return "a byte written with no plane enabled";
-    if (fk.bad_masks != 0)
-        return "a plane mask with bits above plane 3";
-    if (hal_perf_event(HAL_EV_PIXELS) != (uint64_t)len)
-        return "pixels != len";
+    if (fk.lost != 0) return "a byte written with no plane enabled";
+    if (fk.bad_masks != 0) return "a plane mask with bits above plane 3";
+    if (hal_perf_event(HAL_EV_PIXELS) != (uint64_t)len) return "pixels != len";
     if (hal_perf_event(HAL_EV_SYSMEM_WRITES) != 0 || hal_perf_event(HAL_EV_COPY_WRITES) != 0)
         return "system-memory or copy writes";
-    if (writes != w8 + w16 + w32)
-        return "writes != writes8 + writes16 + writes32";
-    if (hal_perf_event(HAL_EV_VRAM_WRITES) != writes)
-        return "vram_writes != writes";
-    if (bytes != w8 + 2u * w16 + 4u * w32)
-        return "bytes != n8 + 2 n16 + 4 n32";
+    if (writes != w8 + w16 + w32) return "writes != writes8 + writes16 + writes32";
+    if (hal_perf_event(HAL_EV_VRAM_WRITES) != writes) return "vram_writes != writes";
+    if (bytes != w8 + 2u * w16 + 4u * w32) return "bytes != n8 + 2 n16 + 4 n32";
     if (len == 0) {
-        if (writes != 0 || bytes != 0 || fk.committed != 0 || hal_perf_tsc() != 0)
-            return "a clipped-away span wrote";
+        if (writes != 0 || bytes != 0 || fk.committed != 0 || hal_perf_tsc() != 0) return "a clipped-away span wrote";
         return NULL;
     }
     expect_counts e = expected(x, len);
-    if (bytes != e.groups)
-        return "bytes != 4-pixel groups covered";
-    if (fk.committed != e.groups)
-        return "bytes reaching the planes != groups covered (a byte written twice or missed)";
-    if (w8 > e.max8)
-        return "writes8 > partial groups + run head and tail";
-    if (w16 > 2)
-        return "writes16 > 2";
-    if (w32 != e.dwords)
-        return "writes32 != the aligned dwords of the whole-group run";
-    if (hal_perf_tsc() != writes * 8u)
-        return "tsc != 8 cycles per VRAM write";
+    if (bytes != e.groups) return "bytes != 4-pixel groups covered";
+    if (fk.committed != e.groups) return "bytes reaching the planes != groups covered (a byte written twice or missed)";
+    if (w8 > e.max8) return "writes8 > partial groups + run head and tail";
+    if (w16 > 2) return "writes16 > 2";
+    if (w32 != e.dwords) return "writes32 != the aligned dwords of the whole-group run";
+    if (hal_perf_tsc() != writes * 8u) return "tsc != 8 cycles per VRAM write";
     return NULL;
 }
 
@@ -270,7 +252,7 @@ static int setup(void **state)
 {
     (void)state;
     fake_reset();
-    hal_perf_set_bus((hal_bus_model){ 8, 1 });
+    hal_perf_set_bus((hal_bus_model){8, 1});
     hal_perf_reset();
     return 0;
 }
@@ -308,13 +290,12 @@ static void exhaustive_row(int y)
                 uint8_t want = (px >= x && px < x + len) ? colour : BACKGROUND;
                 uint8_t got = pixel(HIDDEN, px, y);
                 if (got != want)
-                    fail_msg("row %d span x=%d len=%d: pixel %d is 0x%02x, want 0x%02x",
-                             y, x, len, px, got, want);
+                    fail_msg("row %d span x=%d len=%d: pixel %d is 0x%02x, want 0x%02x", y, x, len, px, got, want);
             }
             const char *why = counts_problem(x, len);
             if (why != NULL)
-                fail_msg("row %d span x=%d len=%d: %s (w8 %llu w16 %llu w32 %llu bytes %llu)", y, x,
-                         len, why, (unsigned long long)hal_perf_event(HAL_EV_WRITES8),
+                fail_msg("row %d span x=%d len=%d: %s (w8 %llu w16 %llu w32 %llu bytes %llu)", y, x, len, why,
+                         (unsigned long long)hal_perf_event(HAL_EV_WRITES8),
                          (unsigned long long)hal_perf_event(HAL_EV_WRITES16),
                          (unsigned long long)hal_perf_event(HAL_EV_WRITES32),
                          (unsigned long long)hal_perf_event(HAL_EV_BYTES));
@@ -327,8 +308,7 @@ static void exhaustive_row(int y)
     /* the shown page was never touched */
     for (int p = 0; p < 4; p++)
         for (uint32_t i = 0; i < PLANE_BYTES; i++)
-            if (fk.plane[0][p][i] != BACKGROUND)
-                fail_msg("shown page plane %d byte %u changed", p, i);
+            if (fk.plane[0][p][i] != BACKGROUND) fail_msg("shown page plane %d byte %u changed", p, i);
 }
 
 static void test_exhaustive_row0(void **state)
@@ -370,8 +350,7 @@ static void test_full_row_and_frame(void **state)
     assert_int_equal(hal_perf_event(HAL_EV_BYTES), 80);
     assert_int_equal(hal_perf_event(HAL_EV_PIXELS), 320);
     assert_int_equal(fk.mask_calls, 1); /* one mask, every plane */
-    for (int px = 0; px < HAL_WIDTH; px++)
-        assert_int_equal(pixel(HIDDEN, px, 37), 0xC3);
+    for (int px = 0; px < HAL_WIDTH; px++) assert_int_equal(pixel(HIDDEN, px, 37), 0xC3);
 
     fake_window_all();
     fake_commit();
@@ -404,31 +383,31 @@ static void test_clipping(void **state)
         int y, x, len;
         int cx, clen; /* the span after clipping; clen 0: nothing */
     } cases[] = {
-        { 0, -5, 10, 0, 5 },
-        { 0, -1, 3, 0, 2 },
-        { 1, -3, 3, 0, 0 },
-        { 1, -4, 1, 0, 0 },
-        { 100, -1000, INT_MAX, 0, 320 },
-        { 199, -2, INT_MAX, 0, 320 },
-        { 199, INT_MIN, INT_MAX, 0, 0 },
-        { 199, INT_MIN, 1, 0, 0 },
-        { 50, 300, 100, 300, 20 },
-        { 50, 317, INT_MAX, 317, 3 },
-        { 50, 319, 2, 319, 1 },
-        { 51, 1, 400, 1, 319 },
-        { 10, 320, 5, 0, 0 },
-        { 10, 321, 1, 0, 0 },
-        { 10, INT_MAX, INT_MAX, 0, 0 },
-        { 10, 5, 0, 0, 0 },
-        { 10, 5, -1, 0, 0 },
-        { 10, 5, INT_MIN, 0, 0 },
-        { 10, -5, -5, 0, 0 },
-        { -1, 0, 320, 0, 0 },
-        { -1, 3, 5, 0, 0 },
-        { 200, 0, 320, 0, 0 },
-        { 200, 7, 9, 0, 0 },
-        { INT_MIN, 0, 320, 0, 0 },
-        { INT_MAX, 0, 320, 0, 0 },
+        {0, -5, 10, 0, 5},
+        {0, -1, 3, 0, 2},
+        {1, -3, 3, 0, 0},
+        {1, -4, 1, 0, 0},
+        {100, -1000, INT_MAX, 0, 320},
+        {199, -2, INT_MAX, 0, 320},
+        {199, INT_MIN, INT_MAX, 0, 0},
+        {199, INT_MIN, 1, 0, 0},
+        {50, 300, 100, 300, 20},
+        {50, 317, INT_MAX, 317, 3},
+        {50, 319, 2, 319, 1},
+        {51, 1, 400, 1, 319},
+        {10, 320, 5, 0, 0},
+        {10, 321, 1, 0, 0},
+        {10, INT_MAX, INT_MAX, 0, 0},
+        {10, 5, 0, 0, 0},
+        {10, 5, -1, 0, 0},
+        {10, 5, INT_MIN, 0, 0},
+        {10, -5, -5, 0, 0},
+        {-1, 0, 320, 0, 0},
+        {-1, 3, 5, 0, 0},
+        {200, 0, 320, 0, 0},
+        {200, 7, 9, 0, 0},
+        {INT_MIN, 0, 320, 0, 0},
+        {INT_MAX, 0, 320, 0, 0},
     };
     hal_surface s = hidden_surface();
     fake_window_all(); /* few cases: commit and compare whole pages */
@@ -437,25 +416,22 @@ static void test_clipping(void **state)
         uint8_t colour = (uint8_t)(0x80u + i);
         draw(&s, y, cases[i].x, cases[i].len, colour);
         const char *why = counts_problem(cx, clen);
-        if (why != NULL)
-            fail_msg("case %zu (y=%d x=%d len=%d): %s", i, y, cases[i].x, cases[i].len, why);
-        if (clen == 0)
-            assert_int_equal(fk.mask_calls, 0);
+        if (why != NULL) fail_msg("case %zu (y=%d x=%d len=%d): %s", i, y, cases[i].x, cases[i].len, why);
+        if (clen == 0) assert_int_equal(fk.mask_calls, 0);
         for (int page = 0; page < 2; page++)
             for (int py = 0; py < HAL_HEIGHT; py++)
                 for (int px = 0; px < HAL_WIDTH; px++) {
                     int in = page == HIDDEN && py == y && px >= cx && px < cx + clen;
                     uint8_t want = in ? colour : BACKGROUND;
                     if (pixel(page, px, py) != want)
-                        fail_msg("case %zu (y=%d x=%d len=%d): page %d pixel (%d, %d) is 0x%02x, want 0x%02x",
-                                 i, y, cases[i].x, cases[i].len, page, px, py, pixel(page, px, py), want);
+                        fail_msg("case %zu (y=%d x=%d len=%d): page %d pixel (%d, %d) is 0x%02x, want 0x%02x", i, y,
+                                 cases[i].x, cases[i].len, page, px, py, pixel(page, px, py), want);
                 }
-        if (clen != 0)
-            row_to_background(HIDDEN, y);
+        if (clen != 0) row_to_background(HIDDEN, y);
     }
     assert_no_stray_writes();
     /* a NULL surface or NULL pixels: nothing */
-    hal_surface none = { NULL, 1, 1 };
+    hal_surface none = {NULL, 1, 1};
     draw(NULL, 0, 0, 320, 1);
     assert_null(counts_problem(0, 0));
     draw(&none, 0, 0, 320, 1);
@@ -485,17 +461,14 @@ static void test_random_overlap(void **state)
         fake_window_row(HIDDEN, y >= 0 && y < HAL_HEIGHT ? y : 0);
         draw(&s, y, x, len, colour);
         const char *why = counts_problem(clen ? cx : 0, clen);
-        if (why != NULL)
-            fail_msg("span %d (y=%d x=%d len=%d): %s", i, y, x, len, why);
+        if (why != NULL) fail_msg("span %d (y=%d x=%d len=%d): %s", i, y, x, len, why);
         pixels += (uint64_t)clen;
-        if (clen == 0)
-            continue;
-        for (int px = cx; px < cend; px++)
-            ref[y][px] = colour;
+        if (clen == 0) continue;
+        for (int px = cx; px < cend; px++) ref[y][px] = colour;
         for (int px = 0; px < HAL_WIDTH; px++)
             if (pixel(HIDDEN, px, y) != ref[y][px])
-                fail_msg("span %d (y=%d x=%d len=%d): pixel %d is 0x%02x, want 0x%02x", i, y, x, len,
-                         px, pixel(HIDDEN, px, y), ref[y][px]);
+                fail_msg("span %d (y=%d x=%d len=%d): pixel %d is 0x%02x, want 0x%02x", i, y, x, len, px,
+                         pixel(HIDDEN, px, y), ref[y][px]);
     }
     assert_true(pixels > 0);
     assert_no_stray_writes();
@@ -556,14 +529,10 @@ static void test_flip_planar(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_setup(test_exhaustive_row0, setup),
-        cmocka_unit_test_setup(test_exhaustive_row1, setup),
-        cmocka_unit_test_setup(test_exhaustive_row100, setup),
-        cmocka_unit_test_setup(test_exhaustive_row199, setup),
-        cmocka_unit_test_setup(test_full_row_and_frame, setup),
-        cmocka_unit_test_setup(test_clipping, setup),
-        cmocka_unit_test_setup(test_random_overlap, setup),
-        cmocka_unit_test_setup(test_flip_planar, setup),
+        cmocka_unit_test_setup(test_exhaustive_row0, setup),    cmocka_unit_test_setup(test_exhaustive_row1, setup),
+        cmocka_unit_test_setup(test_exhaustive_row100, setup),  cmocka_unit_test_setup(test_exhaustive_row199, setup),
+        cmocka_unit_test_setup(test_full_row_and_frame, setup), cmocka_unit_test_setup(test_clipping, setup),
+        cmocka_unit_test_setup(test_random_overlap, setup),     cmocka_unit_test_setup(test_flip_planar, setup),
     };
     return cmocka_run_group_tests_name("planar", tests, NULL, NULL);
 }

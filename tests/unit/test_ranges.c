@@ -24,33 +24,32 @@
 #include "scene.h"
 #include "scene_fixture.h"
 
-#define U(v) ((fx_t)((int64_t)(v) * 65536))
+#define U(v) ((fx_t)((int64_t)(v)*65536))
 
 /* A room filling the whole box, floor and ceiling at the height limits, with a
  * raised block near each corner and a low room in the middle. */
-static const char SCENE_TEXT[] =
-    "sector hall floor=-16383 ceil=16383\n"
-    "sector block floor=16000 ceil=16383\n"
-    "sector low floor=-16383 ceil=-16300\n"
-    "wall -32767 -32767 -32767 32767 hall\n"
-    "wall -32767 32767 32767 32767 hall\n"
-    "wall 32767 32767 32767 -32767 hall\n"
-    "wall 32767 -32767 -32767 -32767 hall\n"
-    /* block in the north-east corner: corner walls shared with the hall's outline
+static const char SCENE_TEXT[] = "sector hall floor=-16383 ceil=16383\n"
+                                 "sector block floor=16000 ceil=16383\n"
+                                 "sector low floor=-16383 ceil=-16300\n"
+                                 "wall -32767 -32767 -32767 32767 hall\n"
+                                 "wall -32767 32767 32767 32767 hall\n"
+                                 "wall 32767 32767 32767 -32767 hall\n"
+                                 "wall 32767 -32767 -32767 -32767 hall\n"
+                                 /* block in the north-east corner: corner walls shared with the hall's outline
      * would make it a separate sector touching the box edge, so keep it 7 units in */
-    "wall 32700 32700 32760 32700 hall block\n"
-    "wall 32760 32700 32760 32760 hall block\n"
-    "wall 32760 32760 32700 32760 hall block\n"
-    "wall 32700 32760 32700 32700 hall block\n"
-    "wall -32760 -32760 -32700 -32760 hall block\n"
-    "wall -32700 -32760 -32700 -32700 hall block\n"
-    "wall -32700 -32700 -32760 -32700 hall block\n"
-    "wall -32760 -32700 -32760 -32760 hall block\n"
-    "wall -100 -100 -100 100 low hall\n"
-    "wall -100 100 100 100 low hall\n"
-    "wall 100 100 100 -100 low hall\n"
-    "wall 100 -100 -100 -100 low hall\n"
-    "player 0 -20000 90\n";
+                                 "wall 32700 32700 32760 32700 hall block\n"
+                                 "wall 32760 32700 32760 32760 hall block\n"
+                                 "wall 32760 32760 32700 32760 hall block\n"
+                                 "wall 32700 32760 32700 32700 hall block\n"
+                                 "wall -32760 -32760 -32700 -32760 hall block\n"
+                                 "wall -32700 -32760 -32700 -32700 hall block\n"
+                                 "wall -32700 -32700 -32760 -32700 hall block\n"
+                                 "wall -32760 -32700 -32760 -32760 hall block\n"
+                                 "wall -100 -100 -100 100 low hall\n"
+                                 "wall -100 100 100 100 low hall\n"
+                                 "wall 100 100 100 -100 low hall\n"
+                                 "wall 100 -100 -100 -100 low hall\n"
+                                 "player 0 -20000 90\n";
 
 typedef struct {
     uint8_t *blob;
@@ -132,13 +131,13 @@ static void check_view(const camera *cam, int *views, int *inside)
     }
     /* The modes differ only where a pixel centre is within rounding of an edge. */
     if (same < VIEW_W * VIEW_H * 99u / 100u)
-        fail_msg("camera (%d, %d, %d) angle %d look %d: spans and painter agree on %u pixels only", cam->x,
-                 cam->y, cam->z, cam->angle_deg, cam->look, same);
+        fail_msg("camera (%d, %d, %d) angle %d look %d: spans and painter agree on %u pixels only", cam->x, cam->y,
+                 cam->z, cam->angle_deg, cam->look, same);
     if (eye_inside_world(cam)) {
         ++*inside;
         if (holes)
-            fail_msg("camera (%d, %d, %d) angle %d look %d: %u empty pixels with the eye inside the world",
-                     cam->x, cam->y, cam->z, cam->angle_deg, cam->look, holes);
+            fail_msg("camera (%d, %d, %d) angle %d look %d: %u empty pixels with the eye inside the world", cam->x,
+                     cam->y, cam->z, cam->angle_deg, cam->look, holes);
     }
     ++*views;
 }
@@ -147,8 +146,8 @@ static void test_box_corners_and_edges(void **state)
 {
     (void)state;
     /* positions on, just inside and just outside the box (the last is clamped) */
-    static const int32_t xy[] = {INT32_MIN, -U(32767), -U(32767) + 1, -U(32766), 0, U(32766), U(32767) - 1,
-                                 U(32767), INT32_MAX};
+    static const int32_t xy[] = {INT32_MIN, -U(32767),    -U(32767) + 1, -U(32766), 0,
+                                 U(32766),  U(32767) - 1, U(32767),      INT32_MAX};
     static const int32_t zs[] = {INT32_MIN, -U(16383), -U(16382), 0, U(16382), U(16383), INT32_MAX};
     static const int32_t angles[] = {0, 45, 90, 135, 180, 225, 270, 315};
     int views = 0, inside = 0;
@@ -174,8 +173,13 @@ static void test_near_the_corner_blocks(void **state)
     int views = 0, inside = 0;
     for (int k = 0; k < 400; k++) {
         int32_t sx = (k & 1) ? 1 : -1;
-        fx_t x = sx * (U(32763) + (fx_t)((k * 7919) % U(3))), y = sx * (U(32700) - U(40) + (fx_t)((k * 104729) % U(80)));
-        if (k & 2) { fx_t t = x; x = y; y = t; }
+        fx_t x = sx * (U(32763) + (fx_t)((k * 7919) % U(3))),
+             y = sx * (U(32700) - U(40) + (fx_t)((k * 104729) % U(80)));
+        if (k & 2) {
+            fx_t t = x;
+            x = y;
+            y = t;
+        }
         camera cam = {x, y, (k & 4) ? U(16100) : U(-16300), (fx_t)((k * 2654435761u) % (360u << 16)),
                       (k % 5) * 50 - 100};
         check_view(&cam, &views, &inside);

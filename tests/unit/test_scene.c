@@ -28,29 +28,28 @@ static size_t blob_len;
 static uint8_t *oblob; /* with models, objects and a door */
 static size_t oblob_len;
 
-static const char OBJECTS_SCENE[] =
-    "sector room floor=0 ceil=128\n"
-    "sector door1 floor=0 ceil=0 door=112\n"
-    "wall 0 0 0 256 room\n"
-    "wall 0 256 256 256 room\n"
-    "wall 256 256 256 0 room\n"
-    "wall 256 0 128 0 room\n"
-    "wall 128 0 96 0 room door1\n"
-    "wall 96 0 0 0 room\n"
-    "wall 128 0 128 -16 door1\n"
-    "wall 128 -16 96 -16 door1\n"
-    "wall 96 -16 96 0 door1\n"
-    "player 64 128 0\n"
-    "model crate\n"
-    "part box w=32 d=32 h=32 color=brown:8\n"
-    "end\n"
-    "model ship\n"
-    "part box w=48 d=16 h=8 color=grey:9\n"
-    "part prism sides=5 r=12 h=4 at=36,0,2 color=red:8\n"
-    "end\n"
-    "object crate 200 200 yaw=30\n"
-    "object ship 128 128 z=40 path=circle:64:8000\n"
-    "object ship 40 200 z=20 path=line:150:-100:5000 spin=90\n";
+static const char OBJECTS_SCENE[] = "sector room floor=0 ceil=128\n"
+                                    "sector door1 floor=0 ceil=0 door=112\n"
+                                    "wall 0 0 0 256 room\n"
+                                    "wall 0 256 256 256 room\n"
+                                    "wall 256 256 256 0 room\n"
+                                    "wall 256 0 128 0 room\n"
+                                    "wall 128 0 96 0 room door1\n"
+                                    "wall 96 0 0 0 room\n"
+                                    "wall 128 0 128 -16 door1\n"
+                                    "wall 128 -16 96 -16 door1\n"
+                                    "wall 96 -16 96 0 door1\n"
+                                    "player 64 128 0\n"
+                                    "model crate\n"
+                                    "part box w=32 d=32 h=32 color=brown:8\n"
+                                    "end\n"
+                                    "model ship\n"
+                                    "part box w=48 d=16 h=8 color=grey:9\n"
+                                    "part prism sides=5 r=12 h=4 at=36,0,2 color=red:8\n"
+                                    "end\n"
+                                    "object crate 200 200 yaw=30\n"
+                                    "object ship 128 128 z=40 path=circle:64:8000\n"
+                                    "object ship 40 200 z=20 path=line:150:-100:5000 spin=90\n";
 
 static int compile_text(const char *text, uint8_t **out, size_t *len)
 {
@@ -248,13 +247,17 @@ typedef struct {
 #define FLD(type, member) offsetof(type, member), (int)sizeof(((type *)0)->member)
 static const damage damages[] = {
     {"door opens below its ceiling", F_SEC, 1, FLD(scn_sector, open_h), -1, 0, SCENE_ERR_RANGE, SCN_SEC_SECTORS, 1},
-    {"door opens above the limit", F_SEC, 1, FLD(scn_sector, open_h), (int64_t)16384 << 16, 0, SCENE_ERR_RANGE, SCN_SEC_SECTORS, 1},
+    {"door opens above the limit", F_SEC, 1, FLD(scn_sector, open_h), (int64_t)16384 << 16, 0, SCENE_ERR_RANGE,
+     SCN_SEC_SECTORS, 1},
     {"non-door with an open ceiling", F_SEC, 0, FLD(scn_sector, open_h), 1, 1, SCENE_ERR_RANGE, SCN_SEC_SECTORS, 0},
     {"door flag on a plain sector", F_SEC, 0, FLD(scn_sector, flags), SCN_SECTOR_DOOR, 0, SCENE_OK, -1, 0},
     {"door flag off", F_SEC, 1, FLD(scn_sector, flags), 0, 0, SCENE_ERR_RANGE, SCN_SEC_SECTORS, 1},
-    {"model vertex x beyond 1024", F_MVERT, 3, FLD(scn_mvert, x), ((int64_t)1024 << 16) + 1, 0, SCENE_ERR_RANGE, SCN_SEC_MVERTS, 3},
-    {"model vertex y below -1024", F_MVERT, 9, FLD(scn_mvert, y), -((int64_t)1024 << 16) - 1, 0, SCENE_ERR_RANGE, SCN_SEC_MVERTS, 9},
-    {"model vertex z beyond 1024", F_MVERT, 17, FLD(scn_mvert, z), (int64_t)INT32_MAX, 0, SCENE_ERR_RANGE, SCN_SEC_MVERTS, 17},
+    {"model vertex x beyond 1024", F_MVERT, 3, FLD(scn_mvert, x), ((int64_t)1024 << 16) + 1, 0, SCENE_ERR_RANGE,
+     SCN_SEC_MVERTS, 3},
+    {"model vertex y below -1024", F_MVERT, 9, FLD(scn_mvert, y), -((int64_t)1024 << 16) - 1, 0, SCENE_ERR_RANGE,
+     SCN_SEC_MVERTS, 9},
+    {"model vertex z beyond 1024", F_MVERT, 17, FLD(scn_mvert, z), (int64_t)INT32_MAX, 0, SCENE_ERR_RANGE,
+     SCN_SEC_MVERTS, 17},
     {"model vertex moved", F_MVERT, 0, FLD(scn_mvert, x), -1, 1, SCENE_ERR_RANGE, SCN_SEC_MODELS, 0},
     {"model vertex lowered", F_MVERT, 8, FLD(scn_mvert, z), -1, 1, SCENE_ERR_RANGE, SCN_SEC_MODELS, 1},
     {"face of 2 vertices", F_FACE, 2, FLD(scn_face, num_index), 2, 0, SCENE_ERR_INDEX, SCN_SEC_FACES, 2},
@@ -263,14 +266,17 @@ static const damage damages[] = {
     {"face index wraps", F_FACE, 1, FLD(scn_face, first_index), 0xFFFFFFFF, 0, SCENE_ERR_INDEX, SCN_SEC_FACES, 1},
     {"face vertex outside its model", F_FINDEX, 5, 0, 4, 8, 0, SCENE_ERR_INDEX, SCN_SEC_MODELS, 0},
     {"face vertex far outside", F_FINDEX, 30, 0, 4, 0xFFFFFFFF, 0, SCENE_ERR_INDEX, SCN_SEC_MODELS, 1},
-    {"model vertices past the section", F_MODEL, 1, FLD(scn_model, first_vert), 1, 1, SCENE_ERR_INDEX, SCN_SEC_MODELS, 1},
-    {"model vertex range wraps", F_MODEL, 1, FLD(scn_model, first_vert), 0xFFFFFFF0, 0, SCENE_ERR_INDEX, SCN_SEC_MODELS, 1},
+    {"model vertices past the section", F_MODEL, 1, FLD(scn_model, first_vert), 1, 1, SCENE_ERR_INDEX, SCN_SEC_MODELS,
+     1},
+    {"model vertex range wraps", F_MODEL, 1, FLD(scn_model, first_vert), 0xFFFFFFF0, 0, SCENE_ERR_INDEX, SCN_SEC_MODELS,
+     1},
     {"model of 65 vertices", F_MODEL, 0, FLD(scn_model, num_verts), 65, 0, SCENE_ERR_INDEX, SCN_SEC_MODELS, 0},
     {"model of 2 vertices", F_MODEL, 0, FLD(scn_model, num_verts), 2, 0, SCENE_ERR_INDEX, SCN_SEC_MODELS, 0},
     {"model of no faces", F_MODEL, 0, FLD(scn_model, num_faces), 0, 0, SCENE_ERR_INDEX, SCN_SEC_MODELS, 0},
     {"model of 65 faces", F_MODEL, 0, FLD(scn_model, num_faces), 65, 0, SCENE_ERR_INDEX, SCN_SEC_MODELS, 0},
     {"model faces past the section", F_MODEL, 1, FLD(scn_model, first_face), 1, 1, SCENE_ERR_INDEX, SCN_SEC_MODELS, 1},
-    {"model with fewer vertices than its faces use", F_MODEL, 1, FLD(scn_model, num_verts), 17, 0, SCENE_ERR_INDEX, SCN_SEC_MODELS, 1},
+    {"model with fewer vertices than its faces use", F_MODEL, 1, FLD(scn_model, num_verts), 17, 0, SCENE_ERR_INDEX,
+     SCN_SEC_MODELS, 1},
     {"radius one too big", F_MODEL, 0, FLD(scn_model, radius), 1, 1, SCENE_ERR_RANGE, SCN_SEC_MODELS, 0},
     {"radius one too small", F_MODEL, 1, FLD(scn_model, radius), -1, 1, SCENE_ERR_RANGE, SCN_SEC_MODELS, 1},
     {"negative radius", F_MODEL, 1, FLD(scn_model, radius), -5, 0, SCENE_ERR_RANGE, SCN_SEC_MODELS, 1},
@@ -279,19 +285,25 @@ static const damage damages[] = {
     {"object of a missing model", F_OBJECT, 1, FLD(scn_object, model), 2, 0, SCENE_ERR_INDEX, SCN_SEC_OBJECTS, 1},
     {"object model none", F_OBJECT, 0, FLD(scn_object, model), 0xFFFFFFFF, 0, SCENE_ERR_INDEX, SCN_SEC_OBJECTS, 0},
     {"unknown path", F_OBJECT, 2, FLD(scn_object, path), 3, 0, SCENE_ERR_INDEX, SCN_SEC_OBJECTS, 2},
-    {"object x outside the box", F_OBJECT, 0, FLD(scn_object, x), ((int64_t)32767 << 16) + 1, 0, SCENE_ERR_RANGE, SCN_SEC_OBJECTS, 0},
+    {"object x outside the box", F_OBJECT, 0, FLD(scn_object, x), ((int64_t)32767 << 16) + 1, 0, SCENE_ERR_RANGE,
+     SCN_SEC_OBJECTS, 0},
     {"object y outside the box", F_OBJECT, 0, FLD(scn_object, y), INT32_MIN, 0, SCENE_ERR_RANGE, SCN_SEC_OBJECTS, 0},
-    {"object z above the limit", F_OBJECT, 0, FLD(scn_object, z), (int64_t)16384 << 16, 0, SCENE_ERR_RANGE, SCN_SEC_OBJECTS, 0},
-    {"circle leaves the box", F_OBJECT, 1, FLD(scn_object, x), (int64_t)32767 << 16, 0, SCENE_ERR_RANGE, SCN_SEC_OBJECTS, 1},
-    {"line leaves the box", F_OBJECT, 2, FLD(scn_object, y), -((int64_t)32700 << 16), 0, SCENE_ERR_RANGE, SCN_SEC_OBJECTS, 2},
+    {"object z above the limit", F_OBJECT, 0, FLD(scn_object, z), (int64_t)16384 << 16, 0, SCENE_ERR_RANGE,
+     SCN_SEC_OBJECTS, 0},
+    {"circle leaves the box", F_OBJECT, 1, FLD(scn_object, x), (int64_t)32767 << 16, 0, SCENE_ERR_RANGE,
+     SCN_SEC_OBJECTS, 1},
+    {"line leaves the box", F_OBJECT, 2, FLD(scn_object, y), -((int64_t)32700 << 16), 0, SCENE_ERR_RANGE,
+     SCN_SEC_OBJECTS, 2},
     {"line along y only", F_OBJECT, 2, FLD(scn_object, pa), 0, 0, SCENE_OK, -1, 0},
     {"circle of radius 0", F_OBJECT, 1, FLD(scn_object, pa), 0, 0, SCENE_ERR_RANGE, SCN_SEC_OBJECTS, 1},
     {"circle with a pb", F_OBJECT, 1, FLD(scn_object, pb), 1, 0, SCENE_ERR_RANGE, SCN_SEC_OBJECTS, 1},
     {"path of period 0", F_OBJECT, 1, FLD(scn_object, period_ms), 0, 0, SCENE_ERR_RANGE, SCN_SEC_OBJECTS, 1},
-    {"path of period over an hour", F_OBJECT, 2, FLD(scn_object, period_ms), 3600001, 0, SCENE_ERR_RANGE, SCN_SEC_OBJECTS, 2},
+    {"path of period over an hour", F_OBJECT, 2, FLD(scn_object, period_ms), 3600001, 0, SCENE_ERR_RANGE,
+     SCN_SEC_OBJECTS, 2},
     {"no path but a period", F_OBJECT, 0, FLD(scn_object, period_ms), 100, 0, SCENE_ERR_RANGE, SCN_SEC_OBJECTS, 0},
     {"no path but a radius", F_OBJECT, 0, FLD(scn_object, pa), 1, 0, SCENE_ERR_RANGE, SCN_SEC_OBJECTS, 0},
-    {"spin too fast", F_OBJECT, 2, FLD(scn_object, spin), ((int64_t)3600 << 16) + 1, 0, SCENE_ERR_RANGE, SCN_SEC_OBJECTS, 2},
+    {"spin too fast", F_OBJECT, 2, FLD(scn_object, spin), ((int64_t)3600 << 16) + 1, 0, SCENE_ERR_RANGE,
+     SCN_SEC_OBJECTS, 2},
     {"spin too fast backwards", F_OBJECT, 0, FLD(scn_object, spin), INT32_MIN, 0, SCENE_ERR_RANGE, SCN_SEC_OBJECTS, 0},
     {"yaw anything", F_OBJECT, 0, FLD(scn_object, yaw), INT32_MIN, 0, SCENE_OK, -1, 0},
     {"colour anything", F_FACE, 4, FLD(scn_face, colour), 255, 0, SCENE_OK, -1, 0},
@@ -305,9 +317,12 @@ static void test_object_damage(void **state)
         const damage *d = &damages[i];
         memcpy(b, oblob, oblob_len);
         oview v = oview_of(b);
-        uint8_t *rec = d->rec == F_SEC ? (uint8_t *)&v.sec[d->idx] : d->rec == F_MODEL ? (uint8_t *)&v.m[d->idx]
-                     : d->rec == F_MVERT ? (uint8_t *)&v.mv[d->idx] : d->rec == F_FACE ? (uint8_t *)&v.f[d->idx]
-                     : d->rec == F_FINDEX ? (uint8_t *)&v.fi[d->idx] : (uint8_t *)&v.o[d->idx];
+        uint8_t *rec = d->rec == F_SEC      ? (uint8_t *)&v.sec[d->idx]
+                       : d->rec == F_MODEL  ? (uint8_t *)&v.m[d->idx]
+                       : d->rec == F_MVERT  ? (uint8_t *)&v.mv[d->idx]
+                       : d->rec == F_FACE   ? (uint8_t *)&v.f[d->idx]
+                       : d->rec == F_FINDEX ? (uint8_t *)&v.fi[d->idx]
+                                            : (uint8_t *)&v.o[d->idx];
         uint8_t *p = rec + d->field;
         if (d->size == 4) {
             uint32_t x;
@@ -345,10 +360,10 @@ static void test_object_body_damage(void **state)
     uint8_t *b = malloc(oblob_len);
     const scn_header *h = (const scn_header *)(const void *)oblob;
     uint32_t refused = 0;
-    static const int secs[] = {SCN_SEC_SECTORS, SCN_SEC_MODELS, SCN_SEC_MVERTS, SCN_SEC_FACES, SCN_SEC_FINDEX,
-                               SCN_SEC_OBJECTS};
-    static const uint32_t recsz[] = {sizeof(scn_sector), sizeof(scn_model), sizeof(scn_mvert),
-                                     sizeof(scn_face), 4, sizeof(scn_object)};
+    static const int secs[] = {SCN_SEC_SECTORS, SCN_SEC_MODELS, SCN_SEC_MVERTS,
+                               SCN_SEC_FACES,   SCN_SEC_FINDEX, SCN_SEC_OBJECTS};
+    static const uint32_t recsz[] = {sizeof(scn_sector), sizeof(scn_model), sizeof(scn_mvert), sizeof(scn_face), 4,
+                                     sizeof(scn_object)};
     for (size_t k = 0; k < sizeof secs / sizeof secs[0]; k++) {
         size_t from = h->sec[secs[k]].offset, to = from + (size_t)h->sec[secs[k]].count * recsz[k];
         for (size_t off = from; off + 4 <= to; off += 4)
@@ -370,7 +385,8 @@ static void test_object_count_limit(void **state)
     (void)state;
     size_t cap = 200 + 40 * SCN_MAX_OBJECTS, n = 0;
     char *text = malloc(cap);
-    n += (size_t)snprintf(text + n, cap - n, "sector a floor=0 ceil=64\nwall 0 0 0 64 a\nwall 0 64 64 64 a\n"
+    n += (size_t)snprintf(text + n, cap - n,
+                          "sector a floor=0 ceil=64\nwall 0 0 0 64 a\nwall 0 64 64 64 a\n"
                           "wall 64 64 64 0 a\nwall 64 0 0 0 a\nplayer 32 32 0\n"
                           "model m\npart box w=1 d=1 h=1\nend\n");
     for (int i = 0; i < SCN_MAX_OBJECTS; i++)
@@ -409,14 +425,10 @@ static void test_object_count_limit(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_good_blob_loads),
-        cmocka_unit_test(test_header_damage),
-        cmocka_unit_test(test_body_damage),
-        cmocka_unit_test(test_tree_must_be_a_tree),
-        cmocka_unit_test(test_objects_blob_loads),
-        cmocka_unit_test(test_object_damage),
-        cmocka_unit_test(test_object_body_damage),
-        cmocka_unit_test(test_object_count_limit),
+        cmocka_unit_test(test_good_blob_loads),    cmocka_unit_test(test_header_damage),
+        cmocka_unit_test(test_body_damage),        cmocka_unit_test(test_tree_must_be_a_tree),
+        cmocka_unit_test(test_objects_blob_loads), cmocka_unit_test(test_object_damage),
+        cmocka_unit_test(test_object_body_damage), cmocka_unit_test(test_object_count_limit),
     };
     return cmocka_run_group_tests_name("scene", tests, setup, teardown);
 }

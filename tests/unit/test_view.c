@@ -44,8 +44,8 @@ static void expect_point(const view_xform *v, int32_t wx, int32_t wy, int32_t h)
     double s = v->sin / 1073741824.0, c = v->cos / 1073741824.0;
     double ez = (dx * c + dy * s) / 4.0, ex = (dx * s - dy * c) / 4.0, ey = ((double)h - (double)v->cz) / 4.0;
     if (fabs(p.z - ez) > 2.0 || fabs(p.x - ex) > 2.0 || fabs(p.y - ey) > 1.0)
-        fail_msg("view_point(%d, %d, %d) from (%lld, %lld, %lld): got (%d, %d, %d), expected (%.1f, %.1f, %.1f)",
-                 wx, wy, h, (long long)v->cx, (long long)v->cy, (long long)v->cz, p.x, p.y, p.z, ex, ey, ez);
+        fail_msg("view_point(%d, %d, %d) from (%lld, %lld, %lld): got (%d, %d, %d), expected (%.1f, %.1f, %.1f)", wx,
+                 wy, h, (long long)v->cx, (long long)v->cy, (long long)v->cz, p.x, p.y, p.z, ex, ey, ez);
     /* docs/ranges.md: |x|, |z| <= 65534 sqrt 2 units, |y| <= 32766 units */
     const double xz_max = 65534.0 * 1.41421357 * 16384.0 + 2.0;
     assert_true(fabs((double)p.x) <= xz_max && fabs((double)p.z) <= xz_max);

@@ -29,7 +29,10 @@ typedef struct {
     size_t at;
 } wr;
 
-static void w8(wr *w, uint8_t v) { w->p[w->at++] = v; }
+static void w8(wr *w, uint8_t v)
+{
+    w->p[w->at++] = v;
+}
 static void w16(wr *w, uint16_t v)
 {
     w8(w, (uint8_t)v);
@@ -40,7 +43,10 @@ static void w32(wr *w, uint32_t v)
     w16(w, (uint16_t)v);
     w16(w, (uint16_t)(v >> 16));
 }
-static void wi32(wr *w, int32_t v) { w32(w, (uint32_t)v); }
+static void wi32(wr *w, int32_t v)
+{
+    w32(w, (uint32_t)v);
+}
 
 static void bbox_add(int32_t b[4], int32_t x, int32_t y)
 {
@@ -110,14 +116,28 @@ static uint64_t blob_layout(const bs_scene *s, const bs_tree *t, uint32_t counts
     for (uint32_t i = 0; i < t->nleaves; i++) npv += t->leaves[i].poly.n;
     const bs_look *lk = &s->look;
     int look = lk->present;
-    const uint32_t c[SCN_SEC_COUNT] = {t->nverts, s->nsectors, s->nlines, t->nsegs,
-                                       t->nnodes, t->nleaves,  npv,       256,
-                                       s->nmodels, s->nmverts, s->nfaces, s->nfindex, s->nobjects, 1,
-                                       look ? 1u : 0u, look ? SCN_LIGHT_MAPS : 0u, look ? lk->ntex : 0u,
-                                       look ? lk->ntexels : 0u, look ? 2u * s->nlines : 0u,
+    const uint32_t c[SCN_SEC_COUNT] = {t->nverts,
+                                       s->nsectors,
+                                       s->nlines,
+                                       t->nsegs,
+                                       t->nnodes,
+                                       t->nleaves,
+                                       npv,
+                                       256,
+                                       s->nmodels,
+                                       s->nmverts,
+                                       s->nfaces,
+                                       s->nfindex,
+                                       s->nobjects,
+                                       1,
+                                       look ? 1u : 0u,
+                                       look ? SCN_LIGHT_MAPS : 0u,
+                                       look ? lk->ntex : 0u,
+                                       look ? lk->ntexels : 0u,
+                                       look ? 2u * s->nlines : 0u,
                                        look ? s->nsectors : 0u};
-    static const uint32_t recsz[SCN_SEC_COUNT] = {8, 12 + 4, 24, 16, 56, 20, 8, 3, 28, 12, 8, 4, 40,
-                                                  sizeof(scn_needs), 8, 256, 12, 1, 24, 4};
+    static const uint32_t recsz[SCN_SEC_COUNT] = {8, 12 + 4, 24, 16, 56, 20, 8, 3, 28, 12, 8, 4, 40, sizeof(scn_needs),
+                                                  8, 256,    12, 1,  24, 4};
     uint64_t at = sizeof(scn_header);
     for (int k = 0; k < SCN_SEC_COUNT; k++) {
         at = (at + 3) & ~(uint64_t)3;
@@ -323,7 +343,10 @@ static void put_look(wr *w, const blob_src *b)
     w32(w, 0);
 }
 
-static void put_lights(wr *w, const blob_src *b) { memcpy(w->p + w->at, b->s->look.lights, 256 * SCN_LIGHT_MAPS); }
+static void put_lights(wr *w, const blob_src *b)
+{
+    memcpy(w->p + w->at, b->s->look.lights, 256 * SCN_LIGHT_MAPS);
+}
 
 static void put_textures(wr *w, const blob_src *b)
 {
@@ -339,7 +362,10 @@ static void put_textures(wr *w, const blob_src *b)
     }
 }
 
-static void put_texels(wr *w, const blob_src *b) { memcpy(w->p + w->at, b->s->look.texels, b->s->look.ntexels); }
+static void put_texels(wr *w, const blob_src *b)
+{
+    memcpy(w->p + w->at, b->s->look.texels, b->s->look.ntexels);
+}
 
 static void put_sides(wr *w, const blob_src *b)
 {
@@ -376,8 +402,7 @@ static void (*const put_section[SCN_SEC_COUNT])(wr *, const blob_src *) = {
     [SCN_SEC_PLANES] = put_planes,
 };
 
-int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *len, char *err,
-                  size_t errlen)
+int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *len, char *err, size_t errlen)
 {
     int32_t(*childbox)[2][4] = malloc(sizeof *childbox * (t->nnodes + 1));
     if (!childbox || blob_child_boxes(t, childbox)) {

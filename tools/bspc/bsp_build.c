@@ -99,8 +99,7 @@ static int push_seg(work *w, uint32_t seg)
 
 /* ---------------------------------------------------------------- splitting */
 
-static int split_set(builder *B, work *w, bs_part c, work *front, work *back, char *err,
-                     size_t errlen)
+static int split_set(builder *B, work *w, bs_part c, work *front, work *back, char *err, size_t errlen)
 {
     bs_tree *t = B->t;
     for (uint32_t i = 0; i < w->n; i++) {
@@ -119,8 +118,7 @@ static int split_set(builder *B, work *w, bs_part c, work *front, work *back, ch
             int32_t x, y;
             if (bs_intersect(t->plines, c.pl, g.line, &x, &y)) {
                 /* cannot happen: ends on opposite sides means not parallel */
-                return bs_fail(err, errlen, "%s: internal error: parallel split of linedef %u",
-                               B->s->name, g.line);
+                return bs_fail(err, errlen, "%s: internal error: parallel split of linedef %u", B->s->name, g.line);
             }
             if (x == g.x1 && y == g.y1) {
                 to = (b > 0) ? front : back; /* the cut rounds onto an end: no cut */
@@ -192,8 +190,8 @@ static int make_leaf(builder *B, work *w, char *err, size_t errlen)
     L->sector = best;
     if (distinct > 1) {
         if (B->warned < 10)
-            bs_warn(B->opt, "%s: leaf %u: segs face %u different sectors; using sector %u", B->s->name,
-                    li, distinct, best);
+            bs_warn(B->opt, "%s: leaf %u: segs face %u different sectors; using sector %u", B->s->name, li, distinct,
+                    best);
         else if (B->warned == 10)
             bs_warn(B->opt, "%s: more leaves with mixed sectors (not listed)", B->s->name);
         B->warned++;
@@ -380,8 +378,7 @@ int bs_build(const bs_scene *s, const bspc_options *opt, bs_tree *t, char *err, 
         if (w.depth >= SCN_MAX_DEPTH) {
             free(w.segs);
             bs_poly_free(&w.poly);
-            bs_fail(err, errlen, "%s: BSP tree deeper than %d nodes (try --split balanced)", s->name,
-                    SCN_MAX_DEPTH);
+            bs_fail(err, errlen, "%s: BSP tree deeper than %d nodes (try --split balanced)", s->name, SCN_MAX_DEPTH);
             goto out;
         }
         if (bs_grow(&t->nodes, &t->nodecap, t->nnodes + 1, sizeof(bs_node))) {
@@ -413,8 +410,7 @@ int bs_build(const bs_scene *s, const bspc_options *opt, bs_tree *t, char *err, 
             e = bs_fail(err, errlen, "%s: out of memory", s->name);
         free(w.segs);
         bs_poly_free(&w.poly);
-        if (!e && bs_grow(&stack, &scap, sn + 2, sizeof(work)))
-            e = bs_fail(err, errlen, "%s: out of memory", s->name);
+        if (!e && bs_grow(&stack, &scap, sn + 2, sizeof(work))) e = bs_fail(err, errlen, "%s: out of memory", s->name);
         if (e) {
             free(f.segs);
             free(b.segs);

@@ -78,7 +78,7 @@ int bspc_model_names(const char *spec, bspc_name **names)
     if (bs_read_text(spec, &s, &opt, err, sizeof err) == 0 && s.nmodels > 0) {
         *names = malloc(sizeof **names * s.nmodels);
         n = *names ? (int)s.nmodels : -1;
-        for (int i = 0; i < n; i++) snprintf((*names)[i].name, sizeof (*names)[i].name, "%s", s.models[i].name);
+        for (int i = 0; i < n; i++) snprintf((*names)[i].name, sizeof(*names)[i].name, "%s", s.models[i].name);
     }
     bs_scene_free(&s);
     return n;
@@ -107,8 +107,7 @@ static void place_objects(bs_scene *s, const bs_tree *t, const bspc_options *opt
             uint32_t sec = walk_sector(t, o.x, o.y);
             if (sec == SCN_NONE) sec = bs_point_sector(s, o.x, o.y);
             if (sec == SCN_NONE) {
-                if (dropped++ < 10)
-                    bs_warn(opt, "%s: thing %d is inside no sector; left out", s->name, o.src_line);
+                if (dropped++ < 10) bs_warn(opt, "%s: thing %d is inside no sector; left out", s->name, o.src_line);
                 continue;
             }
             o.z = s->sectors[sec].floor_h;
@@ -127,8 +126,8 @@ static int fill_needs(const bs_scene *s, uint8_t *blob, size_t len, needs_report
     scene sc;
     scene_error se;
     if (scene_parse(&sc, blob, (uint32_t)len, &se) != SCENE_OK)
-        return bs_fail(err, errlen, "%s: internal error: the compiled scene does not parse (%s, %s record %u)",
-                       s->name, scene_status_text(se.status), scene_section_name(se.section), se.index);
+        return bs_fail(err, errlen, "%s: internal error: the compiled scene does not parse (%s, %s record %u)", s->name,
+                       scene_status_text(se.status), scene_section_name(se.section), se.index);
     if (needs_analyse(&sc, !s->no_look, r)) return bs_fail(err, errlen, "%s: out of memory", s->name);
     const scn_header *h = (const scn_header *)(const void *)blob;
     memcpy(blob + h->sec[SCN_SEC_NEEDS].offset, &r->needs, sizeof r->needs);
@@ -137,8 +136,8 @@ static int fill_needs(const bs_scene *s, uint8_t *blob, size_t len, needs_report
     return 0;
 }
 
-int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, size_t *len,
-                 bspc_stats *stats, char *err, size_t errlen)
+int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, size_t *len, bspc_stats *stats,
+                 char *err, size_t errlen)
 {
     bspc_options opt = opt_in ? *opt_in : bspc_defaults();
     if (err && errlen) err[0] = 0;
@@ -161,8 +160,10 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
         memcpy(wadname, spec, wl);
         wadname[wl] = 0;
         if (bspc_find_wad(wadname, path, sizeof path))
-            return bs_fail(err, errlen, "%s: cannot find %s (looked in the current folder, "
-                           "$DOOMWADDIR and /usr/share/games/doom)", spec, wadname);
+            return bs_fail(err, errlen,
+                           "%s: cannot find %s (looked in the current folder, "
+                           "$DOOMWADDIR and /usr/share/games/doom)",
+                           spec, wadname);
         if (kind == BSPC_SPEC_WAD || !spec[wl + 1]) {
             char maps[200];
             if (bspc_list_maps(wadname, maps, sizeof maps, err, errlen) < 0) return -1;
@@ -182,8 +183,8 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
     s.player_sector = bs_player_sector(&s);
     if (s.player_sector == SCN_NONE && s.is_text) {
         char b1[32], b2[32];
-        bs_fail(err, errlen, "%s:%d: player at (%s, %s) is not inside any sector", s.name,
-                s.player_line, bs_fxstr(s.player_x, b1), bs_fxstr(s.player_y, b2));
+        bs_fail(err, errlen, "%s:%d: player at (%s, %s) is not inside any sector", s.name, s.player_line,
+                bs_fxstr(s.player_x, b1), bs_fxstr(s.player_y, b2));
         goto out;
     }
 
@@ -192,8 +193,8 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
         const bs_object *o = &s.objects[i];
         if (o->has_z || bs_point_sector(&s, o->x, o->y) != SCN_NONE) continue;
         char b1[32], b2[32];
-        bs_fail(err, errlen, "%s:%d: object at (%s, %s) is not inside any sector (give z=Z)", s.name,
-                o->src_line, bs_fxstr(o->x, b1), bs_fxstr(o->y, b2));
+        bs_fail(err, errlen, "%s:%d: object at (%s, %s) is not inside any sector (give z=Z)", s.name, o->src_line,
+                bs_fxstr(o->x, b1), bs_fxstr(o->y, b2));
         goto out;
     }
 
@@ -213,8 +214,8 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
     }
     t.mean_depth = t.nleaves ? (double)dsum / t.nleaves : 0.0;
     if (t.max_depth > SCN_MAX_DEPTH) {
-        bs_fail(err, errlen, "%s: BSP tree %u nodes deep, deeper than %d (try --split balanced)",
-                s.name, t.max_depth, SCN_MAX_DEPTH);
+        bs_fail(err, errlen, "%s: BSP tree %u nodes deep, deeper than %d (try --split balanced)", s.name, t.max_depth,
+                SCN_MAX_DEPTH);
         goto out;
     }
     {
@@ -222,11 +223,15 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
          * differ from the winding-number answer in maps with overlapping sectors) */
         uint32_t walked = walk_sector(&t, s.player_x, s.player_y);
         if (s.player_sector == SCN_NONE)
-            bs_warn(&opt, "%s: player start is inside no closed sector; using the sector of its "
-                    "leaf (%d)", s.name, (int)walked);
+            bs_warn(&opt,
+                    "%s: player start is inside no closed sector; using the sector of its "
+                    "leaf (%d)",
+                    s.name, (int)walked);
         else if (walked != s.player_sector)
-            bs_warn(&opt, "%s: player start: sector %u by its walls, sector %u by its leaf; using "
-                    "the leaf's", s.name, s.player_sector, walked);
+            bs_warn(&opt,
+                    "%s: player start: sector %u by its walls, sector %u by its leaf; using "
+                    "the leaf's",
+                    s.name, s.player_sector, walked);
         if (walked != SCN_NONE) s.player_sector = walked;
     }
     place_objects(&s, &t, &opt);
@@ -234,15 +239,16 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
     needs_report needs;
     if (fill_needs(&s, *blob, *len, &needs, err, errlen)) goto out;
     double t1 = bs_now_ms();
-    bs_note(&opt, "%s: times: tree %.2f ms, T-junctions %.2f ms, blob %.2f ms", s.name, t_tree - t0,
-            t_tj - t_tree, t1 - t_tj);
+    bs_note(&opt, "%s: times: tree %.2f ms, T-junctions %.2f ms, blob %.2f ms", s.name, t_tree - t0, t_tj - t_tree,
+            t1 - t_tj);
 
-    bs_note(&opt, "%s: %u linedefs, %u segs (%u partition splits, %u T-junction splits), %u nodes, "
+    bs_note(&opt,
+            "%s: %u linedefs, %u segs (%u partition splits, %u T-junction splits), %u nodes, "
             "%u leaves, %u vertices, depth %u (mean %.2f), %u polygon vertices inserted, %.2f ms",
-            s.name, s.nlines, t.nsegs, t.part_splits, t.tj_splits, t.nnodes, t.nleaves, t.nverts,
-            t.max_depth, t.mean_depth, t.tj_pverts, t1 - t0);
-    bs_note(&opt, "%s: %u models (%u vertices, %u faces), %u objects, %u doors", s.name, s.nmodels,
-            s.nmverts, s.nfaces, s.nobjects, s.ndoors);
+            s.name, s.nlines, t.nsegs, t.part_splits, t.tj_splits, t.nnodes, t.nleaves, t.nverts, t.max_depth,
+            t.mean_depth, t.tj_pverts, t1 - t0);
+    bs_note(&opt, "%s: %u models (%u vertices, %u faces), %u objects, %u doors", s.name, s.nmodels, s.nmverts, s.nfaces,
+            s.nobjects, s.ndoors);
     if (stats) {
         memset(stats, 0, sizeof *stats);
         stats->input_walls = s.nlines;

@@ -22,9 +22,9 @@ typedef struct {
     uint32_t segs;        /* wall pieces written */
     uint32_t splits;      /* segs cut by partitions */
     uint32_t leaves, nodes, vertices;
-    uint32_t max_depth;   /* nodes on the longest root-to-leaf path */
-    double mean_depth;    /* mean over leaves */
-    double build_ms;      /* wall-clock milliseconds for the tree build and blob write */
+    uint32_t max_depth;              /* nodes on the longest root-to-leaf path */
+    double mean_depth;               /* mean over leaves */
+    double build_ms;                 /* wall-clock milliseconds for the tree build and blob write */
     uint32_t models, objects, doors; /* docs/objects.md */
     needs_report needs;              /* what the scene needs (docs/needs.md), as written in the blob */
 } bspc_stats;
@@ -37,17 +37,17 @@ bspc_options bspc_defaults(void);
  * is also looked for in $DOOMWADDIR and /usr/share/games/doom). On success returns 0 and
  * *blob (malloc'd, caller frees) and *len; stats may be NULL. On failure returns -1 and
  * writes into err a one-line message naming the file, the item and the problem. */
-int bspc_compile(const char *spec, const bspc_options *opt, uint8_t **blob, size_t *len,
-                 bspc_stats *stats, char *err, size_t errlen);
+int bspc_compile(const char *spec, const bspc_options *opt, uint8_t **blob, size_t *len, bspc_stats *stats, char *err,
+                 size_t errlen);
 
 /* Resolve a WAD file name as bspc_compile does; returns 0 and the path in out, or -1. */
 int bspc_find_wad(const char *name, char *out, size_t outlen);
 
 /* What a scene spec names: the one reading of its form. */
 typedef enum {
-    BSPC_SPEC_FILE,    /* a file: a text scene, or a compiled scene */
-    BSPC_SPEC_WAD,     /* "x.wad": a WAD without a map */
-    BSPC_SPEC_WAD_MAP  /* "x.wad:MAP01": a map in a WAD */
+    BSPC_SPEC_FILE,   /* a file: a text scene, or a compiled scene */
+    BSPC_SPEC_WAD,    /* "x.wad": a WAD without a map */
+    BSPC_SPEC_WAD_MAP /* "x.wad:MAP01": a map in a WAD */
 } bspc_spec_kind;
 
 /* The kind of spec; *wadlen (may be NULL) gets the length of the WAD's name. */

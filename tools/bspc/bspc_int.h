@@ -59,15 +59,15 @@ typedef struct {
     int32_t floor_h, ceil_h; /* 16.16; ceil_h is a door's closed ceiling */
     int32_t open_h;          /* 16.16: a door's open ceiling (SCN_SECTOR_DOOR); unused otherwise */
     uint8_t floor_color, ceil_color, light, flags;
-    int src_line;            /* text: line of the declaration; WAD: 0 */
-    char name[32];           /* text: optional name; WAD: "" */
+    int src_line;  /* text: line of the declaration; WAD: 0 */
+    char name[32]; /* text: optional name; WAD: "" */
 } bs_sector;
 
 typedef struct {
-    uint32_t v1, v2;      /* scene vertex indices */
-    uint32_t sector[2];   /* front, back (SCN_NONE) */
-    uint8_t color[2][3];  /* [side][SCN_PART_*] */
-    int src_line;         /* text: line number; WAD: linedef index in the lump */
+    uint32_t v1, v2;     /* scene vertex indices */
+    uint32_t sector[2];  /* front, back (SCN_NONE) */
+    uint8_t color[2][3]; /* [side][SCN_PART_*] */
+    int src_line;        /* text: line number; WAD: linedef index in the lump */
 } bs_line;
 
 /* Models (docs/objects.md): the records of scn_model / scn_mvert / scn_face,
@@ -90,9 +90,9 @@ typedef struct {
     uint32_t nparts;
     uint8_t part_vert[BS_MAX_PARTS];  /* a part's first vertex, relative to first_vert */
     uint8_t part_sides[BS_MAX_PARTS]; /* its ring's corner count */
-    int32_t radius, zmin, zmax; /* set by bs_model_end */
-    int src_line;               /* text: the model statement; WAD: 0 */
-    char name[32];              /* text: its name; WAD: "" */
+    int32_t radius, zmin, zmax;       /* set by bs_model_end */
+    int src_line;                     /* text: the model statement; WAD: 0 */
+    char name[32];                    /* text: its name; WAD: "" */
 } bs_model;
 
 typedef struct {
@@ -102,8 +102,8 @@ typedef struct {
     uint32_t path;        /* SCN_PATH_* */
     int32_t pa, pb;       /* 16.16 */
     uint32_t period_ms;
-    int32_t spin;         /* degrees per second, 16.16 */
-    int src_line;         /* text: line; WAD: thing index in the lump */
+    int32_t spin; /* degrees per second, 16.16 */
+    int src_line; /* text: line; WAD: thing index in the lump */
 } bs_object;
 
 /* Limits beyond scene_format.h that keep the path arithmetic of docs/objects.md
@@ -114,34 +114,34 @@ typedef struct {
 /* A WAD map's look (docs/textures.md), filled by wad_look.c: the records of
  * the look sections, ready to write. */
 typedef struct {
-    int present;                    /* write the look sections (not under --flat) */
-    int doom_palette;               /* palette[] is PLAYPAL's (even under --flat) */
+    int present;      /* write the look sections (not under --flat) */
+    int doom_palette; /* palette[] is PLAYPAL's (even under --flat) */
     uint8_t palette[768];
-    uint8_t *lights;                /* SCN_LIGHT_MAPS tables of 256 */
+    uint8_t *lights; /* SCN_LIGHT_MAPS tables of 256 */
     scn_texture *tex;
     uint32_t ntex, tcap;
     uint8_t *texels;
     uint32_t ntexels, txcap;
-    uint32_t sky_tex;               /* SCN_TEX_NONE: no sky */
-    scn_side *sides;                /* 2 per scene line, index line * 2 + side */
-    scn_plane *planes;              /* one per sector */
-    uint8_t shade[3][256];          /* model faces' fake contrast under PLAYPAL: [contrast + 1][colour] */
+    uint32_t sky_tex;      /* SCN_TEX_NONE: no sky */
+    scn_side *sides;       /* 2 per scene line, index line * 2 + side */
+    scn_plane *planes;     /* one per sector */
+    uint8_t shade[3][256]; /* model faces' fake contrast under PLAYPAL: [contrast + 1][colour] */
 } bs_look;
 
 typedef struct {
-    char name[300];                 /* for messages: "a.scene" or "x.wad:MAP01" */
-    int is_text;                    /* messages quote text line numbers */
-    int32_t *vx, *vy;               /* 16.16 */
+    char name[300];   /* for messages: "a.scene" or "x.wad:MAP01" */
+    int is_text;      /* messages quote text line numbers */
+    int32_t *vx, *vy; /* 16.16 */
     uint32_t nverts, vcap;
     bs_sector *sectors;
     uint32_t nsectors, scap;
     bs_line *lines;
     uint32_t nlines, lcap;
     int has_player;
-    int no_look;                    /* text: 'look off': the camera keeps its horizon level */
+    int no_look;                              /* text: 'look off': the camera keeps its horizon level */
     int32_t player_x, player_y, player_angle; /* 16.16; angle in degrees */
     int player_line;
-    uint32_t player_sector;         /* filled by bs_scene_check / bspc.c */
+    uint32_t player_sector; /* filled by bs_scene_check / bspc.c */
     bs_model *models;
     uint32_t nmodels, mcap;
     bs_mvert *mverts;
@@ -164,8 +164,8 @@ uint32_t bs_scene_add_vertex(bs_scene *s, int32_t x, int32_t y);
 int bs_read_text(const char *path, bs_scene *s, const bspc_options *opt, char *err, size_t errlen);
 /* wad.c: read one Doom-format map. wadpath: a resolved file; map: "MAP01"/"E1M1";
  * display: the spec as the user wrote it, for messages. */
-int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_scene *s,
-                const bspc_options *opt, char *err, size_t errlen);
+int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_scene *s, const bspc_options *opt,
+                char *err, size_t errlen);
 
 /* wad_look.c: a WAD's palette, light tables, textures, flats and sprites
  * (docs/textures.md). wad.c reads the directory and the map; it opens the look
@@ -223,10 +223,23 @@ uint8_t bs_shade(uint8_t c, int delta);
 /* palette.c: the default 256-colour palette: 16 ramps (hues) x 16 shades,
  * index = ramp * 16 + shade, shade 0 darkest. See docs/scene-format.md. */
 enum {
-    BS_RAMP_GREY, BS_RAMP_RED, BS_RAMP_ORANGE, BS_RAMP_YELLOW, BS_RAMP_LIME,
-    BS_RAMP_GREEN, BS_RAMP_TEAL, BS_RAMP_CYAN, BS_RAMP_BLUE, BS_RAMP_VIOLET,
-    BS_RAMP_MAGENTA, BS_RAMP_BROWN, BS_RAMP_SAND, BS_RAMP_MOSS, BS_RAMP_SLATE,
-    BS_RAMP_PLUM, BS_RAMP_COUNT
+    BS_RAMP_GREY,
+    BS_RAMP_RED,
+    BS_RAMP_ORANGE,
+    BS_RAMP_YELLOW,
+    BS_RAMP_LIME,
+    BS_RAMP_GREEN,
+    BS_RAMP_TEAL,
+    BS_RAMP_CYAN,
+    BS_RAMP_BLUE,
+    BS_RAMP_VIOLET,
+    BS_RAMP_MAGENTA,
+    BS_RAMP_BROWN,
+    BS_RAMP_SAND,
+    BS_RAMP_MOSS,
+    BS_RAMP_SLATE,
+    BS_RAMP_PLUM,
+    BS_RAMP_COUNT
 };
 void bs_palette(uint8_t pal[768]);
 const char *bs_ramp_name(int ramp);
@@ -250,7 +263,7 @@ typedef struct {
 
 typedef struct {
     int32_t x, y;
-    uint32_t eline;   /* bs_pline index of the edge from this vertex to the next */
+    uint32_t eline; /* bs_pline index of the edge from this vertex to the next */
 } bs_pv;
 
 typedef struct {
@@ -288,7 +301,7 @@ typedef struct {
     int32_t *vx, *vy;
     uint32_t nverts, vcap, norig;
     uint32_t *line_v; /* per line: tree indices of v1, v2 */
-    uint32_t *vhash; /* open addressing: vertex index + 1, 0 empty */
+    uint32_t *vhash;  /* open addressing: vertex index + 1, 0 empty */
     uint32_t hcap;
     bs_pline *plines; /* one per line, the 4 world-box edges, then free partitions */
     uint32_t nplines, plcap;
@@ -346,8 +359,7 @@ void bs_poly_free(bs_poly *p);
 int bs_poly_push(bs_poly *p, int32_t x, int32_t y, uint32_t eline);
 /* Split p by the oriented line (pl, rev) into the part on its front (right) and
  * the part on its back; either may come out empty (n == 0). -1 on allocation failure. */
-int bs_poly_split(const bs_tree *t, const bs_poly *p, uint32_t pl, uint32_t rev, bs_poly *front,
-                  bs_poly *back);
+int bs_poly_split(const bs_tree *t, const bs_poly *p, uint32_t pl, uint32_t rev, bs_poly *front, bs_poly *back);
 /* Keep only the front (right) part of p, in place. */
 int bs_poly_clip_front(const bs_tree *t, bs_poly *p, uint32_t pl, uint32_t rev);
 /* Drop repeated points and degenerate polygons (< 3 distinct points, zero area). */
@@ -362,7 +374,6 @@ int bs_tjunc_polys(bs_tree *t, char *err, size_t errlen);
 int bs_split_big_leaves(bs_tree *t, const char *name, char *err, size_t errlen);
 
 /* blob_write.c */
-int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *len, char *err,
-                  size_t errlen);
+int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *len, char *err, size_t errlen);
 
 #endif

@@ -27,7 +27,10 @@ static int cmp_x0(const void *a, const void *b)
     return p->line < q->line ? -1 : p->line > q->line;
 }
 
-static int sign128(bs_i128 v) { return (v > 0) - (v < 0); }
+static int sign128(bs_i128 v)
+{
+    return (v > 0) - (v < 0);
+}
 
 /* side of (px, py) relative to the line a -> b: +1, -1 or 0 (exact) */
 static int orient(int64_t ax, int64_t ay, int64_t bx, int64_t by, int64_t px, int64_t py)
@@ -73,10 +76,10 @@ static int refuse(const bs_scene *s, uint32_t a, uint32_t b, int32_t x, int32_t 
         lb = t;
     }
     if (s->is_text)
-        return bs_fail(err, errlen, "%s:%d: wall crosses the wall of line %d at (%s, %s)", s->name,
-                       la->src_line, lb->src_line, bs_fxstr(x, bx), bs_fxstr(y, by));
-    return bs_fail(err, errlen, "%s: linedef %d crosses linedef %d at (%s, %s)", s->name, la->src_line,
-                   lb->src_line, bs_fxstr(x, bx), bs_fxstr(y, by));
+        return bs_fail(err, errlen, "%s:%d: wall crosses the wall of line %d at (%s, %s)", s->name, la->src_line,
+                       lb->src_line, bs_fxstr(x, bx), bs_fxstr(y, by));
+    return bs_fail(err, errlen, "%s: linedef %d crosses linedef %d at (%s, %s)", s->name, la->src_line, lb->src_line,
+                   bs_fxstr(x, bx), bs_fxstr(y, by));
 }
 
 int bs_check_crossings(const bs_scene *s, char *err, size_t errlen)

@@ -13,7 +13,10 @@ uint64_t bs_isqrt(bs_u128 v)
     return r;
 }
 
-static int64_t abs64(int64_t v) { return v < 0 ? -v : v; }
+static int64_t abs64(int64_t v)
+{
+    return v < 0 ? -v : v;
+}
 
 static int64_t gcd64(int64_t a, int64_t b)
 {
@@ -51,8 +54,7 @@ void bs_pline_set(bs_pline *L, int32_t x, int32_t y, int64_t dx, int64_t dy)
     L->rdx = (int32_t)rdx;
     L->rdy = (int32_t)rdy;
     L->small = abs64(rdx) < ((int64_t)1 << 29) && abs64(rdy) < ((int64_t)1 << 29);
-    L->thr = (int64_t)bs_isqrt((bs_u128)(BS_EPS * BS_EPS) *
-                               ((bs_u128)(rdx * rdx) + (bs_u128)(rdy * rdy)));
+    L->thr = (int64_t)bs_isqrt((bs_u128)(BS_EPS * BS_EPS) * ((bs_u128)(rdx * rdx) + (bs_u128)(rdy * rdy)));
 }
 
 /* round(n / d) to nearest, ties toward +infinity; d != 0 */
@@ -86,8 +88,7 @@ int bs_intersect(const bs_pline *lines, uint32_t a, uint32_t b, int32_t *x, int3
     /* A + t dA on B: t = ((B - A) x dB) / (dA x dB) with u x v = ux vy - uy vx */
     bs_i128 den = (bs_i128)A->rdx * B->rdy - (bs_i128)A->rdy * B->rdx;
     if (den == 0) return -1;
-    bs_i128 num =
-        (bs_i128)((int64_t)B->x - A->x) * B->rdy - (bs_i128)((int64_t)B->y - A->y) * B->rdx;
+    bs_i128 num = (bs_i128)((int64_t)B->x - A->x) * B->rdy - (bs_i128)((int64_t)B->y - A->y) * B->rdx;
     /* |num| < 2^65, |dA| < 2^31: products < 2^96 */
     *x = clamp32((bs_i128)A->x + rdiv(num * A->rdx, den));
     *y = clamp32((bs_i128)A->y + rdiv(num * A->rdy, den));

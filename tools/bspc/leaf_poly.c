@@ -49,8 +49,8 @@ void bs_poly_tidy(bs_poly *p)
 }
 
 /* one output of a cut: keep side K (+1 front, -1 back) */
-static int cut(const bs_tree *t, const bs_poly *p, const int8_t *side, const int32_t *cx,
-               const int32_t *cy, uint32_t pl, int K, bs_poly *out)
+static int cut(const bs_tree *t, const bs_poly *p, const int8_t *side, const int32_t *cx, const int32_t *cy,
+               uint32_t pl, int K, bs_poly *out)
 {
     uint32_t n = p->n;
     out->n = 0;
@@ -72,8 +72,7 @@ static int cut(const bs_tree *t, const bs_poly *p, const int8_t *side, const int
     return 0;
 }
 
-static int split_core(const bs_tree *t, const bs_poly *p, uint32_t pl, uint32_t rev, bs_poly *front,
-                      bs_poly *back)
+static int split_core(const bs_tree *t, const bs_poly *p, uint32_t pl, uint32_t rev, bs_poly *front, bs_poly *back)
 {
     if (front) front->n = 0;
     if (back) back->n = 0;
@@ -145,8 +144,7 @@ static int split_core(const bs_tree *t, const bs_poly *p, uint32_t pl, uint32_t 
     return rc;
 }
 
-int bs_poly_split(const bs_tree *t, const bs_poly *p, uint32_t pl, uint32_t rev, bs_poly *front,
-                  bs_poly *back)
+int bs_poly_split(const bs_tree *t, const bs_poly *p, uint32_t pl, uint32_t rev, bs_poly *front, bs_poly *back)
 {
     memset(front, 0, sizeof *front);
     memset(back, 0, sizeof *back);

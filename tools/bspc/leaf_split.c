@@ -67,8 +67,7 @@ static int split_leaf(bs_tree *t, uint32_t li)
     bs_pline L;
     for (i = 0; i < n; i++) {
         j = (i + n / 2) % n;
-        bs_pline_set(&L, p->v[i].x, p->v[i].y, (int64_t)p->v[j].x - p->v[i].x,
-                     (int64_t)p->v[j].y - p->v[i].y);
+        bs_pline_set(&L, p->v[i].x, p->v[i].y, (int64_t)p->v[j].x - p->v[i].x, (int64_t)p->v[j].y - p->v[i].y);
         if (chord_cuts(&L, p)) break;
     }
     if (i == n) return 1;

@@ -229,8 +229,8 @@ int main(int argc, char **argv)
                "\"vertices\": %u, \"max_depth\": %u, \"mean_depth\": %.3f, \"build_ms\": %.3f, "
                "\"models\": %u, \"objects\": %u, \"features\": %u, \"max_edges\": %u, \"max_surfaces\": %u, "
                "\"all_edges\": %u, \"all_surfaces\": %u}\n",
-               st.input_walls, st.segs, st.splits, st.leaves, st.nodes, st.vertices, st.max_depth,
-               st.mean_depth, st.build_ms, st.models, st.objects, st.needs.needs.features, st.needs.needs.edges,
+               st.input_walls, st.segs, st.splits, st.leaves, st.nodes, st.vertices, st.max_depth, st.mean_depth,
+               st.build_ms, st.models, st.objects, st.needs.needs.features, st.needs.needs.edges,
                st.needs.needs.surfaces, st.needs.all_edges, st.needs.all_surfaces);
     return 0;
 }

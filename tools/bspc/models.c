@@ -22,12 +22,14 @@ uint8_t bs_shade(uint8_t c, int delta)
 }
 
 /* nearest integer, ties away from zero, as the text format rounds */
-static int64_t round_away(double v) { return (int64_t)(v < 0 ? -floor(-v + 0.5) : floor(v + 0.5)); }
+static int64_t round_away(double v)
+{
+    return (int64_t)(v < 0 ? -floor(-v + 0.5) : floor(v + 0.5));
+}
 
 int bs_model_begin(bs_scene *s, const char *name, int src_line, char *err, size_t errlen)
 {
-    if (bs_grow(&s->models, &s->mcap, s->nmodels + 1, sizeof *s->models))
-        return bs_fail(err, errlen, "out of memory");
+    if (bs_grow(&s->models, &s->mcap, s->nmodels + 1, sizeof *s->models)) return bs_fail(err, errlen, "out of memory");
     bs_model *m = &s->models[s->nmodels++];
     memset(m, 0, sizeof *m);
     m->first_vert = s->nmverts;
@@ -85,13 +87,12 @@ int bs_model_add_part(bs_scene *s, const bs_mpart *p, char *err, size_t errlen)
     bs_model *m = &s->models[s->nmodels - 1];
     const int n = p->sides;
     if (m->num_verts + 2u * (uint32_t)n > SCN_MAX_MODEL_VERTS)
-        return bs_fail(err, errlen, "model has %u vertices with this part, more than %d",
-                       m->num_verts + 2 * n, SCN_MAX_MODEL_VERTS);
+        return bs_fail(err, errlen, "model has %u vertices with this part, more than %d", m->num_verts + 2 * n,
+                       SCN_MAX_MODEL_VERTS);
     if (m->num_faces + (uint32_t)n + 2u > SCN_MAX_MODEL_FACES)
-        return bs_fail(err, errlen, "model has %u faces with this part, more than %d",
-                       m->num_faces + n + 2, SCN_MAX_MODEL_FACES);
-    if (m->nparts >= BS_MAX_PARTS)
-        return bs_fail(err, errlen, "more than %d parts in one model", BS_MAX_PARTS);
+        return bs_fail(err, errlen, "model has %u faces with this part, more than %d", m->num_faces + n + 2,
+                       SCN_MAX_MODEL_FACES);
+    if (m->nparts >= BS_MAX_PARTS) return bs_fail(err, errlen, "more than %d parts in one model", BS_MAX_PARTS);
 
     bs_mvert ring[2 * SCN_MAX_FACE_VERTS];
     int64_t zb = p->at[2], zt = (int64_t)p->at[2] + p->h;
@@ -113,12 +114,10 @@ int bs_model_add_part(bs_scene *s, const bs_mpart *p, char *err, size_t errlen)
             int64_t z = lift ? zt : zb;
             if (x > MODEL_RAW_MAX || x < -MODEL_RAW_MAX || y > MODEL_RAW_MAX || y < -MODEL_RAW_MAX ||
                 z > MODEL_RAW_MAX || z < -MODEL_RAW_MAX)
-                return bs_fail(err, errlen,
-                               "part: vertex (%s, %s, %s) outside the model's range (|coordinate| <= %d)",
+                return bs_fail(err, errlen, "part: vertex (%s, %s, %s) outside the model's range (|coordinate| <= %d)",
                                x > INT32_MAX || x < INT32_MIN ? "?" : bs_fxstr((int32_t)x, b1),
                                y > INT32_MAX || y < INT32_MIN ? "?" : bs_fxstr((int32_t)y, b2),
-                               z > INT32_MAX || z < INT32_MIN ? "?" : bs_fxstr((int32_t)z, b3),
-                               SCN_MODEL_MAX);
+                               z > INT32_MAX || z < INT32_MIN ? "?" : bs_fxstr((int32_t)z, b3), SCN_MODEL_MAX);
         }
         ring[k] = (bs_mvert){(int32_t)x, (int32_t)y, (int32_t)zb};
         ring[n + k] = (bs_mvert){(int32_t)x, (int32_t)y, (int32_t)zt};
@@ -127,10 +126,8 @@ int bs_model_add_part(bs_scene *s, const bs_mpart *p, char *err, size_t errlen)
      * faces without a direction */
     for (int k = 0; k < n; k++) {
         const bs_mvert *a = &ring[k], *b = &ring[(k + 1) % n], *c = &ring[(k + 2) % n];
-        int64_t cr = ((int64_t)b->x - a->x) * ((int64_t)c->y - b->y) -
-                     ((int64_t)b->y - a->y) * ((int64_t)c->x - b->x);
-        if (cr <= 0)
-            return bs_fail(err, errlen, "part: too small (its corners coincide after rounding to 16.16)");
+        int64_t cr = ((int64_t)b->x - a->x) * ((int64_t)c->y - b->y) - ((int64_t)b->y - a->y) * ((int64_t)c->x - b->x);
+        if (cr <= 0) return bs_fail(err, errlen, "part: too small (its corners coincide after rounding to 16.16)");
     }
     /* earlier parts of this model: their bottom rings are the first half of each part's vertices */
     for (uint32_t q = 0; q < m->nparts; q++) {
@@ -139,8 +136,10 @@ int bs_model_add_part(bs_scene *s, const bs_mpart *p, char *err, size_t errlen)
         int64_t ozb = o[0].z, ozt = o[no].z;
         if (ozt <= zb || zt <= ozb) continue;
         if (rings_overlap(ring, n, o, no))
-            return bs_fail(err, errlen, "part overlaps part %u of the model (the parts of a model may "
-                           "touch but not overlap)", q + 1);
+            return bs_fail(err, errlen,
+                           "part overlaps part %u of the model (the parts of a model may "
+                           "touch but not overlap)",
+                           q + 1);
     }
 
     uint32_t base = m->num_verts;

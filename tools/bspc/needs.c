@@ -42,14 +42,12 @@ static double unit(int32_t raw)
 
 /* Keep the part of in where side(p) <= SLACK, side = signed distance from the line
  * through (px, py) along (dx, dy), positive on its left (sign = +1) or right (-1). */
-static void clip_region(const region *in, region *out, double px, double py, double dx, double dy,
-                        int sign)
+static void clip_region(const region *in, region *out, double px, double py, double dx, double dy, int sign)
 {
     double len = sqrt(dx * dx + dy * dy);
     double d[REGION_MAX];
     out->n = 0;
-    for (int i = 0; i < in->n; i++)
-        d[i] = sign * (dx * (in->y[i] - py) - dy * (in->x[i] - px)) / len - SLACK;
+    for (int i = 0; i < in->n; i++) d[i] = sign * (dx * (in->y[i] - py) - dy * (in->x[i] - px)) / len - SLACK;
     for (int i = 0; i < in->n && out->n < REGION_MAX - 1; i++) {
         int j = (i + 1 == in->n) ? 0 : i + 1;
         if (d[i] <= 0) {
@@ -127,7 +125,7 @@ static int decide(const seg_line *l, const region *r)
     int behind = 0, front = 0;
     for (int i = 0; i < r->n; i++) {
         double f = l->nx * r->x[i] + l->ny * r->y[i] + l->c;
-        if (f >= -SLACK - DECIDE_EPS) front = 1; /* not wholly behind */
+        if (f >= -SLACK - DECIDE_EPS) front = 1;  /* not wholly behind */
         if (f <= -SLACK + DECIDE_EPS) behind = 1; /* not wholly in front */
         if (front && behind) return SEG_UNDECIDED;
     }

@@ -10,9 +10,9 @@
 
 typedef struct {
     scn_needs needs;
-    uint32_t all_edges, all_surfaces;   /* every polygon at once (the bound without analysis) */
-    uint32_t wall_edges, wall_surfaces; /* walls: the most for any eye position */
-    uint32_t worst_leaf;                /* the leaf whose region gives wall_edges */
+    uint32_t all_edges, all_surfaces;     /* every polygon at once (the bound without analysis) */
+    uint32_t wall_edges, wall_surfaces;   /* walls: the most for any eye position */
+    uint32_t worst_leaf;                  /* the leaf whose region gives wall_edges */
     uint32_t plane_edges, plane_surfaces; /* floors and ceilings: the most for any eye height */
 } needs_report;
 

@@ -25,8 +25,8 @@ void needs_print(FILE *f, const char *name, const scene *s, const needs_report *
     fprintf(f, "%s: what the scene needs (docs/needs.md)\n", name);
     for (unsigned i = 0; i < NFEATURES; i++) {
         int on = (n->features & (1u << i)) != 0;
-        fprintf(f, "  %-16s %-4s %s\n", scene_item_name(i), on ? "yes" : "no", on ? feature_text[i].yes
-                                                                              : feature_text[i].no);
+        fprintf(f, "  %-16s %-4s %s\n", scene_item_name(i), on ? "yes" : "no",
+                on ? feature_text[i].yes : feature_text[i].no);
     }
     fprintf(f, "  per frame, for any camera and door state (every polygon at once: %u edges, %u surfaces):\n",
             r->all_edges, r->all_surfaces);
@@ -37,8 +37,8 @@ void needs_print(FILE *f, const char *name, const scene *s, const needs_report *
     fprintf(f, "    surfaces  %8u = walls %u + floors and ceilings %u\n", n->surfaces, r->wall_surfaces,
             r->plane_surfaces);
     fprintf(f, "    tree depth %7u (walk stacks of %u)\n", s->hdr->max_depth, s->hdr->max_depth + 2);
-    fprintf(f, "    leaf polygon vertices %u, model vertices %u, face vertices %u\n", n->leaf_verts,
-            n->model_verts, n->face_verts);
+    fprintf(f, "    leaf polygon vertices %u, model vertices %u, face vertices %u\n", n->leaf_verts, n->model_verts,
+            n->face_verts);
     fprintf(f, "    own objects: %u, %u faces, %u edges at most\n", s->nobjects, n->object_faces, n->object_edges);
 }
 
@@ -49,8 +49,10 @@ static uint32_t at_least(uint32_t v, uint32_t lo)
 
 void needs_write_config(FILE *f, const char *name, const scene *s, const scn_needs *n)
 {
-    fprintf(f, "/* A build for one scene (firmware/build_config.h), written by bspc --config\n"
-               " * from the needs of %s (docs/needs.md). */\n", name);
+    fprintf(f,
+            "/* A build for one scene (firmware/build_config.h), written by bspc --config\n"
+            " * from the needs of %s (docs/needs.md). */\n",
+            name);
     fprintf(f, "#define CFG_FEATURES 0x%02xu /*", n->features);
     for (unsigned i = 0; i < NFEATURES; i++)
         if (n->features & (1u << i)) fprintf(f, " %s;", scene_item_name(i));

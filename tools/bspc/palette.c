@@ -17,12 +17,10 @@ static const struct {
     const char *name;
     unsigned char r, g, b;
 } ramps[BS_RAMP_COUNT] = {
-    {"grey", 210, 210, 210},  {"red", 224, 48, 40},     {"orange", 238, 132, 30},
-    {"yellow", 232, 212, 48}, {"lime", 150, 214, 40},   {"green", 44, 180, 72},
-    {"teal", 36, 168, 150},   {"cyan", 60, 196, 232},   {"blue", 64, 96, 236},
-    {"violet", 136, 80, 224}, {"magenta", 208, 60, 184}, {"brown", 156, 104, 60},
-    {"sand", 196, 174, 120},  {"moss", 112, 136, 80},   {"slate", 104, 124, 156},
-    {"plum", 146, 100, 134},
+    {"grey", 210, 210, 210}, {"red", 224, 48, 40},     {"orange", 238, 132, 30},  {"yellow", 232, 212, 48},
+    {"lime", 150, 214, 40},  {"green", 44, 180, 72},   {"teal", 36, 168, 150},    {"cyan", 60, 196, 232},
+    {"blue", 64, 96, 236},   {"violet", 136, 80, 224}, {"magenta", 208, 60, 184}, {"brown", 156, 104, 60},
+    {"sand", 196, 174, 120}, {"moss", 112, 136, 80},   {"slate", 104, 124, 156},  {"plum", 146, 100, 134},
 };
 
 void bs_palette(uint8_t pal[768])
@@ -113,6 +111,12 @@ uint8_t bs_flat_color(const char flat[8], int light, int ceiling)
     return pick(ramp, light_shade(light) - (ceiling ? 3 : 1));
 }
 
-uint8_t bs_sky_color(void) { return pick(BS_RAMP_CYAN, 13); }
+uint8_t bs_sky_color(void)
+{
+    return pick(BS_RAMP_CYAN, 13);
+}
 
-uint8_t bs_neutral_color(int light) { return pick(BS_RAMP_GREY, light_shade(light) - 1); }
+uint8_t bs_neutral_color(int light)
+{
+    return pick(BS_RAMP_GREY, light_shade(light) - 1);
+}

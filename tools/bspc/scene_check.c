@@ -23,29 +23,23 @@ int bs_check_ranges(const bs_scene *s, char *err, size_t errlen)
         uint32_t vv[2] = {l->v1, l->v2};
         for (int k = 0; k < 2; k++) {
             int32_t x = s->vx[vv[k]], y = s->vy[vv[k]];
-            if (x > BS_COORD_RAW_MAX || x < -BS_COORD_RAW_MAX || y > BS_COORD_RAW_MAX ||
-                y < -BS_COORD_RAW_MAX)
-                return bs_fail(err, errlen,
-                               "%s: linedef %d: vertex %u (%s, %s) out of range (|coordinate| <= %d)",
-                               s->name, l->src_line, vv[k], bs_fxstr(x, b1), bs_fxstr(y, b2),
-                               SCN_COORD_MAX);
+            if (x > BS_COORD_RAW_MAX || x < -BS_COORD_RAW_MAX || y > BS_COORD_RAW_MAX || y < -BS_COORD_RAW_MAX)
+                return bs_fail(err, errlen, "%s: linedef %d: vertex %u (%s, %s) out of range (|coordinate| <= %d)",
+                               s->name, l->src_line, vv[k], bs_fxstr(x, b1), bs_fxstr(y, b2), SCN_COORD_MAX);
         }
     }
     for (uint32_t i = 0; i < s->nsectors; i++) {
         const bs_sector *c = &s->sectors[i];
-        if (c->floor_h > BS_HEIGHT_RAW_MAX || c->floor_h < -BS_HEIGHT_RAW_MAX ||
-            c->ceil_h > BS_HEIGHT_RAW_MAX || c->ceil_h < -BS_HEIGHT_RAW_MAX)
-            return bs_fail(err, errlen,
-                           "%s: sector %u: floor %s / ceiling %s out of range (|height| <= %d)",
-                           s->name, i, bs_fxstr(c->floor_h, b1), bs_fxstr(c->ceil_h, b2),
-                           SCN_HEIGHT_MAX);
+        if (c->floor_h > BS_HEIGHT_RAW_MAX || c->floor_h < -BS_HEIGHT_RAW_MAX || c->ceil_h > BS_HEIGHT_RAW_MAX ||
+            c->ceil_h < -BS_HEIGHT_RAW_MAX)
+            return bs_fail(err, errlen, "%s: sector %u: floor %s / ceiling %s out of range (|height| <= %d)", s->name,
+                           i, bs_fxstr(c->floor_h, b1), bs_fxstr(c->ceil_h, b2), SCN_HEIGHT_MAX);
     }
     for (uint32_t i = 0; i < s->nsectors; i++) {
         const bs_sector *c = &s->sectors[i];
-        if ((c->flags & SCN_SECTOR_DOOR) &&
-            (c->open_h < c->ceil_h || c->open_h > BS_HEIGHT_RAW_MAX))
-            return bs_fail(err, errlen, "%s: sector %u: door opens to %s, below its ceiling %s or above %d",
-                           s->name, i, bs_fxstr(c->open_h, b1), bs_fxstr(c->ceil_h, b2), SCN_HEIGHT_MAX);
+        if ((c->flags & SCN_SECTOR_DOOR) && (c->open_h < c->ceil_h || c->open_h > BS_HEIGHT_RAW_MAX))
+            return bs_fail(err, errlen, "%s: sector %u: door opens to %s, below its ceiling %s or above %d", s->name, i,
+                           bs_fxstr(c->open_h, b1), bs_fxstr(c->ceil_h, b2), SCN_HEIGHT_MAX);
     }
     for (uint32_t i = 0; i < s->nobjects; i++) {
         const bs_object *o = &s->objects[i];
@@ -54,16 +48,15 @@ int bs_check_ranges(const bs_scene *s, char *err, size_t errlen)
             return bs_fail(err, errlen, "%s: object %u at (%s, %s) outside the world box", s->name, i,
                            bs_fxstr(o->x, b1), bs_fxstr(o->y, b2));
     }
-    if (s->has_player &&
-        (s->player_x > BS_COORD_RAW_MAX || s->player_x < -BS_COORD_RAW_MAX ||
-         s->player_y > BS_COORD_RAW_MAX || s->player_y < -BS_COORD_RAW_MAX))
-        return bs_fail(err, errlen, "%s: player start (%s, %s) out of range (|coordinate| <= %d)",
-                       s->name, bs_fxstr(s->player_x, b1), bs_fxstr(s->player_y, b2), SCN_COORD_MAX);
+    if (s->has_player && (s->player_x > BS_COORD_RAW_MAX || s->player_x < -BS_COORD_RAW_MAX ||
+                          s->player_y > BS_COORD_RAW_MAX || s->player_y < -BS_COORD_RAW_MAX))
+        return bs_fail(err, errlen, "%s: player start (%s, %s) out of range (|coordinate| <= %d)", s->name,
+                       bs_fxstr(s->player_x, b1), bs_fxstr(s->player_y, b2), SCN_COORD_MAX);
     return 0;
 }
 
 typedef struct {
-    uint64_t key; /* sector << 32 | vertex */
+    uint64_t key;  /* sector << 32 | vertex */
     int32_t delta; /* +1 a wall leaves the vertex, -1 one arrives */
     uint32_t line;
 } endpoint;
@@ -113,8 +106,8 @@ int bs_check_closed(const bs_scene *s, char *err, size_t errlen)
                          "%s:%d: %s is not closed: at (%s, %s) %d of its walls arrive and %d leave "
                          "(the walls bounding a sector must form closed loops, each with the sector "
                          "on its front (right) side or as its back sector)",
-                         s->name, s->lines[e[i].line].src_line, lab, bs_fxstr(s->vx[v], b1),
-                         bs_fxstr(s->vy[v], b2), in, out);
+                         s->name, s->lines[e[i].line].src_line, lab, bs_fxstr(s->vx[v], b1), bs_fxstr(s->vy[v], b2), in,
+                         out);
         }
         i = j;
     }
@@ -146,8 +139,7 @@ int bs_check_closed(const bs_scene *s, char *err, size_t errlen)
         char lab[64];
         sector_label(s, i, lab, sizeof lab);
         if (area[i] == 0)
-            rc = bs_fail(err, errlen, "%s:%d: %s encloses no area", s->name,
-                         s->lines[first[i]].src_line, lab);
+            rc = bs_fail(err, errlen, "%s:%d: %s encloses no area", s->name, s->lines[first[i]].src_line, lab);
         else
             rc = bs_fail(err, errlen,
                          "%s:%d: the walls of %s face away from it (the front side is on the right "

@@ -57,8 +57,8 @@ static int read_whole(const char *path, uint8_t **data, size_t *len, char *err, 
 
 int scene_file_is_compiled(const uint8_t *data, size_t n)
 {
-    return n >= 4 && ((uint32_t)data[0] | (uint32_t)data[1] << 8 | (uint32_t)data[2] << 16 |
-                      (uint32_t)data[3] << 24) == SCN_MAGIC;
+    return n >= 4 && ((uint32_t)data[0] | (uint32_t)data[1] << 8 | (uint32_t)data[2] << 16 | (uint32_t)data[3] << 24) ==
+                         SCN_MAGIC;
 }
 
 int scene_file_probe(const char *path)
@@ -86,8 +86,10 @@ int scene_file_load(const char *spec, const bspc_options *opt, uint8_t **blob, s
              * to report. */
             const scn_header *h = (const scn_header *)(const void *)data;
             if (n >= sizeof(scn_header) && h->version == SCN_VERSION && h->total_bytes < n) {
-                snprintf(err, errlen, "%s: compiled scene rejected: header: total_bytes = %u, but the file "
-                         "has %zu bytes (bytes appended, or the header is damaged)", spec, h->total_bytes, n);
+                snprintf(err, errlen,
+                         "%s: compiled scene rejected: header: total_bytes = %u, but the file "
+                         "has %zu bytes (bytes appended, or the header is damaged)",
+                         spec, h->total_bytes, n);
                 free(data);
                 return -1;
             }
@@ -124,9 +126,7 @@ static void describe_header(const scn_header *h, size_t len, const scene_error *
             snprintf(out, n, "header: total_bytes = %u, less than the header's %zu", h->total_bytes,
                      sizeof(scn_header));
         break;
-    case SCENE_FIELD_FLAGS:
-        snprintf(out, n, "header: flags = 0x%x, expected 0 (reserved)", h->flags);
-        break;
+    case SCENE_FIELD_FLAGS: snprintf(out, n, "header: flags = 0x%x, expected 0 (reserved)", h->flags); break;
     case SCENE_FIELD_CRC:
         snprintf(out, n, "bad CRC-32: header crc32 = 0x%08x, but bytes [16, %u) give 0x%08x (the file is damaged)",
                  h->crc32, h->total_bytes, crc_update(0, (const uint8_t *)h + 16, h->total_bytes - 16));
@@ -140,7 +140,8 @@ static void describe_header(const scn_header *h, size_t len, const scene_error *
         break;
     case SCENE_FIELD_ROOT:
         if (se->status == SCENE_ERR_TREE)
-            snprintf(out, n, "header: root is a leaf, but there are %u nodes (not a tree)", h->sec[SCN_SEC_NODES].count);
+            snprintf(out, n, "header: root is a leaf, but there are %u nodes (not a tree)",
+                     h->sec[SCN_SEC_NODES].count);
         else if (h->root & SCN_LEAF_BIT)
             snprintf(out, n, "header: root = leaf %u out of range (%u leaves)", h->root & ~SCN_LEAF_BIT,
                      h->sec[SCN_SEC_LEAVES].count);
@@ -153,8 +154,7 @@ static void describe_header(const scn_header *h, size_t len, const scene_error *
         else
             snprintf(out, n, "header: max_depth = %u, but the tree is deeper", h->max_depth);
         break;
-    default:
-        snprintf(out, n, "%s", scene_status_text(se->status));
+    default: snprintf(out, n, "%s", scene_status_text(se->status));
     }
 }
 
@@ -186,8 +186,8 @@ static void describe_section(const scn_header *h, int i, char *out, size_t n)
         snprintf(out, n, "%s section: %u records, expected 1 per sector (%u sectors)", name, count,
                  h->sec[SCN_SEC_SECTORS].count);
     else
-        snprintf(out, n, "%s section: %u records from offset %u run past the end of the scene (total_bytes %u)",
-                 name, count, off, h->total_bytes);
+        snprintf(out, n, "%s section: %u records from offset %u run past the end of the scene (total_bytes %u)", name,
+                 count, off, h->total_bytes);
 }
 
 void scene_file_describe_error(const char *spec, const uint8_t *blob, size_t len, const scene_error *se, char *err,
@@ -198,11 +198,15 @@ void scene_file_describe_error(const char *spec, const uint8_t *blob, size_t len
     const scn_header *h = blob && len >= sizeof(scn_header) ? (const scn_header *)(const void *)blob : NULL;
     char what[300];
     if (se->status == SCENE_ERR_BUILD && se->index < SCENE_ITEM_EDGES)
-        snprintf(err, errlen, "%s: the scene needs %s, which this build leaves out (it was built for another "
-                 "scene; see docs/needs.md)", spec, scene_item_name(se->index));
+        snprintf(err, errlen,
+                 "%s: the scene needs %s, which this build leaves out (it was built for another "
+                 "scene; see docs/needs.md)",
+                 spec, scene_item_name(se->index));
     else if (se->status == SCENE_ERR_BUILD)
-        snprintf(err, errlen, "%s: the scene needs %s %u; this build provides %u (it was built for another "
-                 "scene; see docs/needs.md)", spec, scene_item_name(se->index), se->need, se->have);
+        snprintf(err, errlen,
+                 "%s: the scene needs %s %u; this build provides %u (it was built for another "
+                 "scene; see docs/needs.md)",
+                 spec, scene_item_name(se->index), se->need, se->have);
     else if (se->status == SCENE_ERR_SHORT && !h)
         snprintf(err, errlen, "%s: compiled scene rejected: truncated: %zu bytes, shorter than the %zu-byte header",
                  spec, len, sizeof(scn_header));

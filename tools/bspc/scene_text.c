@@ -34,10 +34,10 @@ typedef struct {
     bs_scene *s;
     uint32_t *vhash; /* vertex index + 1 */
     uint32_t hcap;
-    uint32_t *shash; /* sector index + 1 by name: the first sector of each name */
+    uint32_t *shash;        /* sector index + 1 by name: the first sector of each name */
     uint32_t scap, shashed; /* its size (a power of two); sectors entered so far */
-    int in_model;    /* between 'model' and 'end' */
-    const char *stmt; /* the statement being read, for messages of helpers shared by several */
+    int in_model;           /* between 'model' and 'end' */
+    const char *stmt;       /* the statement being read, for messages of helpers shared by several */
 } parser;
 
 static int perr(parser *p, const char *fmt, ...)
@@ -77,8 +77,10 @@ static int parse_color(parser *p, const char *key, const char *val, uint8_t *out
     }
     int c = bs_color_by_name(val);
     if (c < 0)
-        return perr(p, "%s: %s=%s: unknown colour (a palette index 0..255, or a ramp name such as "
-                       "red or red:12, shade 0..15)", p->stmt, key, val);
+        return perr(p,
+                    "%s: %s=%s: unknown colour (a palette index 0..255, or a ramp name such as "
+                    "red or red:12, shade 0..15)",
+                    p->stmt, key, val);
     *out = (uint8_t)c;
     return 0;
 }
@@ -142,13 +144,11 @@ static int find_sector(parser *p, const char *t, uint32_t *out)
             *out = (uint32_t)v;
             return 0;
         }
-        return perr(p, "wall: unknown sector %s (%u sector(s) declared above this line)", t,
-                    s->nsectors);
+        return perr(p, "wall: unknown sector %s (%u sector(s) declared above this line)", t, s->nsectors);
     }
     if (sector_index(p)) return perr(p, "out of memory");
     if (named_sector(p, t, out)) return 0;
-    return perr(p, "wall: unknown sector '%s' (sectors must be declared before the walls that use them)",
-                t);
+    return perr(p, "wall: unknown sector '%s' (sectors must be declared before the walls that use them)", t);
 }
 
 static uint32_t hash_xy(int32_t x, int32_t y)
@@ -223,13 +223,14 @@ static int do_sector(parser *p, char **tok, int n)
     int i = 1, have_floor = 0, have_ceil = 0, seen_fc = 0, seen_cc = 0, seen_light = 0, have_door = 0;
     if (i < n && !strchr(tok[i], '=') && strcmp(tok[i], "sky") != 0) {
         if (!valid_name(tok[i]))
-            return perr(p, "sector: bad name '%s' (a letter or '_' first, then letters, digits, "
-                           "'_', '-', '.'; up to 31 characters)", tok[i]);
+            return perr(p,
+                        "sector: bad name '%s' (a letter or '_' first, then letters, digits, "
+                        "'_', '-', '.'; up to 31 characters)",
+                        tok[i]);
         uint32_t k;
         if (sector_index(p)) return perr(p, "out of memory");
         if (named_sector(p, tok[i], &k))
-            return perr(p, "sector: name '%s' already used by sector %u (line %d)", tok[i], k,
-                        s->sectors[k].src_line);
+            return perr(p, "sector: name '%s' already used by sector %u (line %d)", tok[i], k, s->sectors[k].src_line);
         strcpy(sec.name, tok[i]);
         i++;
     }
@@ -265,8 +266,10 @@ static int do_sector(parser *p, char **tok, int n)
             if (height(p, "door", val, &sec.open_h)) return -1;
             sec.flags |= SCN_SECTOR_DOOR;
         } else {
-            return perr(p, "sector: unknown key '%s' (floor, ceil, floor_color, ceil_color, light, sky, "
-                           "door)", t);
+            return perr(p,
+                        "sector: unknown key '%s' (floor, ceil, floor_color, ceil_color, light, sky, "
+                        "door)",
+                        t);
         }
     }
     if (!have_floor) return perr(p, "sector: missing floor=HEIGHT");
@@ -287,14 +290,13 @@ static int do_sector(parser *p, char **tok, int n)
 static int do_wall(parser *p, char **tok, int n)
 {
     bs_scene *s = p->s;
-    if (n < 6)
-        return perr(p, "wall: expected 'wall X1 Y1 X2 Y2 FRONT [BACK] [mid=C] [upper=C] [lower=C]'");
+    if (n < 6) return perr(p, "wall: expected 'wall X1 Y1 X2 Y2 FRONT [BACK] [mid=C] [upper=C] [lower=C]'");
     bs_line ln;
     memset(&ln, 0, sizeof ln);
     ln.src_line = p->line;
     int32_t x1, y1, x2, y2;
-    if (coord(p, "wall: x1", tok[1], &x1) || coord(p, "wall: y1", tok[2], &y1) ||
-        coord(p, "wall: x2", tok[3], &x2) || coord(p, "wall: y2", tok[4], &y2))
+    if (coord(p, "wall: x1", tok[1], &x1) || coord(p, "wall: y1", tok[2], &y1) || coord(p, "wall: x2", tok[3], &x2) ||
+        coord(p, "wall: y2", tok[4], &y2))
         return -1;
     if (x1 == x2 && y1 == y2) return perr(p, "wall: zero length (start and end are the same point)");
     if (find_sector(p, tok[5], &ln.sector[0])) return -1;
@@ -315,8 +317,10 @@ static int do_wall(parser *p, char **tok, int n)
         for (k = 0; k < 6; k++)
             if (strcmp(tok[i], keys[k]) == 0) break;
         if (k == 6)
-            return perr(p, "wall: unknown key '%s' (mid, upper, lower, back_mid, back_upper, "
-                           "back_lower)", tok[i]);
+            return perr(p,
+                        "wall: unknown key '%s' (mid, upper, lower, back_mid, back_upper, "
+                        "back_lower)",
+                        tok[i]);
         if (have[k]++) return perr(p, "wall: %s given twice", keys[k]);
         if (parse_color(p, keys[k], eq + 1, &col[k])) return -1;
         if (k >= 3 && ln.sector[1] == SCN_NONE)
@@ -339,11 +343,9 @@ static int do_player(parser *p, char **tok, int n)
 {
     bs_scene *s = p->s;
     if (n != 4) return perr(p, "player: expected 'player X Y ANGLE' (angle in degrees, 0 = east)");
-    if (s->has_player)
-        return perr(p, "player: a second player start (the first is on line %d)", s->player_line);
+    if (s->has_player) return perr(p, "player: a second player start (the first is on line %d)", s->player_line);
     int64_t a;
-    if (coord(p, "player: x", tok[1], &s->player_x) || coord(p, "player: y", tok[2], &s->player_y))
-        return -1;
+    if (coord(p, "player: x", tok[1], &s->player_x) || coord(p, "player: y", tok[2], &s->player_y)) return -1;
     if (fxtext_parse64(tok[3], &a)) return perr(p, "player: angle '%s' is not a number", tok[3]);
     const int64_t turn = (int64_t)360 << 16;
     a %= turn;
@@ -356,19 +358,23 @@ static int do_player(parser *p, char **tok, int n)
 
 /* ---- models and objects (docs/objects.md) ---- */
 
-static const bs_model *cur_model(parser *p) { return &p->s->models[p->s->nmodels - 1]; }
+static const bs_model *cur_model(parser *p)
+{
+    return &p->s->models[p->s->nmodels - 1];
+}
 
 static int do_model(parser *p, char **tok, int n)
 {
     bs_scene *s = p->s;
     if (n != 2) return perr(p, "model: expected 'model NAME'");
     if (!valid_name(tok[1]))
-        return perr(p, "model: bad name '%s' (a letter or '_' first, then letters, digits, '_', '-', "
-                       "'.'; up to 31 characters)", tok[1]);
+        return perr(p,
+                    "model: bad name '%s' (a letter or '_' first, then letters, digits, '_', '-', "
+                    "'.'; up to 31 characters)",
+                    tok[1]);
     for (uint32_t k = 0; k < s->nmodels; k++)
         if (strcmp(s->models[k].name, tok[1]) == 0)
-            return perr(p, "model: name '%s' already used by model %u (line %d)", tok[1], k,
-                        s->models[k].src_line);
+            return perr(p, "model: name '%s' already used by model %u (line %d)", tok[1], k, s->models[k].src_line);
     char msg[300];
     if (bs_model_begin(s, tok[1], p->line, msg, sizeof msg)) return perr(p, "model: %s", msg);
     p->in_model = 1;
@@ -413,10 +419,18 @@ static int do_part(parser *p, char **tok, int n)
         if (have[k]++) return perr(p, "part: %s given twice", keys[k]);
         long lv;
         switch (k) {
-        case K_W: if (model_size(p, "w", val, &pt.w)) return -1; break;
-        case K_D: if (model_size(p, "d", val, &pt.d)) return -1; break;
-        case K_H: if (model_size(p, "h", val, &pt.h)) return -1; break;
-        case K_R: if (model_size(p, "r", val, &pt.r)) return -1; break;
+        case K_W:
+            if (model_size(p, "w", val, &pt.w)) return -1;
+            break;
+        case K_D:
+            if (model_size(p, "d", val, &pt.d)) return -1;
+            break;
+        case K_H:
+            if (model_size(p, "h", val, &pt.h)) return -1;
+            break;
+        case K_R:
+            if (model_size(p, "r", val, &pt.r)) return -1;
+            break;
         case K_SIDES:
             if (parse_int(val, 3, SCN_MAX_FACE_VERTS, &lv))
                 return perr(p, "part: sides=%s: expected a whole number 3..%d", val, SCN_MAX_FACE_VERTS);
@@ -430,8 +444,7 @@ static int do_part(parser *p, char **tok, int n)
                 c[j] = c[j - 1] ? strchr(c[j - 1], ',') : NULL;
                 if (c[j]) *c[j]++ = 0;
             }
-            if (!c[1] || !c[2] || strchr(c[2], ','))
-                return perr(p, "part: at=%s: expected at=X,Y,Z", val);
+            if (!c[1] || !c[2] || strchr(c[2], ',')) return perr(p, "part: at=%s: expected at=X,Y,Z", val);
             for (int j = 0; j < 3; j++) {
                 int64_t v;
                 if (fxtext_parse64(c[j], &v)) return perr(p, "part: at=%s: '%s' is not a number", val, c[j]);
@@ -478,8 +491,7 @@ static int find_model(parser *p, const char *t, uint32_t *out)
             *out = i;
             return 0;
         }
-    return perr(p, "object: unknown model '%s' (models must be declared before the objects that use them)",
-                t);
+    return perr(p, "object: unknown model '%s' (models must be declared before the objects that use them)", t);
 }
 
 /* "A:B[:C...]" -> its fields, in place; returns the count */
@@ -598,8 +610,10 @@ static int do_object(parser *p, char **tok, int n)
     } else if (o.path == SCN_PATH_LINE) {
         int64_t d[2] = {o.pa, o.pb};
         for (int k = 0; k < 2; k++) {
-            if (d[k] < 0) lo[k] += d[k];
-            else hi[k] += d[k];
+            if (d[k] < 0)
+                lo[k] += d[k];
+            else
+                hi[k] += d[k];
         }
     }
     for (int k = 0; k < 2; k++)
@@ -695,10 +709,14 @@ int bs_read_text(const char *path, bs_scene *s, const bspc_options *opt, char *e
         int compiled = scene_file_is_compiled((const uint8_t *)buf, len);
         free(buf);
         if (compiled)
-            return bs_fail(err, errlen, "%s: a compiled scene, not a source to compile (bspc --config reads "
-                           "one; build/render draws it)", path);
-        return bs_fail(err, errlen, "%s: not a scene: not text (contains NUL bytes), and its magic is not "
-                       "\"BSCN\" (a compiled scene's)", path);
+            return bs_fail(err, errlen,
+                           "%s: a compiled scene, not a source to compile (bspc --config reads "
+                           "one; build/render draws it)",
+                           path);
+        return bs_fail(err, errlen,
+                       "%s: not a scene: not text (contains NUL bytes), and its magic is not "
+                       "\"BSCN\" (a compiled scene's)",
+                       path);
     }
 
     snprintf(s->name, sizeof s->name, "%s", path);
@@ -766,8 +784,7 @@ int bs_read_text(const char *path, bs_scene *s, const bspc_options *opt, char *e
         else if (strcmp(tok[0], "part") == 0 || strcmp(tok[0], "end") == 0)
             rc = perr(&p, "%s: outside a model (start one with 'model NAME')", tok[0]);
         else
-            rc = perr(&p, "unknown statement '%s' (expected sector, wall, player, model, object or look)",
-                      tok[0]);
+            rc = perr(&p, "unknown statement '%s' (expected sector, wall, player, model, object or look)", tok[0]);
         line = next;
     }
     free(buf);

@@ -34,37 +34,37 @@
 
 /* Tuning, measured on the 68 Freedoom maps (tools/bench_bsp.py). */
 #ifndef SPLIT_COST
-#define SPLIT_COST 48   /* mixed: the cost of one split */
+#define SPLIT_COST 48 /* mixed: the cost of one split */
 #endif
 #ifndef BAL_Q
-#define BAL_Q 16        /* mixed: imbalance |f - b| costs |f - b| * Q / (min(f, b) + Q) */
+#define BAL_Q 16 /* mixed: imbalance |f - b| costs |f - b| * Q / (min(f, b) + Q) */
 #endif
 #ifndef DIAG_COST
-#define DIAG_COST 4     /* mixed: extra cost of a diagonal partition */
+#define DIAG_COST 4 /* mixed: extra cost of a diagonal partition */
 #endif
 #ifndef DIAG_ALL
-#define DIAG_ALL 32     /* sets with at most this many diagonal lines score them all */
+#define DIAG_ALL 32 /* sets with at most this many diagonal lines score them all */
 #endif
 #ifndef DIAG_SAMPLE
-#define DIAG_SAMPLE 24  /* otherwise this many, spread evenly */
+#define DIAG_SAMPLE 24 /* otherwise this many, spread evenly */
 #endif
 #ifndef DEPTH_BUDGET
 #define DEPTH_BUDGET 52 /* mixed: a set that might reach deeper than this balances first */
 #endif
 #ifndef PEEL
-#define PEEL 8          /* ... and uses a line on no seg if the best keeps < 1/PEEL on a side */
+#define PEEL 8 /* ... and uses a line on no seg if the best keeps < 1/PEEL on a side */
 #endif
 #ifndef LOOK
-#define LOOK 3          /* mixed: look-ahead over this many best candidates */
+#define LOOK 3 /* mixed: look-ahead over this many best candidates */
 #endif
 #ifndef LOOK_MIN
-#define LOOK_MIN 32     /* on sets of at least this many segs */
+#define LOOK_MIN 32 /* on sets of at least this many segs */
 #endif
 #ifndef LOOK_MAX_DEPTH
 #define LOOK_MAX_DEPTH 40 /* and above this depth */
 #endif
 #ifndef SMALL
-#define SMALL 24        /* sets this small are scored by plain loops, without the index */
+#define SMALL 24 /* sets this small are scored by plain loops, without the index */
 #endif
 #define MAX_RANK 8
 
@@ -104,20 +104,20 @@ typedef struct {
 struct bs_chooser {
     const bs_tree *t;
     int strategy;
-    int mode;         /* the strategy, or MODE_RESCUE, for the set being scored */
-    uint32_t *stamp;  /* per line: the set that last listed it */
+    int mode;        /* the strategy, or MODE_RESCUE, for the set being scored */
+    uint32_t *stamp; /* per line: the set that last listed it */
     uint32_t stampno;
     cand *cands;
     uint32_t ccap;
-    int32_t *xy;      /* the set's seg ends, x1 y1 x2 y2 */
+    int32_t *xy; /* the set's seg ends, x1 y1 x2 y2 */
     uint32_t xycap;
-    uint64_t *tmp;    /* radix sort scratch */
+    uint64_t *tmp; /* radix sort scratch */
     uint32_t tmpcap;
-    index_set idx;    /* of the set being chosen for */
-    index_set cidx;   /* of a look-ahead child */
+    index_set idx;  /* of the set being chosen for */
+    index_set cidx; /* of a look-ahead child */
     uint32_t *child[2];
     uint32_t childcap;
-    uint8_t *mark;    /* per seg: look-ahead destination, bit 0 front, bit 1 back */
+    uint8_t *mark; /* per seg: look-ahead destination, bit 0 front, bit 1 back */
     uint32_t markcap;
 };
 
@@ -172,8 +172,14 @@ int bs_same_dir(const bs_tree *t, const bs_seg *g, bs_part p)
 /* ------------------------------------------------------------ sorting */
 
 /* the sort key of a coordinate: order-preserving, unsigned */
-static uint64_t key_of(int32_t v) { return (uint64_t)((uint32_t)v ^ 0x80000000u) << 32; }
-static int32_t val_of(uint64_t k) { return (int32_t)((uint32_t)(k >> 32) ^ 0x80000000u); }
+static uint64_t key_of(int32_t v)
+{
+    return (uint64_t)((uint32_t)v ^ 0x80000000u) << 32;
+}
+static int32_t val_of(uint64_t k)
+{
+    return (int32_t)((uint32_t)(k >> 32) ^ 0x80000000u);
+}
 
 /* sort by the upper 32 bits: insertion sort when short, else LSD radix (digits
  * that are the same for every entry, such as the fraction of whole-unit maps,
@@ -239,12 +245,9 @@ static int64_t cost_of(int mode, uint32_t f, uint32_t b, uint32_t sp, int diag)
 {
     int64_t imb = (f > b) ? (int64_t)(f - b) : (int64_t)(b - f);
     switch (mode) {
-    case BSPC_SPLIT_FEWEST:
-        return ((int64_t)sp << 32) + imb;
-    case BSPC_SPLIT_BALANCED:
-        return (imb << 32) + sp;
-    case MODE_RESCUE:
-        return (int64_t)sp + 4 * imb;
+    case BSPC_SPLIT_FEWEST: return ((int64_t)sp << 32) + imb;
+    case BSPC_SPLIT_BALANCED: return (imb << 32) + sp;
+    case MODE_RESCUE: return (int64_t)sp + 4 * imb;
     default: {
         /* imbalance matters most when one side is nearly empty (a peel-off) */
         int64_t m = f < b ? f : b;
@@ -257,14 +260,10 @@ static int64_t cost_of(int mode, uint32_t f, uint32_t b, uint32_t sp, int diag)
 static int64_t cost_floor(int mode, uint32_t sp)
 {
     switch (mode) {
-    case BSPC_SPLIT_FEWEST:
-        return (int64_t)sp << 32;
-    case BSPC_SPLIT_BALANCED:
-        return 0;
-    case MODE_RESCUE:
-        return (int64_t)sp;
-    default:
-        return (int64_t)sp * SPLIT_COST;
+    case BSPC_SPLIT_FEWEST: return (int64_t)sp << 32;
+    case BSPC_SPLIT_BALANCED: return 0;
+    case MODE_RESCUE: return (int64_t)sp;
+    default: return (int64_t)sp * SPLIT_COST;
     }
 }
 
@@ -299,8 +298,8 @@ static score finish(int mode, score r, const cand *c)
 
 /* exact scoring by a loop over the set (xy: its seg ends, 4 per seg, copied
  * together for speed); gives up (invalid) once worse than best */
-static score eval_loop(const bs_chooser *C, const cand *c, const uint32_t *segs,
-                       const int32_t *xy, uint32_t n, int64_t best)
+static score eval_loop(const bs_chooser *C, const cand *c, const uint32_t *segs, const int32_t *xy, uint32_t n,
+                       int64_t best)
 {
     const bs_tree *t = C->t;
     const bs_pline *L = &t->plines[c->pl];
@@ -400,9 +399,8 @@ static int index_filter(bs_chooser *C, index_set *dst, const index_set *src, uin
 }
 
 /* counts for an axis-aligned line at c from the prefix counts (see eval_axis) */
-static score axis_score(int mode, const cand *c, uint32_t nn, uint32_t lo_lt, uint32_t hi_le,
-                        uint32_t al_lt, uint32_t al_le, uint32_t pos_lt, uint32_t pos_le,
-                        uint32_t nal, uint32_t npos)
+static score axis_score(int mode, const cand *c, uint32_t nn, uint32_t lo_lt, uint32_t hi_le, uint32_t al_lt,
+                        uint32_t al_le, uint32_t pos_lt, uint32_t pos_le, uint32_t nal, uint32_t npos)
 {
     uint32_t high = nn - lo_lt; /* crossing segs wholly on the high side (or touching) */
     uint32_t low = hi_le;       /* wholly on the low side */
@@ -432,8 +430,8 @@ static score eval_axis(const bs_chooser *C, const index_set *x, const cand *c)
         if (i < al_lt) pos_lt += p;
         if (i < al_le) pos_le += p;
     }
-    return axis_score(C->mode, c, A->nn, count_lt(A->lo, A->nn, lo), count_le(A->hi, A->nn, hi),
-                      al_lt, al_le, pos_lt, pos_le, A->nal, npos);
+    return axis_score(C->mode, c, A->nn, count_lt(A->lo, A->nn, lo), count_le(A->hi, A->nn, hi), al_lt, al_le, pos_lt,
+                      pos_le, A->nal, npos);
 }
 
 static void rank_insert(ranked *top, uint32_t *ntop, uint32_t k, const cand *c, score s)
@@ -450,8 +448,7 @@ static void rank_insert(ranked *top, uint32_t *ntop, uint32_t k, const cand *c, 
 
 /* Every axis-aligned candidate of one axis in one sweep: the parallel segs
  * that lie exactly on an axis-aligned line are the candidates, in order. */
-static void sweep_axis(bs_chooser *C, const index_set *x, int a, ranked *top, uint32_t *ntop,
-                       uint32_t k)
+static void sweep_axis(bs_chooser *C, const index_set *x, int a, ranked *top, uint32_t *ntop, uint32_t k)
 {
     const bs_tree *t = C->t;
     const axis_index *A = &x->ax[a];
@@ -475,8 +472,7 @@ static void sweep_axis(bs_chooser *C, const index_set *x, int a, ranked *top, ui
         while (hi_le < A->nn && val_of(A->hi[hi_le]) <= hi) hi_le++;
         while (al_lt < A->nal && val_of(A->al[al_lt]) < lo) pos_lt += (uint32_t)(A->al[al_lt++] >> 31) & 1u;
         while (al_le < A->nal && val_of(A->al[al_le]) <= hi) pos_le += (uint32_t)(A->al[al_le++] >> 31) & 1u;
-        score s = axis_score(C->mode, &c, A->nn, lo_lt, hi_le, al_lt, al_le, pos_lt, pos_le, A->nal,
-                             npos);
+        score s = axis_score(C->mode, &c, A->nn, lo_lt, hi_le, al_lt, al_le, pos_lt, pos_le, A->nal, npos);
         if (s.valid) rank_insert(top, ntop, k, &c, s);
     }
 }
@@ -484,8 +480,8 @@ static void sweep_axis(bs_chooser *C, const index_set *x, int a, ranked *top, ui
 /* Score the candidates of a set; the best k go to top[] (k >= 1). x: the
  * set's index, or NULL for a small set. Returns the number found (0: the set
  * is convex), or -1 on allocation failure. */
-static int score_set(bs_chooser *C, const uint32_t *segs, uint32_t n, uint32_t depth,
-                     const index_set *x, ranked *top, uint32_t k)
+static int score_set(bs_chooser *C, const uint32_t *segs, uint32_t n, uint32_t depth, const index_set *x, ranked *top,
+                     uint32_t k)
 {
     const bs_tree *t = C->t;
     C->mode = C->strategy;
@@ -552,8 +548,7 @@ static int score_set(bs_chooser *C, const uint32_t *segs, uint32_t n, uint32_t d
 
 /* look-ahead: the children of c (classification only: a seg to be split goes
  * to both whole, close enough for scoring) into child[0] / child[1] and mark[] */
-static int classify_children(bs_chooser *C, const uint32_t *segs, uint32_t n, const cand *c,
-                             uint32_t *nf, uint32_t *nb)
+static int classify_children(bs_chooser *C, const uint32_t *segs, uint32_t n, const cand *c, uint32_t *nf, uint32_t *nb)
 {
     const bs_tree *t = C->t;
     if (n > C->childcap) {

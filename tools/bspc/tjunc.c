@@ -92,8 +92,8 @@ static int hit_cmp(const void *a, const void *b)
 }
 
 /* points of the grid strictly inside segment A-B (within BS_TJ_TOL of it), sorted from A */
-static int find_on_segment(const grid *g, const int32_t *px, const int32_t *py, int32_t ax,
-                           int32_t ay, int32_t bx, int32_t by, hits *out)
+static int find_on_segment(const grid *g, const int32_t *px, const int32_t *py, int32_t ax, int32_t ay, int32_t bx,
+                           int32_t by, hits *out)
 {
     out->n = 0;
     int64_t dx = (int64_t)bx - ax, dy = (int64_t)by - ay;

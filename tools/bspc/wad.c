@@ -22,16 +22,21 @@
 
 typedef bs_wadlump lump;
 
-static uint16_t rd16(const uint8_t *p) { return (uint16_t)(p[0] | (p[1] << 8)); }
-static int16_t rds16(const uint8_t *p) { return (int16_t)rd16(p); }
+static uint16_t rd16(const uint8_t *p)
+{
+    return (uint16_t)(p[0] | (p[1] << 8));
+}
+static int16_t rds16(const uint8_t *p)
+{
+    return (int16_t)rd16(p);
+}
 static uint32_t rd32(const uint8_t *p)
 {
     return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
 }
 
-static const char *map_lumps[] = {"THINGS",  "LINEDEFS", "SIDEDEFS", "VERTEXES", "SEGS",
-                                  "SSECTORS", "NODES",   "SECTORS",  "REJECT",   "BLOCKMAP",
-                                  "BEHAVIOR", "SCRIPTS", NULL};
+static const char *map_lumps[] = {"THINGS",  "LINEDEFS", "SIDEDEFS", "VERTEXES", "SEGS",    "SSECTORS", "NODES",
+                                  "SECTORS", "REJECT",   "BLOCKMAP", "BEHAVIOR", "SCRIPTS", NULL};
 
 static int is_map_lump(const char *n)
 {
@@ -62,8 +67,8 @@ typedef struct {
     int32_t radius, height; /* whole units */
     uint8_t colour;
     uint8_t table_colour; /* things.txt's colour: kinds share a model by it, as tools/refrender.py counts them */
-    char sprite[4];  /* Doom's sprite name */
-    int coloured;    /* colour taken from the sprite (or PLAYPAL's nearest) */
+    char sprite[4];       /* Doom's sprite name */
+    int coloured;         /* colour taken from the sprite (or PLAYPAL's nearest) */
 } thing_kind;
 
 /* Parse the built-in table into kinds[] (at most cap); returns the count, or -1
@@ -87,12 +92,12 @@ static int read_thing_table(thing_kind *kinds, int cap, char *err, size_t errlen
         char *col[7];
         int nc = 0;
         char *save = NULL;
-        for (char *c = strtok_r(line, " \t\r", &save); c && nc < 7; c = strtok_r(NULL, " \t\r", &save))
-            col[nc++] = c;
+        for (char *c = strtok_r(line, " \t\r", &save); c && nc < 7; c = strtok_r(NULL, " \t\r", &save)) col[nc++] = c;
         if (nc == 0) continue;
         long v[3];
         int bad = nc != 6 || strlen(col[4]) != 4;
-        for (int j = 0; j < 4 && !bad; j++) bad = !isupper((unsigned char)col[4][j]) && !isdigit((unsigned char)col[4][j]);
+        for (int j = 0; j < 4 && !bad; j++)
+            bad = !isupper((unsigned char)col[4][j]) && !isdigit((unsigned char)col[4][j]);
         for (int j = 0; j < 3 && !bad; j++) {
             char *end;
             errno = 0;
@@ -111,8 +116,10 @@ static int read_thing_table(thing_kind *kinds, int cap, char *err, size_t errlen
             bad = colour < 0;
         }
         if (bad)
-            return bs_fail(err, errlen, "things.txt:%d: expected 'type radius height colour sprite name' "
-                           "(radius 1..%d)", lineno, SCN_MODEL_MAX);
+            return bs_fail(err, errlen,
+                           "things.txt:%d: expected 'type radius height colour sprite name' "
+                           "(radius 1..%d)",
+                           lineno, SCN_MODEL_MAX);
         if (n == cap) return bs_fail(err, errlen, "things.txt: more than %d thing types", cap);
         kinds[n] = (thing_kind){(uint16_t)v[0], (int32_t)v[1], (int32_t)v[2], (uint8_t)colour, (uint8_t)colour, {0}, 0};
         memcpy(kinds[n++].sprite, col[4], 4);
@@ -120,7 +127,7 @@ static int read_thing_table(thing_kind *kinds, int cap, char *err, size_t errlen
     return n;
 }
 
-#define THING_SKILL3 0x0002u  /* present on skill 3 ("hurt me plenty") */
+#define THING_SKILL3 0x0002u /* present on skill 3 ("hurt me plenty") */
 #define THING_MULTI_ONLY 0x0010u
 
 /* Things of listed types, on skill 3 and in single player, become objects, one
@@ -168,8 +175,8 @@ static int read_things(bs_scene *s, bs_wadlook *look, const uint8_t *recs, uint3
         }
         /* kinds sharing a size and things.txt colour share a model (the first one's sprite colours it) */
         for (int j = 0; j < nk && model_of[k] == SCN_NONE; j++)
-            if (model_of[j] != SCN_NONE && kinds[j].radius == kinds[k].radius &&
-                kinds[j].height == kinds[k].height && kinds[j].table_colour == kinds[k].table_colour)
+            if (model_of[j] != SCN_NONE && kinds[j].radius == kinds[k].radius && kinds[j].height == kinds[k].height &&
+                kinds[j].table_colour == kinds[k].table_colour)
                 model_of[k] = model_of[j];
         if (model_of[k] == SCN_NONE) {
             bs_mpart p;
@@ -228,8 +235,8 @@ static int is_manual_door(unsigned special)
  * sector with the line's non-zero tag. A door opens to the lowest ceiling of
  * the sectors across its two-sided lines minus 4 (Doom's
  * P_FindLowestCeilingSurrounding), never below its closed ceiling. */
-static int find_doors(bs_scene *s, const uint8_t *lines, uint32_t nl, const uint8_t *sides,
-                      const uint8_t *sectors, const char *display, char *err, size_t errlen)
+static int find_doors(bs_scene *s, const uint8_t *lines, uint32_t nl, const uint8_t *sides, const uint8_t *sectors,
+                      const char *display, char *err, size_t errlen)
 {
     uint32_t ns = s->nsectors;
     uint8_t *door = calloc(ns + 1, 1);
@@ -283,7 +290,7 @@ static const char *const need[L_N] = {"THINGS", "LINEDEFS", "SIDEDEFS", "VERTEXE
  * shared by the per-lump readers below (as Doom's P_Load* share the level). */
 typedef struct {
     FILE *f;
-    size_t len;          /* file size */
+    size_t len; /* file size */
     const char *wadpath, *display;
     const bspc_options *opt;
     char *err;
@@ -291,11 +298,11 @@ typedef struct {
     lump *dir;
     uint8_t *dirbuf;
     uint32_t nlumps;
-    char want[9];        /* the map marker's name, upper case */
-    uint8_t *ld[L_N];    /* the lumps this reader uses, NULL until found */
-    uint32_t cnt[L_N];   /* their record counts */
-    uint8_t *vused;      /* [nverts]: the vertex ends a kept linedef */
-    bs_wadlook *look;    /* textures and light tables; NULL with --flat */
+    char want[9];      /* the map marker's name, upper case */
+    uint8_t *ld[L_N];  /* the lumps this reader uses, NULL until found */
+    uint32_t cnt[L_N]; /* their record counts */
+    uint8_t *vused;    /* [nverts]: the vertex ends a kept linedef */
+    bs_wadlook *look;  /* textures and light tables; NULL with --flat */
 } wad_map;
 
 /* The 12-byte header and the lump directory. */
@@ -311,14 +318,16 @@ static int wad_read_dir(wad_map *m)
         char magic[5];
         for (int i = 0; i < 4; i++) magic[i] = isprint(hdr[i]) ? (char)hdr[i] : '?';
         magic[4] = 0;
-        return bs_fail(m->err, m->errlen, "%s: %s is not a WAD file (header magic '%s', not IWAD or PWAD)",
-                       m->display, m->wadpath, magic);
+        return bs_fail(m->err, m->errlen, "%s: %s is not a WAD file (header magic '%s', not IWAD or PWAD)", m->display,
+                       m->wadpath, magic);
     }
     m->len = (size_t)flen;
     uint32_t nlumps = rd32(hdr + 4), dirofs = rd32(hdr + 8);
     if (dirofs > m->len || nlumps > (m->len - dirofs) / 16)
-        return bs_fail(m->err, m->errlen, "%s: %s: lump directory (%u lumps at offset %u) runs past the end of "
-                       "the file (%zu bytes)", m->display, m->wadpath, nlumps, dirofs, m->len);
+        return bs_fail(m->err, m->errlen,
+                       "%s: %s: lump directory (%u lumps at offset %u) runs past the end of "
+                       "the file (%zu bytes)",
+                       m->display, m->wadpath, nlumps, dirofs, m->len);
     m->nlumps = nlumps;
     m->dir = calloc(nlumps + 1, sizeof *m->dir);
     m->dirbuf = malloc((size_t)nlumps * 16 + 1);
@@ -359,8 +368,8 @@ static int wad_read_lump(wad_map *m, uint32_t i, int k)
     if (d->pos > m->len || d->size > m->len - d->pos)
         return bs_fail(m->err, m->errlen, "%s: %s lump runs past the end of the file", m->display, need[k]);
     if (d->size % recsz[k] != 0)
-        return bs_fail(m->err, m->errlen, "%s: %s lump size %u is not a multiple of %u bytes", m->display,
-                       need[k], d->size, recsz[k]);
+        return bs_fail(m->err, m->errlen, "%s: %s lump size %u is not a multiple of %u bytes", m->display, need[k],
+                       d->size, recsz[k]);
     m->ld[k] = malloc(d->size + 1);
     if (!m->ld[k]) return bs_fail(m->err, m->errlen, "%s: out of memory", m->display);
     if (read_at(m->f, d->pos, d->size, m->ld[k]))
@@ -375,8 +384,10 @@ static int wad_read_map_lumps(wad_map *m, uint32_t marker)
 {
     for (uint32_t i = marker + 1; i < m->nlumps && is_map_lump(m->dir[i].name); i++) {
         if (strcmp(m->dir[i].name, "BEHAVIOR") == 0)
-            return bs_fail(m->err, m->errlen, "%s: Hexen-format map (has a BEHAVIOR lump): only Doom-format maps "
-                           "are supported", m->display);
+            return bs_fail(m->err, m->errlen,
+                           "%s: Hexen-format map (has a BEHAVIOR lump): only Doom-format maps "
+                           "are supported",
+                           m->display);
         for (int k = 0; k < L_N; k++)
             if (strcmp(m->dir[i].name, need[k]) == 0 && !m->ld[k] && wad_read_lump(m, i, k)) return -1;
     }
@@ -445,8 +456,8 @@ static int wad_load_side(wad_map *m, bs_scene *s, bs_line *l, uint32_t i, int k,
     const uint8_t *sr = m->ld[L_SIDEDEFS] + 30 * sd;
     uint32_t sec = rd16(sr + 28);
     if (sec >= s->nsectors)
-        return bs_fail(m->err, m->errlen, "%s: linedef %u: sidedef %u: sector %u out of range (have %u)",
-                       m->display, i, sd, sec, s->nsectors);
+        return bs_fail(m->err, m->errlen, "%s: linedef %u: sidedef %u: sector %u out of range (have %u)", m->display, i,
+                       sd, sec, s->nsectors);
     l->sector[k] = sec;
     int light = s->sectors[sec].light;
     char up[9], lo[9], mid[9];
@@ -476,8 +487,8 @@ static int wad_load_linedef(wad_map *m, bs_scene *s, uint32_t i)
     if (sd[0] == 0xFFFF) return bs_fail(m->err, m->errlen, "%s: linedef %u: no front sidedef", m->display, i);
     for (int k = 0; k < 2; k++)
         if (sd[k] != 0xFFFF && sd[k] >= nsd)
-            return bs_fail(m->err, m->errlen, "%s: linedef %u: sidedef %u out of range (have %u)", m->display, i,
-                           sd[k], nsd);
+            return bs_fail(m->err, m->errlen, "%s: linedef %u: sidedef %u out of range (have %u)", m->display, i, sd[k],
+                           nsd);
     if (s->vx[v1] == s->vx[v2] && s->vy[v1] == s->vy[v2]) {
         bs_warn(m->opt, "%s: linedef %u: zero length, skipped", m->display, i);
         return 1;
@@ -522,11 +533,11 @@ static int wad_check_vertexes(wad_map *m, const bs_scene *s)
 {
     for (uint32_t i = 0; i < s->nverts; i++)
         if (m->vused[i] && s->vx[i] == -32768 * 65536)
-            return bs_fail(m->err, m->errlen, "%s: vertex %u: x = -32768 out of range (|coordinate| <= %d)",
-                           m->display, i, SCN_COORD_MAX);
+            return bs_fail(m->err, m->errlen, "%s: vertex %u: x = -32768 out of range (|coordinate| <= %d)", m->display,
+                           i, SCN_COORD_MAX);
         else if (m->vused[i] && s->vy[i] == -32768 * 65536)
-            return bs_fail(m->err, m->errlen, "%s: vertex %u: y = -32768 out of range (|coordinate| <= %d)",
-                           m->display, i, SCN_COORD_MAX);
+            return bs_fail(m->err, m->errlen, "%s: vertex %u: y = -32768 out of range (|coordinate| <= %d)", m->display,
+                           i, SCN_COORD_MAX);
     return 0;
 }
 
@@ -568,14 +579,14 @@ static int wad_load_map(wad_map *m, const char *map, bs_scene *s)
         wad_load_player(m, s))
         return -1;
     /* every sidedef and sector index was checked by wad_load_linedefs */
-    if (find_doors(s, m->ld[L_LINEDEFS], m->cnt[L_LINEDEFS], m->ld[L_SIDEDEFS], m->ld[L_SECTORS], m->display,
-                   m->err, m->errlen))
+    if (find_doors(s, m->ld[L_LINEDEFS], m->cnt[L_LINEDEFS], m->ld[L_SIDEDEFS], m->ld[L_SECTORS], m->display, m->err,
+                   m->errlen))
         return -1;
     return read_things(s, m->look, m->ld[L_THINGS], m->cnt[L_THINGS], m->display, m->opt, m->err, m->errlen);
 }
 
-int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_scene *s,
-                const bspc_options *opt, char *err, size_t errlen)
+int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_scene *s, const bspc_options *opt,
+                char *err, size_t errlen)
 {
     snprintf(s->name, sizeof s->name, "%s", display);
     s->is_text = 0;

@@ -20,7 +20,7 @@ enum { KIND_WALL, KIND_FLAT };
 typedef struct {
     char name[9];
     int kind;
-    uint16_t tex; /* SCN_TEX_NONE: unknown (warned once) */
+    uint16_t tex;  /* SCN_TEX_NONE: unknown (warned once) */
     uint32_t hash; /* of name: most entries are told apart by it alone */
 } used_name;
 
@@ -50,15 +50,21 @@ struct bs_wadlook {
     uint32_t mcap;
     uint32_t nlines_cap; /* sides has room for 2 * nlines_cap */
     const char *sky_name;
-    uint8_t neutral; /* palette index of a mid grey, for parts without a texture */
-    uint32_t *flats; /* the lumps between flat markers, in directory order (found once) */
-    uint32_t nflats; /* valid once flats is set */
+    uint8_t neutral;   /* palette index of a mid grey, for parts without a texture */
+    uint32_t *flats;   /* the lumps between flat markers, in directory order (found once) */
+    uint32_t nflats;   /* valid once flats is set */
     uint32_t *sprites; /* the same for the sprite markers */
     uint32_t nsprites;
 };
 
-static uint16_t rd16(const uint8_t *p) { return (uint16_t)(p[0] | (p[1] << 8)); }
-static int16_t rds16(const uint8_t *p) { return (int16_t)rd16(p); }
+static uint16_t rd16(const uint8_t *p)
+{
+    return (uint16_t)(p[0] | (p[1] << 8));
+}
+static int16_t rds16(const uint8_t *p)
+{
+    return (int16_t)rd16(p);
+}
 static uint32_t rd32(const uint8_t *p)
 {
     return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
@@ -131,8 +137,8 @@ static int log2_ceil(uint32_t v)
 
 /* Append a texture from a column-major w x h picture: 2^floor(log2 w) columns,
  * rows padded to 2^ceil(log2 h) by repeating from the top (docs/textures.md). */
-static int store(bs_wadlook *L, const char *name, const uint8_t *pic, uint32_t w, uint32_t h, uint16_t *out,
-                 char *err, size_t errlen)
+static int store(bs_wadlook *L, const char *name, const uint8_t *pic, uint32_t w, uint32_t h, uint16_t *out, char *err,
+                 size_t errlen)
 {
     bs_look *lk = L->lk;
     int wb = log2_floor(w), hb = log2_ceil(h);
@@ -141,8 +147,7 @@ static int store(bs_wadlook *L, const char *name, const uint8_t *pic, uint32_t w
                        1 << SCN_TEX_MAX_BITS, 1 << SCN_TEX_MAX_BITS);
     if (lk->ntex >= SCN_TEX_NONE) return bs_fail(err, errlen, "%s: more than %u textures", L->wad, SCN_TEX_NONE);
     uint32_t cols = 1u << wb, rows = 1u << hb, n = cols << hb;
-    if ((uint64_t)lk->ntexels + n > UINT32_MAX / 2 ||
-        bs_grow(&lk->texels, &lk->txcap, lk->ntexels + n, 1) ||
+    if ((uint64_t)lk->ntexels + n > UINT32_MAX / 2 || bs_grow(&lk->texels, &lk->txcap, lk->ntexels + n, 1) ||
         bs_grow(&lk->tex, &lk->tcap, lk->ntex + 1, sizeof *lk->tex) ||
         bs_grow(&L->mean, &L->mcap, lk->ntex + 1, sizeof *L->mean))
         return bs_fail(err, errlen, "%s: out of memory", L->wad);
@@ -176,11 +181,11 @@ static int store(bs_wadlook *L, const char *name, const uint8_t *pic, uint32_t w
 /* Draw patch data p[0..size) into the column-major w x h picture at (ox, oy),
  * clipped. what names the lump for messages. opaque counts the pixels drawn
  * and sum their colours (either may be NULL). */
-static int draw_patch(const bs_wadlook *L, const uint8_t *p, uint32_t size, const char *what, uint8_t *pic,
-                      int32_t w, int32_t h, int32_t ox, int32_t oy, uint64_t *opaque, double sum[3], char *err,
-                      size_t errlen)
+static int draw_patch(const bs_wadlook *L, const uint8_t *p, uint32_t size, const char *what, uint8_t *pic, int32_t w,
+                      int32_t h, int32_t ox, int32_t oy, uint64_t *opaque, double sum[3], char *err, size_t errlen)
 {
-    if (size < 8) return bs_fail(err, errlen, "%s: patch %s: %u bytes, shorter than its 8-byte header", L->wad, what, size);
+    if (size < 8)
+        return bs_fail(err, errlen, "%s: patch %s: %u bytes, shorter than its 8-byte header", L->wad, what, size);
     int32_t pw = rds16(p), ph = rds16(p + 2);
     if (pw <= 0 || ph <= 0 || (uint64_t)8 + 4u * (uint64_t)pw > size)
         return bs_fail(err, errlen, "%s: patch %s: size %d x %d does not fit its %u bytes", L->wad, what, pw, ph, size);
@@ -197,8 +202,10 @@ static int draw_patch(const bs_wadlook *L, const uint8_t *p, uint32_t size, cons
                 return bs_fail(err, errlen, "%s: patch %s: column %d: post header past the end", L->wad, what, c);
             uint32_t len = p[at + 1];
             if ((uint64_t)at + 3 + len > size)
-                return bs_fail(err, errlen, "%s: patch %s: column %d: post of %u bytes at %u runs past the end "
-                               "(%u bytes)", L->wad, what, c, len, at, size);
+                return bs_fail(err, errlen,
+                               "%s: patch %s: column %d: post of %u bytes at %u runs past the end "
+                               "(%u bytes)",
+                               L->wad, what, c, len, at, size);
             const uint8_t *src = p + at + 3;
             if (pic && !opaque && !sum) { /* a texture's patch: the rows of the post inside the picture */
                 int32_t y0 = oy + (int32_t)top, k0 = y0 < 0 ? -y0 : 0, k1 = (int32_t)len;
@@ -237,8 +244,8 @@ static int find_texdef(const bs_wadlook *L, const char *name, int *which, uint32
         for (uint32_t i = 0; i < n; i++) {
             uint32_t o = rd32(d + 4 + 4 * i);
             if (o > sz || sz - o < 22)
-                return bs_fail(err, errlen, "%s: lump %s: texture %u at offset %u runs past the end (%u bytes)",
-                               L->wad, lumpname[t], i, o, sz);
+                return bs_fail(err, errlen, "%s: lump %s: texture %u at offset %u runs past the end (%u bytes)", L->wad,
+                               lumpname[t], i, o, sz);
             char nm[9];
             name8(nm, d + o);
             if (strcmp(nm, name) == 0) {
@@ -286,8 +293,8 @@ static int compose_wall(bs_wadlook *L, const char *name, uint16_t *out, char *er
         name8(pn, L->pnames + 4 + 8 * pi);
         uint32_t li = find_lump(L, pn, 0, L->ndir);
         if (li == L->ndir) {
-            rc = bs_fail(err, errlen, "%s: texture %s: patch %s (PNAMES entry %u) is not in the WAD", L->wad, name,
-                         pn, pi);
+            rc = bs_fail(err, errlen, "%s: texture %s: patch %s (PNAMES entry %u) is not in the WAD", L->wad, name, pn,
+                         pi);
             break;
         }
         uint8_t *p;
@@ -302,8 +309,14 @@ static int compose_wall(bs_wadlook *L, const char *name, uint16_t *out, char *er
 
 /* ---- flats ---- */
 
-static int is_flat_start(const char *n) { return strcmp(n, "F_START") == 0 || strcmp(n, "FF_START") == 0; }
-static int is_flat_end(const char *n) { return strcmp(n, "F_END") == 0 || strcmp(n, "FF_END") == 0; }
+static int is_flat_start(const char *n)
+{
+    return strcmp(n, "F_START") == 0 || strcmp(n, "FF_START") == 0;
+}
+static int is_flat_end(const char *n)
+{
+    return strcmp(n, "F_END") == 0 || strcmp(n, "FF_END") == 0;
+}
 
 /* the lumps between F_START/F_END or FF_START/FF_END, listed on the first call */
 static int list_flats(bs_wadlook *L)
@@ -314,9 +327,12 @@ static int list_flats(bs_wadlook *L)
     int in = 0;
     for (uint32_t i = 0; i < L->ndir; i++) {
         const char *n = L->dir[i].name;
-        if (is_flat_start(n)) in = 1;
-        else if (is_flat_end(n)) in = 0;
-        else if (in) L->flats[L->nflats++] = i;
+        if (is_flat_start(n))
+            in = 1;
+        else if (is_flat_end(n))
+            in = 0;
+        else if (in)
+            L->flats[L->nflats++] = i;
     }
     return 0;
 }
@@ -360,8 +376,10 @@ static int texture(bs_wadlook *L, const char *name, int kind, uint16_t *out, cha
         }
     int f = kind == KIND_WALL ? compose_wall(L, name, out, err, errlen) : compose_flat(L, name, out, err, errlen);
     if (f < 0) return -1;
-    if (f == 0) bs_warn(L->opt, "%s: unknown %s '%s': drawn flat", L->wad, kind == KIND_WALL ? "texture" : "flat", name);
-    if (bs_grow(&L->used, &L->ucap, L->nused + 1, sizeof *L->used)) return bs_fail(err, errlen, "%s: out of memory", L->wad);
+    if (f == 0)
+        bs_warn(L->opt, "%s: unknown %s '%s': drawn flat", L->wad, kind == KIND_WALL ? "texture" : "flat", name);
+    if (bs_grow(&L->used, &L->ucap, L->nused + 1, sizeof *L->used))
+        return bs_fail(err, errlen, "%s: out of memory", L->wad);
     used_name *u = &L->used[L->nused++];
     snprintf(u->name, sizeof u->name, "%s", name);
     u->hash = name_hash(u->name);
@@ -406,8 +424,8 @@ int bs_look_open(FILE *f, size_t flen, const bs_wadlump *dir, uint32_t ndir, con
                  size_t errlen)
 {
     *out = NULL;
-    bs_wadlook tmp = {f, flen, dir, ndir, s->name, opt, s, &s->look, NULL, 0, {NULL, NULL}, {0, 0},
-                      NULL, 0, 0, NULL, 0, 0, NULL, 0};
+    bs_wadlook tmp = {f,      flen, dir, ndir, s->name, opt, s, &s->look, NULL, 0, {NULL, NULL},
+                      {0, 0}, NULL, 0,   0,    NULL,    0,   0, NULL,     0};
     static const char *need[] = {"PLAYPAL", "COLORMAP", "PNAMES", "TEXTURE1"};
     uint32_t at[4];
     char missing[64] = "";
@@ -522,21 +540,32 @@ int bs_look_side(bs_wadlook *L, uint32_t li, int k, const uint8_t rec[30], unsig
     int64_t iu = llround(u0) % m;
     sd->u0 = (int32_t)(iu < 0 ? iu + m : iu);
     sd->row_off = (int32_t)(yoff * 65536.0);
-    sd->flags = (uint8_t)(((line_flags & 8u) ? SCN_SIDE_UNPEG_TOP : 0) | ((line_flags & 16u) ? SCN_SIDE_UNPEG_BOTTOM : 0));
+    sd->flags = (uint8_t)(((line_flags & 8u) ? SCN_SIDE_UNPEG_TOP : 0) |
+                          ((line_flags & 16u) ? SCN_SIDE_UNPEG_BOTTOM : 0));
     sd->light_adj = (int8_t)(dy == 0 ? -1 : dx == 0 ? 1 : 0);
 
     int lightnum = (s->sectors[l->sector[k]].light >> 4) + sd->light_adj;
     uint8_t cm = lit(L, sd->tex[SCN_PART_MIDDLE], lightnum, 1);
     l->color[k][SCN_PART_MIDDLE] = cm;
-    l->color[k][SCN_PART_UPPER] = sd->tex[SCN_PART_UPPER] == SCN_TEX_NONE ? cm : lit(L, sd->tex[SCN_PART_UPPER], lightnum, 1);
-    l->color[k][SCN_PART_LOWER] = sd->tex[SCN_PART_LOWER] == SCN_TEX_NONE ? cm : lit(L, sd->tex[SCN_PART_LOWER], lightnum, 1);
+    l->color[k][SCN_PART_UPPER] = sd->tex[SCN_PART_UPPER] == SCN_TEX_NONE
+                                      ? cm
+                                      : lit(L, sd->tex[SCN_PART_UPPER], lightnum, 1);
+    l->color[k][SCN_PART_LOWER] = sd->tex[SCN_PART_LOWER] == SCN_TEX_NONE
+                                      ? cm
+                                      : lit(L, sd->tex[SCN_PART_LOWER], lightnum, 1);
     return 0;
 }
 
 /* ---- sprites ---- */
 
-static int is_sprite_start(const char *n) { return strcmp(n, "S_START") == 0 || strcmp(n, "SS_START") == 0; }
-static int is_sprite_end(const char *n) { return strcmp(n, "S_END") == 0 || strcmp(n, "SS_END") == 0; }
+static int is_sprite_start(const char *n)
+{
+    return strcmp(n, "S_START") == 0 || strcmp(n, "SS_START") == 0;
+}
+static int is_sprite_end(const char *n)
+{
+    return strcmp(n, "S_END") == 0 || strcmp(n, "SS_END") == 0;
+}
 
 /* the lumps between S_START/S_END or SS_START/SS_END, listed on the first call */
 static int list_sprites(bs_wadlook *L)
@@ -547,9 +576,12 @@ static int list_sprites(bs_wadlook *L)
     int in = 0;
     for (uint32_t i = 0; i < L->ndir; i++) {
         const char *n = L->dir[i].name;
-        if (is_sprite_start(n)) in = 1;
-        else if (is_sprite_end(n)) in = 0;
-        else if (in) L->sprites[L->nsprites++] = i;
+        if (is_sprite_start(n))
+            in = 1;
+        else if (is_sprite_end(n))
+            in = 0;
+        else if (in)
+            L->sprites[L->nsprites++] = i;
     }
     return 0;
 }
@@ -571,7 +603,8 @@ uint8_t bs_look_thing_colour(bs_wadlook *L, const char prefix[4], uint8_t fallba
             int rc = load_lump(L, i, 0, &p, msg, sizeof msg);
             if (rc == 0) rc = draw_patch(L, p, L->dir[i].size, n, NULL, 0, 0, 0, 0, &count, sum, msg, sizeof msg);
             if (rc == 0 && count)
-                colour = nearest(L->lk->palette, sum[0] / (double)count, sum[1] / (double)count, sum[2] / (double)count);
+                colour = nearest(L->lk->palette, sum[0] / (double)count, sum[1] / (double)count,
+                                 sum[2] / (double)count);
             else
                 bs_warn(L->opt, "%s: sprite %s: %s; the box keeps things.txt's colour", L->wad, n,
                         rc ? msg : "no opaque pixels");

@@ -31,8 +31,10 @@ int bspc_list_maps(const char *wad, char *out, size_t outlen, char *err, size_t 
     char path[1100];
     if (outlen) out[0] = 0;
     if (bspc_find_wad(wad, path, sizeof path))
-        return bs_fail(err, errlen, "%s: cannot find it (looked in the current folder, $DOOMWADDIR and "
-                       "/usr/share/games/doom)", wad);
+        return bs_fail(err, errlen,
+                       "%s: cannot find it (looked in the current folder, $DOOMWADDIR and "
+                       "/usr/share/games/doom)",
+                       wad);
     FILE *f = fopen(path, "rb");
     if (!f) return bs_fail(err, errlen, "%s: cannot open: %s", path, strerror(errno));
     uint8_t hdr[12];

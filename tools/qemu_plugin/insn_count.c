@@ -42,8 +42,8 @@
 
 QEMU_PLUGIN_EXPORT int qemu_plugin_version = QEMU_PLUGIN_VERSION;
 
-static uint64_t insns;              /* instructions of every block entered so far */
-static uint64_t mark_addr[2];       /* begin, end (Thumb bit cleared) */
+static uint64_t insns;        /* instructions of every block entered so far */
+static uint64_t mark_addr[2]; /* begin, end (Thumb bit cleared) */
 static int have_mark[2];
 static char *out_path;
 
@@ -117,7 +117,8 @@ static void write_profile(void)
     } else {
         fprintf(f, "# insn_count profile: guest instruction address, runs inside frames (%zu frames)\n", nframes);
         for (prof_tb *p = prof_list; p; p = p->next)
-            for (size_t i = 0; p->runs && i < p->n; i++) fprintf(f, "%#x %llu\n", (unsigned)p->pc[i], (unsigned long long)p->runs);
+            for (size_t i = 0; p->runs && i < p->n; i++)
+                fprintf(f, "%#x %llu\n", (unsigned)p->pc[i], (unsigned long long)p->runs);
         fclose(f);
     }
     while (prof_list) {
