@@ -145,9 +145,9 @@ typedef struct {
 } scn_mvert;
 
 typedef struct {
-    uint32_t
-        first_index; /* findex[first_index .. + num_index): vertex numbers within the model [range: FINDEX, num_index] */
-    uint16_t num_index; /* 3 .. SCN_MAX_FACE_VERTS, counter-clockwise seen from outside [count of first_index] */
+    /* findex[first_index .. + num_index): vertex numbers within the model */
+    uint32_t first_index; /* [range: FINDEX, num_index] */
+    uint16_t num_index;   /* 3 .. SCN_MAX_FACE_VERTS, counter-clockwise seen from outside [count of first_index] */
     uint8_t colour;
     uint8_t part; /* convex part of the model it belongs to */
 } scn_face;
