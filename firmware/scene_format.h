@@ -208,8 +208,8 @@ typedef struct {
 } scn_side;
 
 typedef struct {
-    uint16_t floor_tex,
-        ceil_tex; /* scn_texture index, or SCN_TEX_NONE (a sky ceiling: the sky) [index: TEXTURES or SCN_TEX_NONE] */
+    uint16_t floor_tex; /* scn_texture index, or SCN_TEX_NONE [index: TEXTURES or SCN_TEX_NONE] */
+    uint16_t ceil_tex;  /* the same; SCN_TEX_NONE is a sky ceiling [index: TEXTURES or SCN_TEX_NONE] */
 } scn_plane;
 
 /* What a scene needs of a renderer, written by the compiler's analysis

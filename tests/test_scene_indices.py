@@ -32,9 +32,14 @@ def parse_format(text):
     structs = {}
     for body, name in re.findall(r"typedef struct \{(.*?)\} (scn_\w+);", text, re.S):
         members = []
+        # a declaration a formatter wrapped after its type is one member
+        body = re.sub(r"\b((?:u?int\d+_t)|scn_\w+)[ \t]*\n\s*(?=\w)", r"\1 ", body)
         for line in body.splitlines():
             m = MEMBER.match(line)
             if not m:
+                # only blank lines and comments may be left unread: a member missed here
+                # would drop out of the tests unnoticed
+                assert re.fullmatch(r"\s*(/\*.*\*/)?\s*", line), f"{name}: cannot read '{line.strip()}'"
                 continue
             for decl in m.group(2).split(","):
                 decl = decl.strip()
