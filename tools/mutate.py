@@ -50,6 +50,8 @@ TESTS = {
     "firmware/scene.c": [GOLDEN, "test_bsp", "test_scene"],
     "firmware/camera.c": [GOLDEN, "test_collide", "test_objects"],
     "firmware/collide.c": ["test_collide", "test_objects"],
+    "firmware/collide_geom.c": ["test_collide", "test_objects"],
+    "firmware/collide_sight.c": ["test_collide", "test_objects"],
     "firmware/objects.c": [GOLDEN, "test_objects"],
     "firmware/obj_draw.c": [GOLDEN, "test_objects"],
     "firmware/engine.c": [GOLDEN, "test_objects", "test_ranges", "test_scene"],
