@@ -12,7 +12,6 @@ import re
 import select
 import shutil
 import socket
-import struct
 import subprocess
 import sys
 import threading
@@ -24,7 +23,6 @@ from test_display_board import EXIT_NO_APP, SLOT, built, host_frame, stream_into
 from test_flash_usb import SLOT_SIZE, have_gi, run_mock
 
 sys.path.insert(0, str(ROOT / "tools"))
-from armelf import symbol  # noqa: E402
 from boardrig import ARM, Board, frames_of  # noqa: E402
 
 pytestmark = pytest.mark.skipif(shutil.which("qemu-system-arm") is None, reason="qemu-system-arm missing")
@@ -128,9 +126,7 @@ def test_emu_link_into_the_board(built, tmp_path, scene):
                              cwd=ROOT, capture_output=True, text=True, timeout=300)
         assert emu.returncode == 0, emu.stderr
         board.wait_for(r"board: done:[^\n]*\n", 300)
-        board.qmp("stop")
-        start = struct.unpack("<I", board.pmem(symbol(board_elf, "mps2_display_start"), 4, tmp_path / "ds.bin"))[0]
-        page = board.pmem(symbol(board_elf, "mps2_vram1" if start else "mps2_vram0"), 64000, tmp_path / "page.bin")
+        start, page = board.shown_page(board_elf, tmp_path)
         text = board.text
     finally:
         if relay:

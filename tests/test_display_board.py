@@ -16,7 +16,6 @@ import pytest
 from conftest import BUILD, ROOT, program, run
 
 sys.path.insert(0, str(ROOT / "tools"))
-from armelf import symbol  # noqa: E402
 from boardrig import ARM, Board, Sender, frames_of  # noqa: E402
 from capture import MODES, PRESENTS  # noqa: E402
 from fxtext import fx_text  # noqa: E402
@@ -62,10 +61,7 @@ def stream_into_board(image, fw_elf, tmp_path, frames=FRAMES):
         snd = Sender(fw_elf, board.tcp_port, f"--frames {frames} --acks on", tmp=tmp_path)
         sent = snd.finish(frames)
         board.wait_for(r"board: done:[^\n]*\n", 120)
-        board.qmp("stop")
-        start = struct.unpack("<I", board.pmem(symbol(board_elf, "mps2_display_start"), 4, tmp_path / "ds.bin"))[0]
-        assert start in (0, 1)
-        page = board.pmem(symbol(board_elf, "mps2_vram1" if start else "mps2_vram0"), 64000, tmp_path / "page.bin")
+        start, page = board.shown_page(board_elf, tmp_path)
         text = board.text
     finally:
         if snd:

@@ -12,10 +12,13 @@ import re
 import select
 import shutil
 import socket
+import struct
 import subprocess
 import threading
 import time
 from pathlib import Path
+
+from armelf import symbol
 
 ROOT = Path(__file__).resolve().parent.parent
 ARM = ROOT / "build" / "arm"
@@ -117,6 +120,15 @@ class Board:
         """size bytes of the board's physical memory from addr (QMP pmemsave)."""
         self.qmp("pmemsave", val=addr, size=size, filename=str(path))
         return Path(path).read_bytes()
+
+    def shown_page(self, elf, tmp):
+        """Stop the board and read what it shows: (display-start register, the 64,000 bytes of the
+        page it selects), at the addresses elf's symbols give."""
+        self.qmp("stop")
+        start = struct.unpack("<I", self.pmem(symbol(elf, "mps2_display_start"), 4, Path(tmp) / "ds.bin"))[0]
+        assert start in (0, 1), start
+        page = self.pmem(symbol(elf, "mps2_vram1" if start else "mps2_vram0"), 64000, Path(tmp) / "page.bin")
+        return start, page
 
     def wait(self, timeout=60):
         try:
