@@ -12,7 +12,7 @@
 #include "fxtext.h"
 #include "hal.h"
 #include "hal_sdl.h"
-#include "link_info.h"
+#include "fl_engine_info.h"
 #include "link_send.h"
 #include "png.h"
 #include "port.h"
@@ -79,7 +79,7 @@ static int step(engine *e, uint32_t input, uint32_t dt_ms)
 {
     eng_step(e, input, dt_ms);
     if (!linked) return 0;
-    fl_frame_info info = link_info_of(e);
+    fl_frame_info info = fl_engine_info(e);
     if (link_frame(linked, e->frame - 1u, hal_shown_page(), hal_get_palette(), &info) == 0) return 0;
     fprintf(stderr, "emu: --link %s\n", link_error(linked));
     return -1;

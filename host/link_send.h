@@ -9,7 +9,7 @@
  * A receiver that goes away (closed socket, closed pty, EPIPE) or takes no
  * bytes for LINK_STALL_MS stops the link with a message naming the port; no
  * call blocks longer than that, and no SIGPIPE is raised. Knows nothing of the
- * engine: the caller fills the frame's camera and modes (link_info.h). */
+ * engine: the caller fills the frame's camera and modes (fl_engine_info.h). */
 #ifndef LINK_SEND_H
 #define LINK_SEND_H
 

@@ -14,7 +14,7 @@
 #include "fxtext.h"
 #include "hal.h"
 #include "hal_null.h"
-#include "link_info.h"
+#include "fl_engine_info.h"
 #include "link_send.h"
 #include "objects.h"
 #include "png.h"
@@ -628,7 +628,7 @@ static void print_json(const options *o, const engine *e, uint32_t crc, const li
 static int send_link(link_sender *l, const engine *e, const uint8_t *frame, const char *scene_name, const uint8_t *blob,
                      size_t blob_len)
 {
-    fl_frame_info info = link_info_of(e);
+    fl_frame_info info = fl_engine_info(e);
     if (link_hello(l, scene_name, blob, blob_len) == 0 && link_frame(l, 0, frame, hal_get_palette(), &info) == 0 &&
         link_finish(l) == 0)
         return 0;

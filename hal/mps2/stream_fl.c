@@ -16,6 +16,7 @@
 
 #include <stdarg.h>
 
+#include "fl_engine_info.h"
 #include "framelink.h"
 #include "hal.h"
 #include "format.h"
@@ -96,19 +97,11 @@ int stream_frame(const engine *e, uint32_t frame_no)
         while (!fl_enc_may_send(&enc, hal_ticks_ms())) poll_rx();
     }
     const uint8_t *page = hal_shown_page();
-    fl_frame_info info = {
-        .x = e->cam.view.x,
-        .y = e->cam.view.y,
-        .z = e->cam.view.z,
-        .angle = e->cam.view.angle_deg,
-        .look = e->cam.view.look,
-        .mode = (uint8_t)e->mode,
-        .present = (uint8_t)e->present,
-        /* the frame check carries the end-to-end check at a fraction of the
-         * pixel CRC-32's cost (640 K instructions a frame on the Cortex-M3);
-         * the receiver fills the CRC in */
-        .no_crc = 1,
-    };
+    fl_frame_info info = fl_engine_info(e);
+    /* the frame check carries the end-to-end check at a fraction of the
+     * pixel CRC-32's cost (640 K instructions a frame on the Cortex-M3);
+     * the receiver fills the CRC in */
+    info.no_crc = 1;
     const uint8_t *base = 0;
     if (st.have_prev && st.prev_flip && e->present == HAL_PRESENT_FLIP && st.prev_no == frame_no - 1u)
         base = hal_target_vram(1 - hal_target_display_start());
