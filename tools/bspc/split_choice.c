@@ -81,6 +81,7 @@ typedef struct {
 typedef struct {
     uint32_t front, back, splits;
     int valid;
+    int cut; /* eval_loop stopped early: the candidate costs more than its bar */
     int64_t cost;
 } score;
 
@@ -304,7 +305,7 @@ static score eval_loop(const bs_chooser *C, const cand *c, const uint32_t *segs,
     const bs_tree *t = C->t;
     const bs_pline *L = &t->plines[c->pl];
     bs_part p = {c->pl, c->rev, 0, 0};
-    score r = {0, 0, 0, 0, 0};
+    score r = {0, 0, 0, 0, 0, 0};
     for (uint32_t i = 0; i < n; i++) {
         const int32_t *q = xy + 4 * i;
         int a = bs_side(L, c->rev, q[0], q[1]);
@@ -322,7 +323,10 @@ static score eval_loop(const bs_chooser *C, const cand *c, const uint32_t *segs,
             r.front++;
             r.back++;
             r.splits++;
-            if (cost_floor(C->mode, r.splits) > best) return r;
+            if (cost_floor(C->mode, r.splits) > best) {
+                r.cut = 1;
+                return r;
+            }
         }
     }
     return finish(C->mode, r, c);
@@ -409,7 +413,7 @@ static score axis_score(int mode, const cand *c, uint32_t nn, uint32_t lo_lt, ui
     uint32_t n_low = al_lt - pos_lt, n_high = (nal - npos) - (al_le - pos_le);
     uint32_t p_on = npos - p_low - p_high, n_on = (nal - npos) - n_low - n_high;
     uint32_t hs = high + p_high + n_high, ls = low + p_low + n_low;
-    score r = {0, 0, sp, 0, 0};
+    score r = {0, 0, sp, 0, 0, 0};
     /* front is the right side: east of a north-going line, south of an east-going one */
     int front_high = (c->kind == 2) ? c->pos : !c->pos;
     r.front = (front_high ? hs : ls) + sp + (c->pos ? p_on : n_on);
@@ -477,11 +481,30 @@ static void sweep_axis(bs_chooser *C, const index_set *x, int a, ranked *top, ui
     }
 }
 
+/* The bar of a loop-scored candidate: what it must stay under to be ranked. */
+static int64_t bar_of(const ranked *top, uint32_t ntop, uint32_t k, int64_t cap)
+{
+    int64_t bar = ntop == k ? top[k - 1].s.cost : INT64_MAX;
+    return cap < bar ? cap : bar;
+}
+
+/* A loop-scored candidate into the ranking; a cut one only says that it
+ * costs more than the bar it was given. */
+static void rank_loop(bs_chooser *C, const cand *c, const uint32_t *segs, uint32_t n, ranked *top, uint32_t *ntop,
+                      uint32_t k, int64_t cap, int *cut)
+{
+    score s = eval_loop(C, c, segs, C->xy, n, bar_of(top, *ntop, k, cap));
+    if (s.valid) rank_insert(top, ntop, k, c, s);
+    *cut |= s.cut;
+}
+
 /* Score the candidates of a set; the best k go to top[] (k >= 1). x: the
- * set's index, or NULL for a small set. Returns the number found (0: the set
- * is convex), or -1 on allocation failure. */
+ * set's index, or NULL for a small set. Candidates costing more than cap may
+ * be cut short: *cut says some were, so that a set with nothing ranked is
+ * convex only if none was. Returns the number ranked, or -1 on allocation
+ * failure. */
 static int score_set(bs_chooser *C, const uint32_t *segs, uint32_t n, uint32_t depth, const index_set *x, ranked *top,
-                     uint32_t k)
+                     uint32_t k, int64_t cap, int *cut)
 {
     const bs_tree *t = C->t;
     C->mode = C->strategy;
@@ -495,6 +518,7 @@ static int score_set(bs_chooser *C, const uint32_t *segs, uint32_t n, uint32_t d
     if (bs_grow(&C->xy, &C->xycap, 4 * n + 4, sizeof(int32_t))) return -1;
     int32_t *xy = C->xy;
     uint32_t nc = 0, ndiag = 0, ntop = 0;
+    *cut = 0;
     C->stampno++;
     for (uint32_t i = 0; i < n; i++) {
         const bs_seg *g = &t->segs[segs[i]];
@@ -516,9 +540,7 @@ static int score_set(bs_chooser *C, const uint32_t *segs, uint32_t n, uint32_t d
     } else {
         for (uint32_t i = 0; i < nc; i++) {
             const cand *c = &C->cands[i];
-            if (!c->kind) continue;
-            score s = eval_loop(C, c, segs, xy, n, ntop == k ? top[k - 1].s.cost : INT64_MAX);
-            if (s.valid) rank_insert(top, &ntop, k, c, s);
+            if (c->kind) rank_loop(C, c, segs, n, top, &ntop, k, cap, cut);
         }
     }
     uint32_t want = ndiag <= DIAG_ALL ? ndiag : DIAG_SAMPLE;
@@ -528,20 +550,15 @@ static int score_set(bs_chooser *C, const uint32_t *segs, uint32_t n, uint32_t d
         if (c->kind) continue;
         /* the kd-th pick is the diagonal candidate of rank kd * ndiag / want */
         if ((uint64_t)kd * ndiag / want == id) {
-            score s = eval_loop(C, c, segs, xy, n, ntop == k ? top[k - 1].s.cost : INT64_MAX);
-            if (s.valid) rank_insert(top, &ntop, k, c, s);
+            rank_loop(C, c, segs, n, top, &ntop, k, cap, cut);
             kd++;
         }
         id++;
     }
-    if (ntop == 0 && want < ndiag) {
+    if (ntop == 0 && !*cut && want < ndiag) {
         /* the sample found nothing: every diagonal before calling it convex */
-        for (uint32_t i = 0; i < nc; i++) {
-            const cand *c = &C->cands[i];
-            if (c->kind) continue;
-            score s = eval_loop(C, c, segs, xy, n, ntop == k ? top[k - 1].s.cost : INT64_MAX);
-            if (s.valid) rank_insert(top, &ntop, k, c, s);
-        }
+        for (uint32_t i = 0; i < nc; i++)
+            if (!C->cands[i].kind) rank_loop(C, &C->cands[i], segs, n, top, &ntop, k, cap, cut);
     }
     return (int)ntop;
 }
@@ -593,7 +610,8 @@ int bs_choose(bs_chooser *C, const uint32_t *segs, uint32_t n, uint32_t depth, b
         if (index_build(C, &C->idx, segs, n)) return -1;
         x = &C->idx;
     }
-    int nt = score_set(C, segs, n, depth, x, top, k);
+    int cut;
+    int nt = score_set(C, segs, n, depth, x, top, k, INT64_MAX, &cut);
     if (nt < 0) return -1;
     if (nt == 0) return 1;
     int mode = C->mode;
@@ -611,10 +629,15 @@ int bs_choose(bs_chooser *C, const uint32_t *segs, uint32_t n, uint32_t depth, b
                     if (index_filter(C, &C->cidx, x, (uint8_t)(1u << side))) return -1;
                     cx = &C->cidx;
                 }
+                /* the child's best matters only while it keeps v under bestv */
+                int64_t cap = bestv == INT64_MAX ? INT64_MAX : bestv - v - 1;
                 ranked ct;
-                int r = score_set(C, C->child[side], nch[side], depth + 1, cx, &ct, 1);
+                int r = score_set(C, C->child[side], nch[side], depth + 1, cx, &ct, 1, cap, &cut);
                 if (r < 0) return -1;
-                if (r > 0) v += ct.s.cost;
+                if (r > 0)
+                    v += ct.s.cost;
+                else if (cut)
+                    v = bestv; /* costs more than cap: this candidate loses */
             }
             if (v < bestv) {
                 bestv = v;
