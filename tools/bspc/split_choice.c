@@ -297,12 +297,60 @@ static score finish(int mode, score r, const cand *c)
     return r;
 }
 
+/* eval_loop for a line whose cross products fit in 64 bits (bs_pline.small,
+ * nearly every line): bs_side's arithmetic with the line held in registers,
+ * the sides counted unreversed and swapped once at the end */
+static score eval_small(const bs_chooser *C, const cand *c, const uint32_t *segs, const int32_t *xy, uint32_t n,
+                        int64_t best)
+{
+    const bs_tree *t = C->t;
+    const bs_pline *L = &t->plines[c->pl];
+    const int64_t x0 = L->x, y0 = L->y, dx = L->rdx, dy = L->rdy, thr = L->thr;
+    bs_part p = {c->pl, c->rev, 0, 0};
+    uint32_t right = 0, left = 0, on_f = 0, on_b = 0, splits = 0;
+    score r = {0, 0, 0, 0, 0, 0};
+    for (uint32_t i = 0; i < n; i++) {
+        const int32_t *q = xy + 4 * i;
+        int64_t c1 = (q[0] - x0) * dy - (q[1] - y0) * dx;
+        int64_t c2 = (q[2] - x0) * dy - (q[3] - y0) * dx;
+        int split = 0;
+        if (c1 > thr) { /* a on the right */
+            if (c2 >= -thr)
+                right++;
+            else
+                split = 1;
+        } else if (c1 < -thr) {
+            if (c2 <= thr)
+                left++;
+            else
+                split = 1;
+        } else if (c2 > thr) {
+            right++;
+        } else if (c2 < -thr) {
+            left++;
+        } else if (bs_same_dir(t, &t->segs[segs[i]], p)) {
+            on_f++;
+        } else {
+            on_b++;
+        }
+        if (split && cost_floor(C->mode, ++splits) > best) {
+            r.cut = 1;
+            return r;
+        }
+    }
+    r.front = (c->rev ? left : right) + on_f + splits;
+    r.back = (c->rev ? right : left) + on_b + splits;
+    r.splits = splits;
+    return finish(C->mode, r, c);
+}
+
 /* exact scoring by a loop over the set (xy: its seg ends, 4 per seg, copied
- * together for speed); gives up (invalid) once worse than best */
+ * together for speed); gives up (invalid, cut) once worse than best */
 static score eval_loop(const bs_chooser *C, const cand *c, const uint32_t *segs, const int32_t *xy, uint32_t n,
                        int64_t best)
 {
     const bs_tree *t = C->t;
+    if (t->plines[c->pl].small) return eval_small(C, c, segs, xy, n, best);
     const bs_pline *L = &t->plines[c->pl];
     bs_part p = {c->pl, c->rev, 0, 0};
     score r = {0, 0, 0, 0, 0, 0};
