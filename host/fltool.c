@@ -8,7 +8,12 @@
  *       frame: number, crc32, the camera exactly as the firmware used it, raw and
  *       as exact decimals, mode, present) and DIR/palette.bin (768 bytes).
  *       --flat draws a textured scene in its flat colours (the cameras are
- *       the same: drawing does not steer the walk).
+ *       the same: drawing does not steer the walk). --keys STEPS replaces the
+ *       autopilot by a script (for tests of what happens over time, such as
+ *       doors): STEPS is KEYS*N[,KEYS*N...], KEYS letters held for N frames,
+ *       f forward, b back, l turn left, r turn right, '-' nothing; it sets the
+ *       number of frames. Each line also has the time (t_ms) and the ceilings
+ *       not at their compiled height, as build/render's JSON has them.
  *   fltool encode FRAMES.raw --out STREAM [--info FRAMES.jsonl] [--palette P.bin]
  *                 [--key-interval N] [--scratch BYTES] [--sizes] [--scene NAME [--scene-crc HEX]]
  *       Encodes the frames with the C encoder (hello, palette, then one frame
@@ -40,7 +45,7 @@
 
 static int usage_to(FILE *f, int rc)
 {
-    fputs("usage: fltool walk SCENE [--frames N] [--dt MS] [--out DIR] [--flat]\n"
+    fputs("usage: fltool walk SCENE [--frames N] [--dt MS] [--out DIR] [--flat] [--keys STEPS]\n"
           "       fltool encode FRAMES.raw --out STREAM [--info FRAMES.jsonl] [--palette P.bin]\n"
           "                     [--key-interval N] [--scratch BYTES] [--sizes]\n"
           "       fltool decode STREAM [--chunk N] [--frames-out FILE]\n"
@@ -116,6 +121,58 @@ static int ang_diff(int a, int b) /* a - b in (-180, 180] */
     return d > 180 ? d - 360 : d;
 }
 
+/* One script step "KEYS*N" at *p: the keys into *keys, N into *n; the end of the step, or NULL. */
+static const char *key_step(const char *p, uint32_t *keys, long *n)
+{
+    *keys = 0;
+    for (; *p && *p != '*'; p++) {
+        switch (*p) {
+        case 'f': *keys |= HAL_KEY_FORWARD; break;
+        case 'b': *keys |= HAL_KEY_BACK; break;
+        case 'l': *keys |= HAL_KEY_TURN_LEFT; break;
+        case 'r': *keys |= HAL_KEY_TURN_RIGHT; break;
+        case '-': break;
+        default: return NULL;
+        }
+    }
+    if (*p != '*') return NULL;
+    char *end;
+    *n = strtol(p + 1, &end, 10);
+    if (end == p + 1 || *n < 1 || *n > 100000 || (*end && *end != ',')) return NULL;
+    return end;
+}
+
+/* The keys the script holds at frame n; -1 if the script is malformed, 0 past its end. */
+static long script_keys(const char *script, long n, long *total)
+{
+    uint32_t keys = 0, at = 0;
+    long count, sum = 0, found = -1;
+    for (const char *p = script; *p;) {
+        if (!(p = key_step(p, &keys, &count))) return -1;
+        if (found < 0 && n < sum + count) at = keys, found = 1;
+        sum += count;
+        if (*p == ',') p++;
+    }
+    if (total) *total = sum;
+    return found < 0 ? 0 : (long)at;
+}
+
+static void print_ceilings(FILE *f, const engine *e)
+{
+    fprintf(f, "\"ceilings\": {");
+    int first = 1;
+    for (uint32_t i = 0; i < e->sc.nsectors; i++) {
+        fx_t h = obj_ceil(&e->world, &e->sc, i);
+        if (h == e->sc.sectors[i].ceil_h) continue;
+        char key[16], buf[48];
+        snprintf(key, sizeof key, "%u", (unsigned)i);
+        fxtext_format(h, buf, sizeof buf);
+        fprintf(f, "%s\"%s\": %s", first ? "" : ", ", key, buf);
+        first = 0;
+    }
+    fprintf(f, "}");
+}
+
 static void print_fx(FILE *f, const char *key, int32_t v, const char *sep)
 {
     char buf[48];
@@ -125,7 +182,7 @@ static void print_fx(FILE *f, const char *key, int32_t v, const char *sep)
 
 static int cmd_walk(int argc, char **argv)
 {
-    const char *spec = NULL, *out = ".";
+    const char *spec = NULL, *out = ".", *script = NULL;
     long frames = 200, dt = 50;
     int flat = 0;
     for (int i = 0; i < argc; i++) {
@@ -137,10 +194,16 @@ static int cmd_walk(int argc, char **argv)
             dt = atol(argv[++i]);
         else if (!strcmp(argv[i], "--out") && i + 1 < argc)
             out = argv[++i];
+        else if (!strcmp(argv[i], "--keys") && i + 1 < argc)
+            script = argv[++i];
         else if (argv[i][0] != '-' && !spec)
             spec = argv[i];
         else
             return usage();
+    }
+    if (script && script_keys(script, 0, &frames) < 0) {
+        fprintf(stderr, "fltool: --keys '%s': expected KEYS*N[,KEYS*N...], KEYS of f b l r -\n", script);
+        return 2;
     }
     if (!spec || frames < 1 || dt < 1) return usage();
     char err[512];
@@ -199,6 +262,7 @@ static int cmd_walk(int argc, char **argv)
         if (diff > 3) keys |= HAL_KEY_TURN_LEFT;
         if (diff < -3) keys |= HAL_KEY_TURN_RIGHT;
         if (abs(diff) < 60 && free_dist(&e.sc, c->x, c->y, z, here, 32, NULL) >= 16) keys |= HAL_KEY_FORWARD;
+        if (script) keys = (uint32_t)script_keys(script, n, NULL);
         eng_step(&e, keys, (uint32_t)dt);
         if ((keys & HAL_KEY_FORWARD) && c->x == lastx && c->y == lasty)
             stuck++;
@@ -215,8 +279,11 @@ static int cmd_walk(int argc, char **argv)
         print_fx(fj, "y", c->y, ", ");
         print_fx(fj, "z", c->z, ", ");
         print_fx(fj, "angle", c->angle_deg, ", ");
-        fprintf(fj, "\"look\": %d}, \"raw\": [%d, %d, %d, %d, %d], \"mode\": %d, \"present\": %d}\n", (int)c->look,
-                (int)c->x, (int)c->y, (int)c->z, (int)c->angle_deg, (int)c->look, (int)e.mode, (int)e.present);
+        fprintf(fj, "\"look\": %d}, \"raw\": [%d, %d, %d, %d, %d], \"mode\": %d, \"present\": %d, \"t_ms\": %u, ",
+                (int)c->look, (int)c->x, (int)c->y, (int)c->z, (int)c->angle_deg, (int)c->look, (int)e.mode,
+                (int)e.present, (unsigned)e.t_ms);
+        print_ceilings(fj, &e);
+        fprintf(fj, "}\n");
     }
     fclose(fr);
     fclose(fj);

@@ -241,3 +241,61 @@ def test_absent_device(tmp_path):
     assert s["exit"] == 3, s["stderr"]
     assert "no device found for 1209:00ff" in s["stderr"]
     assert "1209:0001" in s["stderr"]              # the attached DFU device is named
+
+
+def manifestation_tail(tolerant):
+    """The states a DFU 1.1 device goes through from the last block on (section 7): a
+    manifestation-tolerant one comes back to dfuIDLE, another waits for the reset; either
+    way the reset boots the new firmware."""
+    after = "dfuIDLE" if tolerant else "dfuMANIFEST-WAIT-RESET"
+    return ["dfuDNLOAD-IDLE", "dfuMANIFEST-SYNC", "dfuMANIFEST", after, "appIDLE"]
+
+
+@pytest.mark.parametrize("tolerant", [True, False])
+def test_manifestation_writes_the_mark_last(tmp_path, tolerant):
+    """Manifestation end to end: the states the device goes through, the bwPollTimeout it asks
+    for and the host waits out, and the order of the flash writes: the old mark erased before
+    any application page, every image byte programmed once in order, then the 16-byte mark in
+    the last page as the very last write."""
+    payload = os.urandom(3 * PAGE + 1234)
+    dfu = make_dfu(tmp_path, payload)
+    region = tmp_path / "region.bin"
+    extra = [] if tolerant else ["--not-tolerant"]
+    s = run_mock("ok", [dfu, "--device", "1209:0001", "-v"], *extra, out=region)
+    assert s["exit"] == 0, s["stderr"]
+    dev = s["devices"][0]
+    assert dev["manifest_tolerant"] is tolerant
+    assert ("device is manifestation-tolerant" in s["stderr"]) is tolerant
+    assert "the device verified the image and marked it valid" in s["stdout"]
+    assert "runs the new firmware (appIDLE)" in s["stdout"]
+    assert dev["states_seen"][-5:] == manifestation_tail(tolerant), dev["states_seen"]
+    assert dev["resets"] == 1 and dev["stalls"] == 0
+
+    # GETSTATUS in dfuMANIFEST asks for the manifestation time; the host asks again only after it
+    gs = dev["getstatus"]
+    at = [i for i, (_, state, _) in enumerate(gs) if state == "dfuMANIFEST"]
+    assert len(at) == 1, gs
+    t, _, poll = gs[at[0]]
+    assert poll == dev["manifest_ms"]
+    t_next, state_next, poll_next = gs[at[0] + 1]
+    assert state_next == manifestation_tail(tolerant)[3] and poll_next == 0
+    assert t_next - t >= poll
+
+    # the writes: mark erased first, the image in order, the mark last
+    mark = SLOT_SIZE - PAGE
+    log = dev["flash_log"]
+    assert log[0] == ["erase", mark], log[:3]
+    assert log[-1] == ["program", mark, 16], log[-3:]
+    assert [e for e in log if e[0] == "program" and e[1] >= mark] == [["program", mark, 16]]
+    pages = (len(payload) + PAGE - 1) // PAGE
+    assert [e[1] for e in log if e[0] == "erase"] == [mark] + [k * PAGE for k in range(pages)]
+    end = 0
+    for e in log[1:-1]:
+        if e[0] == "program":
+            assert e[1] == end, (e, end)
+            end += e[2]
+    assert end == len(payload)
+    mem = region.read_bytes()
+    assert mem[:len(payload)] == payload
+    valid, length, crc = app_check(mem)
+    assert valid and length == len(payload) and crc == zlib.crc32(payload)

@@ -399,3 +399,81 @@ def test_battle_demo(view, t, tmp_path):
     assert same >= 0.995, f"only {same:.4%} of pixels agree with the reference"
     rows, _ = misplaced_object_pixels(c, ref)
     assert rows.size == 0, f"{rows.size} object pixels where the reference has a nearer surface"
+
+
+# ---- doors over time, the player walking (build/fltool walk --keys: eng_step frame by frame) ----
+
+DOOR_BOX = (-16, 160, 0, 224)    # the door sector of objects.scene (xmin, ymin, xmax, ymax)
+DOOR_OPEN, DOOR_SPEED, DOOR_WAIT_MS, DOOR_REACH = 112, 128, 3000, 64   # docs/objects.md
+
+
+def door_triggered(raw_x, raw_y):
+    """docs/objects.md: the player within 64 units of a door wall, or in the door; decided on
+    the 1/16 grid. The door is a box, so that is the distance to the box."""
+    gx, gy = raw_x >> 12, raw_y >> 12
+    x0, y0, x1, y1 = (v * 16 for v in DOOR_BOX)
+    dx, dy = max(x0 - gx, 0, gx - x1), max(y0 - gy, 0, gy - y1)
+    return dx * dx + dy * dy <= (DOOR_REACH * 16) ** 2
+
+
+def door_model(triggered, dt):
+    """The door's ceiling (16.16) after each frame, from the rules written out millisecond by
+    millisecond: rise at 128 units/s while triggered; once open, stay open 3 s from the last
+    triggered frame, then fall at 128 units/s; triggered again while falling, rise again."""
+    rate = DOOR_SPEED << 16                              # 16.16 units per 1000 ms
+    full = -(-(DOOR_OPEN << 16) * 1000 // rate)          # ms from closed to open
+    travel, wait, out = 0, 0, []
+    for trig in triggered:
+        if trig:
+            wait, travel = DOOR_WAIT_MS, min(full, travel + dt)
+        else:
+            for _ in range(dt):
+                if wait and travel == full:
+                    wait -= 1
+                else:
+                    wait, travel = 0, max(0, travel - 1)
+        out.append(min(DOOR_OPEN << 16, travel * rate // 1000))
+    return out
+
+
+@pytest.mark.parametrize("dt", [50, 29])
+def test_door_timing_while_walking(tmp_path, dt):
+    """The player walks up to the closet's door, waits, leaves, comes back while it closes and
+    leaves again, frame by frame through the engine (build/fltool walk --keys). Each frame's
+    door ceiling is what the rules give for the positions the walk went through, and the named
+    moments fall where the rules put them: open 875 ms after the first triggered frame, open
+    for 3 s after the last, then closed 875 ms later."""
+    per_s = 1000 // dt
+    script = (f"b*{per_s // 3},-*{per_s * 3 // 2},f*{per_s // 2},-*{per_s * 5 // 2},"
+              f"b*{per_s // 2},-*{per_s * 3 // 2},f*{per_s // 2},-*{per_s * 5}")
+    run([program("fltool"), "walk", SCENE, "--keys", script, "--dt", dt, "--out", tmp_path])
+    frames = [json.loads(line) for line in (tmp_path / "frames.jsonl").read_text().splitlines()]
+    assert [f["t_ms"] for f in frames] == [dt * (n + 1) for n in range(len(frames))]
+    trig = [door_triggered(f["raw"][0], f["raw"][1]) for f in frames]
+    got = [round(float(f["ceilings"].get(str(DOOR), 0)) * 65536) for f in frames]
+    # the walk does what the script means: near, away (long enough to close partly), near, away
+    runs = [k for k in range(1, len(trig)) if trig[k] != trig[k - 1]]
+    assert trig[0] is False and len(runs) == 4, runs
+    first, leave1, back, leave2 = runs
+    assert got == door_model(trig, dt)
+
+    full_ms, rate = -(-DOOR_OPEN * 1000 // DOOR_SPEED), DOOR_SPEED << 16
+    opened = first + -(-full_ms // dt) - 1                  # the frame it reaches 112
+    assert all(g == 0 for g in got[:first])
+    assert got[opened] == DOOR_OPEN << 16 and got[opened - 1] < DOOR_OPEN << 16
+    assert all(0 < g < DOOR_OPEN << 16 for g in got[first:opened])
+    # open from then until 3 s after the last triggered frame, then falling
+    last = leave1 - 1
+    stays = last + DOOR_WAIT_MS // dt                       # the last frame the 3 s cover whole
+    assert all(g == DOOR_OPEN << 16 for g in got[opened:stays + 1])
+    assert got[stays + 1] < DOOR_OPEN << 16
+    # back while it falls: it rises again from where it was, at the same speed
+    assert 0 < got[back - 1] < DOOR_OPEN << 16
+    assert got[back] - got[back - 1] == pytest.approx(dt * rate / 1000, abs=1)
+    # after the second visit: open 3 s, then closed the travel time later
+    last = leave2 - 1
+    stays = last + DOOR_WAIT_MS // dt
+    closed = last + -(-(DOOR_WAIT_MS + full_ms) // dt)      # the first frame that ends past both
+    assert got[stays] == DOOR_OPEN << 16 and got[stays + 1] < DOOR_OPEN << 16
+    assert got[closed] == 0 and got[closed - 1] > 0
+    assert all(g == 0 for g in got[closed:])

@@ -56,6 +56,46 @@ def test_present_modes_count_like_the_book(compiled, present, copy_writes, vram)
         j["sysmem_writes"] * j["bus_model"]["sysmem_cycles"]
 
 
+WIDTH_KEY = {1: "writes8", 2: "writes16", 4: "writes32"}
+
+
+@pytest.mark.parametrize("mode", ["direct", "painter"])
+@pytest.mark.parametrize("present,width", [("copy8", 1), ("copy16", 2), ("copy32", 4)])
+def test_copy_adds_exactly_one_page_of_writes(compiled, mode, present, width):
+    """The same frame drawn for flip and for a copy mode: the drawing is the same writes (in
+    VRAM for flip, in system memory for a copy), so the difference is the copy alone, derived
+    from the mode: 64,000 bytes in 64,000 / width writes of that width, all into VRAM."""
+    flip = render(str(compiled), "--mode", mode, "--present", "flip")
+    copy = render(str(compiled), "--mode", mode, "--present", present)
+    n = 64000 // width
+    for j in (flip, copy):
+        assert j["bytes"] == j["writes8"] + 2 * j["writes16"] + 4 * j["writes32"]
+        assert j["writes"] == j["writes8"] + j["writes16"] + j["writes32"]
+        assert j["writes"] == j["vram_writes"] + j["sysmem_writes"]
+    # page flip writes nothing: the drawing is every write, and it writes each drawn pixel once
+    assert flip["copy_writes"] == 0 and flip["sysmem_writes"] == 0
+    assert flip["bytes"] == flip["pixels_written"]
+    assert copy["copy_writes"] == n and copy["vram_writes"] == n
+    assert copy["sysmem_writes"] == flip["vram_writes"]
+    assert copy["writes"] - flip["writes"] == n
+    assert copy["bytes"] - flip["bytes"] == 64000
+    for w, key in WIDTH_KEY.items():
+        assert copy[key] - flip[key] == (n if w == width else 0), key
+    bus = copy["bus_model"]
+    assert copy["bus_cycles"] == flip["vram_writes"] * bus["sysmem_cycles"] + n * bus["vram_cycles"]
+
+
+@pytest.mark.parametrize("present", ["flip", "copy16"])
+def test_counters_are_per_frame(compiled, present):
+    """--repeat N reports the last frame's counters: the same as one frame, not N times them."""
+    one = render(str(compiled), "--present", present)
+    three = render(str(compiled), "--present", present, "--repeat", "3")
+    assert three["frames"] == 3
+    for key in ("writes", "bytes", "writes8", "writes16", "writes32", "vram_writes", "sysmem_writes",
+                "copy_writes", "bus_cycles"):
+        assert three[key] == one[key], key
+
+
 def test_present_modes_show_the_same_frame(compiled):
     crcs = {render(str(compiled), "--present", p)["crc32"] for p in ("flip", "copy8", "copy16", "copy32")}
     assert len(crcs) == 1

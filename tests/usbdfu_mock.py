@@ -152,6 +152,7 @@ class RamFlash:
         self.base = ctypes.addressof(self._cbuf)
         self.fail_program_from = None
         self.erases = self.programs = 0
+        self.log = []   # ["erase", offset] and ["program", offset, n], in the order done
         # keep the callbacks alive as long as the flash
         self.cb = (ERASE_FN(self._erase), PROGRAM_FN(self._program), READ_FN(self._read))
         self.desc = DfuFlash(None, size, page_size, *self.cb)
@@ -160,6 +161,7 @@ class RamFlash:
         if off % self.page_size or off >= self.size:
             return -1
         self.erases += 1
+        self.log.append(["erase", off])
         self.mem[off:off + self.page_size] = b"\xff" * self.page_size
         return 0
 
@@ -169,6 +171,7 @@ class RamFlash:
         if self.fail_program_from is not None and off + n > self.fail_program_from:
             return -1
         self.programs += 1
+        self.log.append(["program", off, n])
         new = int.from_bytes(ctypes.string_at(src, n), "little")
         old = int.from_bytes(self.mem[off:off + n], "little")
         self.mem[off:off + n] = (old & new).to_bytes(n, "little")
@@ -205,12 +208,13 @@ def string_descriptor(text):
 # ---- one emulated device --------------------------------------------------------------
 
 class Device:
-    def __init__(self, mock, index, serial, vid, pid, region_size, page_size):
+    def __init__(self, mock, index, serial, vid, pid, region_size, page_size, tolerant=True):
         self.mock, self.index, self.serial, self.vid, self.pid = mock, index, serial, vid, pid
         self.port = index + 1
         self.devnum = 2 + index
         self.flash = RamFlash(region_size, page_size)
-        self.cfg = DfuConfig(ATTR_DNLOAD | ATTR_UPLOAD | ATTR_TOLERANT, 4096, 1000, 5, 20, 100)
+        self.cfg = DfuConfig(ATTR_DNLOAD | ATTR_UPLOAD | (ATTR_TOLERANT if tolerant else 0), 4096, 1000, 5, 20,
+                             100)
         self.dev = DfuDev()
         self.lib = mock.lib
         if self.lib.dfu_dev_init(ctypes.byref(self.dev), ctypes.byref(self.cfg),
@@ -224,6 +228,8 @@ class Device:
         self.requests = {name: 0 for name in REQ_NAMES}
         self.stalls = self.resets = self.enumerations = 0
         self.blocks_done = 0         # DNLOAD blocks the host saw written (GETSTATUS -> DNLOAD-IDLE)
+        self.getstatus = []          # each GETSTATUS answered: [ms since the first, bState, bwPollTimeout]
+        self.t0 = None
         self.note_state()
 
     # state bookkeeping
@@ -303,6 +309,13 @@ class Device:
         if res != 0:
             self.stalls += 1
             return None
+        if req == 3 and actual.value >= 6:
+            t = now_ms()
+            self.t0 = t if self.t0 is None else self.t0
+            reply = bytes(buf)
+            self.getstatus.append([(t - self.t0) & 0xFFFFFFFF,
+                                   STATE_NAMES[reply[4]] if reply[4] < len(STATE_NAMES) else str(reply[4]),
+                                   reply[1] | reply[2] << 8 | reply[3] << 16])
         if rtype & 0x80:
             return bytes(buf)[:actual.value]
         return b""
@@ -324,6 +337,8 @@ class Device:
             "app_valid": bool(valid), "app_length": info.length, "app_crc": info.crc,
             "region_sha256": hashlib.sha256(self.flash.mem).hexdigest(),
             "erases": self.flash.erases, "programs": self.flash.programs,
+            "flash_log": self.flash.log, "getstatus": self.getstatus,
+            "manifest_ms": self.cfg.manifest_ms, "manifest_tolerant": bool(self.cfg.attributes & ATTR_TOLERANT),
         }
 
 
@@ -484,7 +499,7 @@ class Mock:
         self.t0 = time.monotonic()
         serials = args.serials.split(",")
         region = args.region_size or (64 * 1024 if args.scenario == "stall" else SLOT_SIZE)
-        self.devices = [Device(self, i, sn, args.vid, args.pid, region, PAGE_SIZE)
+        self.devices = [Device(self, i, sn, args.vid, args.pid, region, PAGE_SIZE, not args.not_tolerant)
                         for i, sn in enumerate(serials)]
         self.target = self.devices[0]
         if args.scenario == "errwrite":
@@ -582,6 +597,8 @@ def main(argv):
     ap.add_argument("--vid", type=lambda s: int(s, 16), default=0x1209)
     ap.add_argument("--pid", type=lambda s: int(s, 16), default=0x0001)
     ap.add_argument("--region-size", type=int, default=0)
+    ap.add_argument("--not-tolerant", action="store_true",
+                    help="the devices are not manifestation-tolerant (bmAttributes bit 2 clear)")
     ap.add_argument("--reenum-ms", type=int, default=300, help="how long a re-enumeration takes")
     ap.add_argument("--out", help="write device 0's flash region here")
     ap.add_argument("--lib", default=str(ROOT / "build" / "libdfudev.so"))
