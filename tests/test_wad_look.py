@@ -206,8 +206,9 @@ def texture1(name=b"WALLA", w=64, h=64, patch_index=0, count=None):
     return struct.pack("<II", n, 8) + tex
 
 
-def small_wad(freedoom2, **over):
-    """A room of 4 one-sided lines, its walls WALLA (one patch), floor and ceiling FLATA."""
+def small_wad(freedoom2, before=(), **over):
+    """A room of 4 one-sided lines, its walls WALLA (one patch), floor and ceiling FLATA; the lumps of
+    before (name, data) come ahead of the palette."""
     lumps = read_wad(freedoom2)
     room = [(0, 0), (0, 256), (256, 256), (256, 0)]
     verts = b"".join(struct.pack("<hh", x, y) for x, y in room)
@@ -222,7 +223,7 @@ def small_wad(freedoom2, **over):
     }
     parts.update(over)
     out = [("MAP01", b""), ("THINGS", things), ("LINEDEFS", lines), ("SIDEDEFS", sides), ("VERTEXES", verts),
-           ("SECTORS", sector)]
+           ("SECTORS", sector), *before]
     for k in ("PLAYPAL", "COLORMAP", "PNAMES", "TEXTURE1", "PATCHA"):
         if parts[k] is not None:
             out.append((k, parts[k]))
@@ -283,3 +284,50 @@ def test_small_wad_compiles_with_its_look_and_without_texture1_flat(tmp_path):
     wad.write_bytes(small_wad(freedoom("freedoom2.wad"), TEXTURE1=None))
     blob = compile_map(tmp_path, f"{wad}:MAP01")
     assert all(sections(blob)[i][1] == 0 for i in range(SEC_LOOK, SEC_PLANES + 1))
+
+
+def texture_lump(entries):
+    """A TEXTURE1 of entries in order: (name, width) for a texture of one patch (PNAMES 0), 64 high, or an
+    int for an entry whose offset is that number."""
+    base, body, offs = 4 + 4 * len(entries), b"", []
+    for e in entries:
+        if isinstance(e, int):
+            offs.append(e)
+            continue
+        offs.append(base + len(body))
+        body += struct.pack("<8sIhhIH", e[0], 0, e[1], 64, 0, 1) + struct.pack("<hhHhh", 0, 0, 0, 1, 0)
+    return struct.pack("<I", len(entries)) + b"".join(struct.pack("<I", o) for o in offs) + body
+
+
+def compile_small(tmp_path, **over):
+    wad = tmp_path / "t.wad"
+    wad.write_bytes(small_wad(freedoom("freedoom2.wad"), **over))
+    out = tmp_path / "o.bsc"
+    out.unlink(missing_ok=True)
+    proc = run([program("bspc"), f"{wad}:MAP01", "-o", out], check=False)
+    assert "Sanitizer" not in proc.stderr and "runtime error" not in proc.stderr, proc.stderr
+    return proc, out
+
+
+def test_texture_definitions_are_searched_in_doom_order(tmp_path):
+    """TEXTURE1 is searched from its first entry: a damaged entry after the texture used is never reached,
+    one before it refuses the map, and of two definitions of a name the first is used."""
+    proc, out = compile_small(tmp_path, TEXTURE1=texture_lump([(b"WALLA", 64), 999999]))
+    assert proc.returncode == 0, proc.stderr
+    proc, out = compile_small(tmp_path, TEXTURE1=texture_lump([999999, (b"WALLA", 64)]))
+    assert proc.returncode == 1 and "TEXTURE1: texture 0 at offset 999999 runs past the end" in proc.stderr
+    assert not out.exists()
+    for widths, wide in (((128, 64), True), ((64, 128), False)):
+        proc, out = compile_small(tmp_path, TEXTURE1=texture_lump([(b"WALLA", w) for w in widths]))
+        assert proc.returncode == 0, proc.stderr
+        assert any(t[1] == 7 for t in textures(out.read_bytes())) == wide, widths
+
+
+def test_the_last_lump_of_a_name_is_the_patch(tmp_path):
+    """A patch name found twice in the directory is the later lump, as in Doom."""
+    proc, out = compile_small(tmp_path, before=[("PATCHA", patch_lump(colour=9))])
+    assert proc.returncode == 0, proc.stderr
+    blob = out.read_bytes()
+    toff = sections(blob)[SEC_TEXELS][0]
+    texels = {blob[toff + t[0]:toff + t[0] + 4096] for t in textures(blob)}
+    assert bytes([5]) * 4096 in texels and bytes([9]) * 4096 not in texels

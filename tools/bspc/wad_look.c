@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "bspc_int.h"
+#include "name_table.h"
 
 enum { KIND_WALL, KIND_FLAT };
 
@@ -55,7 +56,19 @@ struct bs_wadlook {
     uint32_t nflats;   /* valid once flats is set */
     uint32_t *sprites; /* the same for the sprite markers */
     uint32_t nsprites;
+    name_table lumps;     /* the directory, the last of a name winning (lumps.e NULL until needed) */
+    name_table flat_name; /* the flats, the same */
+    name_table texdefs;   /* TEXTURE1 then TEXTURE2 up to the first bad entry, the first winning:
+                           * entry i of TEXTURE1 is i, entry i of TEXTURE2 is texdef_n0 + i */
+    uint32_t texdef_n0;
+    int bad_kind;             /* what stopped that indexing: BAD_NONE, BAD_COUNT or BAD_ENTRY ... */
+    int bad_lump;             /* ... in TEXTURE1 (0) or TEXTURE2 (1) ... */
+    uint32_t bad_entry;       /* ... at this entry */
+    uint8_t def_palette[768]; /* the flat-shaded palette (bs_palette), for things.txt's colours */
+    int have_def_palette;
 };
+
+enum { BAD_NONE, BAD_COUNT, BAD_ENTRY };
 
 static uint16_t rd16(const uint8_t *p)
 {
@@ -229,38 +242,86 @@ static int draw_patch(const bs_wadlook *L, const uint8_t *p, uint32_t size, cons
 
 /* ---- wall textures ---- */
 
-/* Find name in TEXTURE1 then TEXTURE2 (the first definition wins, as in Doom):
- * the lump number (0, 1) and the definition's offset, or -1. */
-static int find_texdef(const bs_wadlook *L, const char *name, int *which, uint32_t *off, char *err, size_t errlen)
+static const char *const texdef_lump[2] = {"TEXTURE1", "TEXTURE2"};
+
+/* The number of definitions lump t declares, or -1 if they cannot fit it. */
+static int64_t texdef_count(const bs_wadlook *L, int t)
 {
-    static const char *lumpname[2] = {"TEXTURE1", "TEXTURE2"};
+    if (!L->tdef[t]) return 0;
+    uint32_t n = rd32(L->tdef[t]);
+    return n > (L->tdsize[t] - 4) / 4 ? -1 : (int64_t)n;
+}
+
+/* Index TEXTURE1 then TEXTURE2 once, in Doom's search order, up to the first
+ * entry that a search would refuse (noted in bad_*): a name found in the index
+ * is the one the search finds, and a name not in it meets the refusal first. */
+static int index_texdefs(bs_wadlook *L)
+{
+    if (L->texdefs.e) return 0;
+    int64_t n[2] = {texdef_count(L, 0), texdef_count(L, 1)};
+    if (nt_init(&L->texdefs, (uint32_t)((n[0] > 0 ? n[0] : 0) + (n[1] > 0 ? n[1] : 0)))) return -1;
+    L->texdef_n0 = n[0] > 0 ? (uint32_t)n[0] : 0;
+    L->bad_kind = BAD_NONE;
     for (int t = 0; t < 2; t++) {
+        if (n[t] < 0) {
+            L->bad_kind = BAD_COUNT;
+            L->bad_lump = t;
+            return 0;
+        }
         const uint8_t *d = L->tdef[t];
         uint32_t sz = L->tdsize[t];
-        if (!d) continue;
-        uint32_t n = rd32(d);
-        if (n > (sz - 4) / 4)
-            return bs_fail(err, errlen, "%s: lump %s: %u textures do not fit its %u bytes", L->wad, lumpname[t], n, sz);
-        for (uint32_t i = 0; i < n; i++) {
+        for (uint32_t i = 0; i < (uint32_t)n[t]; i++) {
             uint32_t o = rd32(d + 4 + 4 * i);
-            if (o > sz || sz - o < 22)
-                return bs_fail(err, errlen, "%s: lump %s: texture %u at offset %u runs past the end (%u bytes)", L->wad,
-                               lumpname[t], i, o, sz);
+            if (o > sz || sz - o < 22) {
+                L->bad_kind = BAD_ENTRY;
+                L->bad_lump = t;
+                L->bad_entry = i;
+                return 0;
+            }
             char nm[9];
             name8(nm, d + o);
-            if (strcmp(nm, name) == 0) {
-                *which = t;
-                *off = o;
-                return 1;
-            }
+            nt_put(&L->texdefs, nm, t ? L->texdef_n0 + i : i, 0);
         }
     }
     return 0;
 }
 
+/* Find name in TEXTURE1 then TEXTURE2 (the first definition wins, as in Doom):
+ * the lump number (0, 1) and the definition's offset, or -1. */
+static int find_texdef(bs_wadlook *L, const char *name, int *which, uint32_t *off, char *err, size_t errlen)
+{
+    if (index_texdefs(L)) return bs_fail(err, errlen, "%s: out of memory", L->wad);
+    uint32_t k = nt_get(&L->texdefs, name);
+    if (k != NT_NONE) {
+        *which = k >= L->texdef_n0;
+        uint32_t i = *which ? k - L->texdef_n0 : k;
+        *off = rd32(L->tdef[*which] + 4 + 4 * i);
+        return 1;
+    }
+    int t = L->bad_lump;
+    uint32_t sz = L->tdsize[t];
+    if (L->bad_kind == BAD_COUNT)
+        return bs_fail(err, errlen, "%s: lump %s: %u textures do not fit its %u bytes", L->wad, texdef_lump[t],
+                       rd32(L->tdef[t]), sz);
+    if (L->bad_kind == BAD_ENTRY)
+        return bs_fail(err, errlen, "%s: lump %s: texture %u at offset %u runs past the end (%u bytes)", L->wad,
+                       texdef_lump[t], L->bad_entry, rd32(L->tdef[t] + 4 + 4 * L->bad_entry), sz);
+    return 0;
+}
+
+/* The directory and the flats by name, once (the last of a name wins). */
+static int index_lumps(bs_wadlook *L)
+{
+    if (L->lumps.e) return 0;
+    if (nt_init(&L->lumps, L->ndir)) return -1;
+    for (uint32_t i = 0; i < L->ndir; i++) nt_put(&L->lumps, L->dir[i].name, i, 1);
+    return 0;
+}
+
 static int compose_wall(bs_wadlook *L, const char *name, uint16_t *out, char *err, size_t errlen)
 {
-    static const char *lumpname[2] = {"TEXTURE1", "TEXTURE2"};
+    const char *const *lumpname = texdef_lump;
+    if (index_lumps(L)) return bs_fail(err, errlen, "%s: out of memory", L->wad);
     int which = 0;
     uint32_t off = 0;
     int f = find_texdef(L, name, &which, &off, err, errlen);
@@ -291,8 +352,8 @@ static int compose_wall(bs_wadlook *L, const char *name, uint16_t *out, char *er
         }
         char pn[9];
         name8(pn, L->pnames + 4 + 8 * pi);
-        uint32_t li = find_lump(L, pn, 0, L->ndir);
-        if (li == L->ndir) {
+        uint32_t li = nt_get(&L->lumps, pn);
+        if (li == NT_NONE) {
             rc = bs_fail(err, errlen, "%s: texture %s: patch %s (PNAMES entry %u) is not in the WAD", L->wad, name, pn,
                          pi);
             break;
@@ -334,15 +395,21 @@ static int list_flats(bs_wadlook *L)
         else if (in)
             L->flats[L->nflats++] = i;
     }
+    if (nt_init(&L->flat_name, L->nflats)) {
+        free(L->flats);
+        L->flats = NULL;
+        L->nflats = 0;
+        return -1;
+    }
+    for (uint32_t k = 0; k < L->nflats; k++) nt_put(&L->flat_name, L->dir[L->flats[k]].name, L->flats[k], 1);
     return 0;
 }
 
 /* the last flat of that name between the markers, or ndir */
 static uint32_t find_flat(const bs_wadlook *L, const char *name)
 {
-    for (uint32_t k = L->nflats; k-- > 0;)
-        if (strcmp(L->dir[L->flats[k]].name, name) == 0) return L->flats[k];
-    return L->ndir;
+    uint32_t li = nt_get(&L->flat_name, name);
+    return li == NT_NONE ? L->ndir : li;
 }
 
 static int compose_flat(bs_wadlook *L, const char *name, uint16_t *out, char *err, size_t errlen)
@@ -588,14 +655,17 @@ static int list_sprites(bs_wadlook *L)
 
 uint8_t bs_look_thing_colour(bs_wadlook *L, const char prefix[4], uint8_t fallback)
 {
-    uint8_t def[768];
-    bs_palette(def);
+    if (!L->have_def_palette) {
+        bs_palette(L->def_palette);
+        L->have_def_palette = 1;
+    }
+    const uint8_t *def = L->def_palette;
     uint8_t colour = nearest(L->lk->palette, def[3 * fallback], def[3 * fallback + 1], def[3 * fallback + 2]);
     if (list_sprites(L)) return colour; /* out of memory: things.txt's colour */
     for (uint32_t k = 0; k < L->nsprites; k++) {
         uint32_t i = L->sprites[k];
         const char *n = L->dir[i].name;
-        if (strncmp(n, prefix, 4) == 0 && n[4] == 'A' && (n[5] == '0' || n[5] == '1')) {
+        if (n[0] == prefix[0] && strncmp(n, prefix, 4) == 0 && n[4] == 'A' && (n[5] == '0' || n[5] == '1')) {
             uint8_t *p;
             char msg[300];
             uint64_t count = 0;
@@ -633,5 +703,8 @@ void bs_look_close(bs_wadlook *L)
     free(L->mean);
     free(L->flats);
     free(L->sprites);
+    nt_free(&L->lumps);
+    nt_free(&L->flat_name);
+    nt_free(&L->texdefs);
     free(L);
 }
