@@ -268,7 +268,10 @@ static int64_t cost_of(int mode, uint32_t f, uint32_t b, uint32_t sp, int diag)
     default: {
         /* imbalance matters most when one side is nearly empty (a peel-off) */
         int64_t m = f < b ? f : b;
-        return (int64_t)sp * SPLIT_COST + imb * BAL_Q / (m + BAL_Q) + (diag ? DIAG_COST : 0);
+        /* the same quotient in 32 bits when it fits (a division costs less) */
+        int64_t bal = imb < (1 << 26) ? (int64_t)((uint32_t)imb * BAL_Q / (uint32_t)(m + BAL_Q))
+                                      : imb * BAL_Q / (m + BAL_Q);
+        return (int64_t)sp * SPLIT_COST + bal + (diag ? DIAG_COST : 0);
     }
     }
 }
@@ -587,6 +590,8 @@ static void sweep_axis(bs_chooser *C, const index_set *x, int a, ranked *top, ui
         while (hi_le < A->nn && val_of(A->hi[hi_le]) <= hi) hi_le++;
         while (al_lt < A->nal && val_of(A->al[al_lt]) < lo) pos_lt += (uint32_t)(A->al[al_lt++] >> 31) & 1u;
         while (al_le < A->nal && val_of(A->al[al_le]) <= hi) pos_le += (uint32_t)(A->al[al_le++] >> 31) & 1u;
+        /* a candidate whose splits alone cost more than the last ranked one is not scored */
+        if (*ntop == k && cost_floor(C->mode, lo_lt - hi_le) >= top[k - 1].s.cost) continue;
         score s = axis_score(C->mode, &c, A->nn, lo_lt, hi_le, al_lt, al_le, pos_lt, pos_le, A->nal, npos);
         if (s.valid) rank_insert(top, ntop, k, &c, s);
     }
