@@ -215,13 +215,23 @@ static void sort_keys(uint64_t *a, uint32_t n, uint64_t *tmp)
         }
         return;
     }
+    /* the four digits' counts in one pass (a pass's order does not change them) */
+    uint32_t cnt[4][257];
+    memset(cnt, 0, sizeof cnt);
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t k = (uint32_t)(a[i] >> 32);
+        cnt[0][(k & 255u) + 1]++;
+        cnt[1][((k >> 8) & 255u) + 1]++;
+        cnt[2][((k >> 16) & 255u) + 1]++;
+        cnt[3][(k >> 24) + 1]++;
+    }
     uint64_t *src = a, *dst = tmp;
-    for (int shift = 32; shift < 64; shift += 8) {
-        uint32_t cnt[257] = {0};
-        for (uint32_t i = 0; i < n; i++) cnt[((src[i] >> shift) & 255u) + 1]++;
-        if (cnt[((src[0] >> shift) & 255u) + 1] == n) continue;
-        for (int k = 0; k < 256; k++) cnt[k + 1] += cnt[k];
-        for (uint32_t i = 0; i < n; i++) dst[cnt[(src[i] >> shift) & 255u]++] = src[i];
+    for (int d = 0; d < 4; d++) {
+        int shift = 32 + 8 * d;
+        uint32_t *c = cnt[d];
+        if (c[((src[0] >> shift) & 255u) + 1] == n) continue;
+        for (int k = 0; k < 256; k++) c[k + 1] += c[k];
+        for (uint32_t i = 0; i < n; i++) dst[c[(src[i] >> shift) & 255u]++] = src[i];
         uint64_t *s = src;
         src = dst;
         dst = s;
