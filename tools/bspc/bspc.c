@@ -119,6 +119,41 @@ static void place_objects(bs_scene *s, const bs_tree *t, const bspc_options *opt
     s->nobjects = kept;
 }
 
+/* a * b mod the CRC-32 polynomial, in crc_update's reflected bit order (bit 31
+ * holds x^0) */
+static uint32_t crc_mulmod(uint32_t a, uint32_t b)
+{
+    uint32_t p = 0;
+    for (uint32_t m = 1u << 31; m; m >>= 1) {
+        if (a & m) p ^= b;
+        b = (b & 1u) ? (b >> 1) ^ 0xEDB88320u : b >> 1;
+    }
+    return p;
+}
+
+/* x^(8 n) mod the polynomial: what n bytes after a message multiply its CRC's
+ * linear part by */
+static uint32_t crc_zeros(uint64_t n)
+{
+    uint32_t r = 1u << 31, sq = 1u << 23; /* x^0, x^8 */
+    for (; n; n >>= 1) {
+        if (n & 1u) r = crc_mulmod(r, sq);
+        sq = crc_mulmod(sq, sq);
+    }
+    return r;
+}
+
+/* The CRC of a message whose n bytes (n <= 256) changed from old to new, with
+ * after more bytes behind them, from its CRC before and without reading the
+ * rest: the CRC is linear, so the change adds the linear part of old ^ new,
+ * carried through the bytes after it. */
+static uint32_t crc_patch(uint32_t crc, const uint8_t *old, const uint8_t *new, uint32_t n, uint64_t after)
+{
+    uint8_t d[256], z[256] = {0};
+    for (uint32_t i = 0; i < n; i++) d[i] = old[i] ^ new[i];
+    return crc ^ crc_mulmod(crc_update(0, d, n) ^ crc_update(0, z, n), crc_zeros(after));
+}
+
 /* Analyse the blob just written (as the renderer will read it) and write what
  * it needs into its needs record; the CRC covers the record. */
 static int fill_needs(const bs_scene *s, uint8_t *blob, size_t len, needs_report *r, char *err, size_t errlen)
@@ -130,8 +165,10 @@ static int fill_needs(const bs_scene *s, uint8_t *blob, size_t len, needs_report
                        scene_status_text(se.status), scene_section_name(se.section), se.index);
     if (needs_analyse(&sc, !s->no_look, r)) return bs_fail(err, errlen, "%s: out of memory", s->name);
     const scn_header *h = (const scn_header *)(const void *)blob;
-    memcpy(blob + h->sec[SCN_SEC_NEEDS].offset, &r->needs, sizeof r->needs);
-    uint32_t crc = crc_update(0, blob + 16, len - 16);
+    uint32_t at = h->sec[SCN_SEC_NEEDS].offset, crc = h->crc32;
+    _Static_assert(sizeof r->needs <= 256, "crc_patch takes up to 256 bytes");
+    crc = crc_patch(crc, blob + at, (const uint8_t *)&r->needs, sizeof r->needs, len - at - sizeof r->needs);
+    memcpy(blob + at, &r->needs, sizeof r->needs);
     memcpy(blob + 12, &crc, 4);
     return 0;
 }

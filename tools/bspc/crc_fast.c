@@ -1,7 +1,8 @@
 /* crc_fast.c - crc_update of firmware/crc32.h (CRC-32, reflected 0xEDB88320)
  * for the compiler, eight bytes a step with eight 1 KB tables (slicing-by-8).
- * bspc checksums each blob of up to megabytes three times (write, parse,
- * after the needs record); the firmware keeps its 64-byte nibble table. */
+ * bspc checksums each blob of up to megabytes twice (when written, and when
+ * parsed back; the needs record written after that patches the CRC,
+ * bspc.c's crc_patch); the firmware keeps its 64-byte nibble table. */
 #include "crc32.h"
 
 static uint32_t crc_tab[8][256];

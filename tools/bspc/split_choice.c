@@ -66,6 +66,12 @@
 #ifndef SMALL
 #define SMALL 24 /* sets this small are scored by plain loops, without the index */
 #endif
+#ifndef CHUNK
+#define CHUNK 16 /* segs per chunk of a chunked set */
+#endif
+#ifndef CHUNK_MIN
+#define CHUNK_MIN 128 /* sets of at least this many segs with diagonals to score are chunked */
+#endif
 #define MAX_RANK 8
 
 typedef struct {
@@ -74,6 +80,11 @@ typedef struct {
     int pos;   /* axis-aligned: points north (vertical) / east (horizontal) */
     int32_t c; /* axis-aligned: x of a vertical line, y of a horizontal one */
 } cand;
+
+/* the box of the seg ends of one chunk of a chunked set */
+typedef struct {
+    int32_t x0, y0, x1, y1;
+} chunk_box;
 
 /* mixed, on a set that could grow the tree past DEPTH_BUDGET: balance first */
 #define MODE_RESCUE 100
@@ -120,6 +131,10 @@ struct bs_chooser {
     uint32_t childcap;
     uint8_t *mark; /* per seg: look-ahead destination, bit 0 front, bit 1 back */
     uint32_t markcap;
+    /* the chunks of the set being scored (nchunked: its size, 0 when not chunked) */
+    uint32_t nchunked, nchunks;
+    chunk_box *cbox;
+    uint32_t cbcap;
 };
 
 bs_chooser *bs_chooser_new(const bs_tree *t, bspc_split strategy)
@@ -157,6 +172,7 @@ void bs_chooser_free(bs_chooser *C)
     free(C->child[0]);
     free(C->child[1]);
     free(C->mark);
+    free(C->cbox);
     free(C);
 }
 
@@ -199,13 +215,23 @@ static void sort_keys(uint64_t *a, uint32_t n, uint64_t *tmp)
         }
         return;
     }
+    /* the four digits' counts in one pass (a pass's order does not change them) */
+    uint32_t cnt[4][257];
+    memset(cnt, 0, sizeof cnt);
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t k = (uint32_t)(a[i] >> 32);
+        cnt[0][(k & 255u) + 1]++;
+        cnt[1][((k >> 8) & 255u) + 1]++;
+        cnt[2][((k >> 16) & 255u) + 1]++;
+        cnt[3][(k >> 24) + 1]++;
+    }
     uint64_t *src = a, *dst = tmp;
-    for (int shift = 32; shift < 64; shift += 8) {
-        uint32_t cnt[257] = {0};
-        for (uint32_t i = 0; i < n; i++) cnt[((src[i] >> shift) & 255u) + 1]++;
-        if (cnt[((src[0] >> shift) & 255u) + 1] == n) continue;
-        for (int k = 0; k < 256; k++) cnt[k + 1] += cnt[k];
-        for (uint32_t i = 0; i < n; i++) dst[cnt[(src[i] >> shift) & 255u]++] = src[i];
+    for (int d = 0; d < 4; d++) {
+        int shift = 32 + 8 * d;
+        uint32_t *c = cnt[d];
+        if (c[((src[0] >> shift) & 255u) + 1] == n) continue;
+        for (int k = 0; k < 256; k++) c[k + 1] += c[k];
+        for (uint32_t i = 0; i < n; i++) dst[c[(src[i] >> shift) & 255u]++] = src[i];
         uint64_t *s = src;
         src = dst;
         dst = s;
@@ -252,7 +278,10 @@ static int64_t cost_of(int mode, uint32_t f, uint32_t b, uint32_t sp, int diag)
     default: {
         /* imbalance matters most when one side is nearly empty (a peel-off) */
         int64_t m = f < b ? f : b;
-        return (int64_t)sp * SPLIT_COST + imb * BAL_Q / (m + BAL_Q) + (diag ? DIAG_COST : 0);
+        /* the same quotient in 32 bits when it fits (a division costs less) */
+        int64_t bal = imb < (1 << 26) ? (int64_t)((uint32_t)imb * BAL_Q / (uint32_t)(m + BAL_Q))
+                                      : imb * BAL_Q / (m + BAL_Q);
+        return (int64_t)sp * SPLIT_COST + bal + (diag ? DIAG_COST : 0);
     }
     }
 }
@@ -297,51 +326,97 @@ static score finish(int mode, score r, const cand *c)
     return r;
 }
 
-/* eval_loop for a line whose cross products fit in 64 bits (bs_pline.small,
- * nearly every line): bs_side's arithmetic with the line held in registers,
- * the sides counted unreversed and swapped once at the end */
-static score eval_small(const bs_chooser *C, const cand *c, const uint32_t *segs, const int32_t *xy, uint32_t n,
-                        int64_t best)
+/* A small line (bs_pline.small: cross products fit in 64 bits) held in
+ * registers, and the sides of segs counted against it unreversed. */
+typedef struct {
+    int64_t x0, y0, dx, dy, thr;
+    bs_part p;
+    uint32_t right, left, on_f, on_b, splits;
+} side_count;
+
+/* bs_side's arithmetic on segs [lo, hi) of xy / segs; 0, or 1 once the splits
+ * cost more than best (the count is then cut short) */
+static int count_segs(const bs_chooser *C, side_count *k, const uint32_t *segs, const int32_t *xy, uint32_t lo,
+                      uint32_t hi, int64_t best)
 {
     const bs_tree *t = C->t;
-    const bs_pline *L = &t->plines[c->pl];
-    const int64_t x0 = L->x, y0 = L->y, dx = L->rdx, dy = L->rdy, thr = L->thr;
-    bs_part p = {c->pl, c->rev, 0, 0};
-    uint32_t right = 0, left = 0, on_f = 0, on_b = 0, splits = 0;
-    score r = {0, 0, 0, 0, 0, 0};
-    for (uint32_t i = 0; i < n; i++) {
+    const int64_t x0 = k->x0, y0 = k->y0, dx = k->dx, dy = k->dy, thr = k->thr;
+    for (uint32_t i = lo; i < hi; i++) {
         const int32_t *q = xy + 4 * i;
         int64_t c1 = (q[0] - x0) * dy - (q[1] - y0) * dx;
         int64_t c2 = (q[2] - x0) * dy - (q[3] - y0) * dx;
         int split = 0;
         if (c1 > thr) { /* a on the right */
             if (c2 >= -thr)
-                right++;
+                k->right++;
             else
                 split = 1;
         } else if (c1 < -thr) {
             if (c2 <= thr)
-                left++;
+                k->left++;
             else
                 split = 1;
         } else if (c2 > thr) {
-            right++;
+            k->right++;
         } else if (c2 < -thr) {
-            left++;
-        } else if (bs_same_dir(t, &t->segs[segs[i]], p)) {
-            on_f++;
+            k->left++;
+        } else if (bs_same_dir(t, &t->segs[segs[i]], k->p)) {
+            k->on_f++;
         } else {
-            on_b++;
+            k->on_b++;
         }
-        if (split && cost_floor(C->mode, ++splits) > best) {
-            r.cut = 1;
-            return r;
-        }
+        if (split && cost_floor(C->mode, ++k->splits) > best) return 1;
     }
-    r.front = (c->rev ? left : right) + on_f + splits;
-    r.back = (c->rev ? right : left) + on_b + splits;
-    r.splits = splits;
+    return 0;
+}
+
+static side_count side_count_of(const bs_pline *L, const cand *c)
+{
+    side_count k = {L->x, L->y, L->rdx, L->rdy, L->thr, {c->pl, c->rev, 0, 0}, 0, 0, 0, 0, 0};
+    return k;
+}
+
+static score score_of(const bs_chooser *C, const cand *c, const side_count *k)
+{
+    score r = {0, 0, 0, 0, 0, 0};
+    r.front = (c->rev ? k->left : k->right) + k->on_f + k->splits;
+    r.back = (c->rev ? k->right : k->left) + k->on_b + k->splits;
+    r.splits = k->splits;
     return finish(C->mode, r, c);
+}
+
+/* eval_loop for a small line (nearly every line) */
+static score eval_small(const bs_chooser *C, const cand *c, const uint32_t *segs, const int32_t *xy, uint32_t n,
+                        int64_t best)
+{
+    side_count k = side_count_of(&C->t->plines[c->pl], c);
+    if (count_segs(C, &k, segs, xy, 0, n, best)) return (score){0, 0, 0, 0, 1, 0};
+    return score_of(C, c, &k);
+}
+
+/* eval_loop for a small line on a chunked set: a chunk whose box lies wholly
+ * on one side (the box's two corners extreme across the line tell) counts at
+ * once; only the chunks the line passes near are counted seg by seg. The
+ * counts, and so the score, are those of eval_small: a box wholly beyond thr
+ * holds no seg that is on the line or split. */
+static score eval_chunked(const bs_chooser *C, const cand *c, const uint32_t *segs, const int32_t *xy, int64_t best)
+{
+    side_count k = side_count_of(&C->t->plines[c->pl], c);
+    const int64_t x0 = k.x0, y0 = k.y0, dx = k.dx, dy = k.dy, thr = k.thr;
+    for (uint32_t b = 0; b < C->nchunks; b++) {
+        const chunk_box *B = &C->cbox[b];
+        /* cross = (x - x0) dy - (y - y0) dx: least and most over the box */
+        int64_t lo = ((dy > 0 ? B->x0 : B->x1) - x0) * dy - ((dx > 0 ? B->y1 : B->y0) - y0) * dx;
+        int64_t hi = ((dy > 0 ? B->x1 : B->x0) - x0) * dy - ((dx > 0 ? B->y0 : B->y1) - y0) * dx;
+        uint32_t first = b * CHUNK, end = first + CHUNK < C->nchunked ? first + CHUNK : C->nchunked;
+        if (lo > thr)
+            k.right += end - first;
+        else if (hi < -thr)
+            k.left += end - first;
+        else if (count_segs(C, &k, segs, xy, first, end, best))
+            return (score){0, 0, 0, 0, 1, 0};
+    }
+    return score_of(C, c, &k);
 }
 
 /* exact scoring by a loop over the set (xy: its seg ends, 4 per seg, copied
@@ -350,7 +425,8 @@ static score eval_loop(const bs_chooser *C, const cand *c, const uint32_t *segs,
                        int64_t best)
 {
     const bs_tree *t = C->t;
-    if (t->plines[c->pl].small) return eval_small(C, c, segs, xy, n, best);
+    if (t->plines[c->pl].small)
+        return C->nchunked == n ? eval_chunked(C, c, segs, xy, best) : eval_small(C, c, segs, xy, n, best);
     const bs_pline *L = &t->plines[c->pl];
     bs_part p = {c->pl, c->rev, 0, 0};
     score r = {0, 0, 0, 0, 0, 0};
@@ -524,9 +600,36 @@ static void sweep_axis(bs_chooser *C, const index_set *x, int a, ranked *top, ui
         while (hi_le < A->nn && val_of(A->hi[hi_le]) <= hi) hi_le++;
         while (al_lt < A->nal && val_of(A->al[al_lt]) < lo) pos_lt += (uint32_t)(A->al[al_lt++] >> 31) & 1u;
         while (al_le < A->nal && val_of(A->al[al_le]) <= hi) pos_le += (uint32_t)(A->al[al_le++] >> 31) & 1u;
+        /* a candidate whose splits alone cost more than the last ranked one is not scored */
+        if (*ntop == k && cost_floor(C->mode, lo_lt - hi_le) >= top[k - 1].s.cost) continue;
         score s = axis_score(C->mode, &c, A->nn, lo_lt, hi_le, al_lt, al_le, pos_lt, pos_le, A->nal, npos);
         if (s.valid) rank_insert(top, ntop, k, &c, s);
     }
+}
+
+/* Cut the set (its ends in xy) into chunks of CHUNK segs in the set's own
+ * order, and find the box of each chunk's ends for eval_chunked. The order is
+ * the map's (a map lists walls room by room) and what the splits made of it,
+ * so most chunks are small boxes. */
+static int chunk_set(bs_chooser *C, uint32_t n)
+{
+    uint32_t nb = (n + CHUNK - 1) / CHUNK;
+    if (bs_grow(&C->cbox, &C->cbcap, nb, sizeof *C->cbox)) return -1;
+    const int32_t *xy = C->xy;
+    for (uint32_t b = 0; b < nb; b++) {
+        chunk_box B = {INT32_MAX, INT32_MAX, INT32_MIN, INT32_MIN};
+        uint32_t end = (b + 1) * CHUNK < n ? (b + 1) * CHUNK : n;
+        for (const int32_t *q = xy + 4 * b * CHUNK; q < xy + 4 * end; q += 2) {
+            B.x0 = q[0] < B.x0 ? q[0] : B.x0;
+            B.x1 = q[0] > B.x1 ? q[0] : B.x1;
+            B.y0 = q[1] < B.y0 ? q[1] : B.y0;
+            B.y1 = q[1] > B.y1 ? q[1] : B.y1;
+        }
+        C->cbox[b] = B;
+    }
+    C->nchunked = n;
+    C->nchunks = nb;
+    return 0;
 }
 
 /* The bar of a loop-scored candidate: what it must stay under to be ranked. */
@@ -567,6 +670,7 @@ static int score_set(bs_chooser *C, const uint32_t *segs, uint32_t n, uint32_t d
     int32_t *xy = C->xy;
     uint32_t nc = 0, ndiag = 0, ntop = 0;
     *cut = 0;
+    C->nchunked = 0;
     C->stampno++;
     for (uint32_t i = 0; i < n; i++) {
         const bs_seg *g = &t->segs[segs[i]];
@@ -581,6 +685,7 @@ static int score_set(bs_chooser *C, const uint32_t *segs, uint32_t n, uint32_t d
         C->cands[nc++] = c;
         ndiag += c.kind == 0;
     }
+    if (x && n >= CHUNK_MIN && ndiag > 0 && chunk_set(C, n)) return -1;
     /* axis-aligned first: they set a low bar for the early exits of the rest */
     if (x) {
         sweep_axis(C, x, 0, top, &ntop, k);

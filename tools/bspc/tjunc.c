@@ -99,7 +99,7 @@ static int find_on_segment(const grid *g, const int32_t *px, const int32_t *py, 
     int64_t dx = (int64_t)bx - ax, dy = (int64_t)by - ay;
     bs_i128 len2 = (bs_i128)dx * dx + (bs_i128)dy * dy;
     if (len2 == 0) return 0;
-    bs_i128 thr = (bs_i128)bs_isqrt((bs_u128)(BS_TJ_TOL * BS_TJ_TOL) * (bs_u128)len2);
+    bs_i128 thr = -1; /* the tolerance on the cross product, found for the first point near (most segs have none) */
     int64_t x0 = (ax < bx ? ax : bx) - BS_TJ_TOL, x1 = (ax > bx ? ax : bx) + BS_TJ_TOL;
     int64_t y0 = (ay < by ? ay : by) - BS_TJ_TOL, y1 = (ay > by ? ay : by) + BS_TJ_TOL;
     int64_t cx0 = (x0 - g->x0) >> g->shift, cx1 = (x1 - g->x0) >> g->shift;
@@ -133,6 +133,7 @@ static int find_on_segment(const grid *g, const int32_t *px, const int32_t *py, 
                 int64_t qx = px[i], qy = py[i];
                 if (qx < x0 || qx > x1 || qy < y0 || qy > y1) continue;
                 if ((qx == ax && qy == ay) || (qx == bx && qy == by)) continue;
+                if (thr < 0) thr = (bs_i128)bs_isqrt((bs_u128)(BS_TJ_TOL * BS_TJ_TOL) * (bs_u128)len2);
                 bs_i128 cr = (bs_i128)(qx - ax) * dy - (bs_i128)(qy - ay) * dx;
                 if (cr > thr || cr < -thr) continue;
                 bs_i128 along = (bs_i128)(qx - ax) * dx + (bs_i128)(qy - ay) * dy;
