@@ -26,49 +26,67 @@ int bs_poly_push(bs_poly *p, int32_t x, int32_t y, uint32_t eline)
     return 0;
 }
 
-void bs_poly_tidy(bs_poly *p)
+/* drop a point equal to the one after it (the later keeps its outgoing edge);
+ * nothing moves until the first one dropped */
+static void drop_repeats(bs_poly *p)
 {
-    /* drop a point equal to the one after it (the later keeps its outgoing edge) */
     uint32_t n = p->n, k = 0;
     for (uint32_t i = 0; i < n; i++) {
-        const bs_pv *a = &p->v[i], *b = &p->v[(i + 1) % n];
+        const bs_pv *a = &p->v[i], *b = &p->v[i + 1 < n ? i + 1 : 0];
         if (n > 1 && a->x == b->x && a->y == b->y) continue;
-        p->v[k++] = *a;
+        if (k != i) p->v[k] = *a;
+        k++;
     }
     p->n = k;
-    if (p->n < 3) {
-        p->n = 0;
-        return;
-    }
+}
+
+/* twice the signed area: the sum of the cross products of each vertex and the
+ * next (a repeated point adds 0, so repeats may be dropped before or after) */
+static bs_i128 area2(const bs_pv *v, uint32_t n)
+{
     bs_i128 area = 0;
-    for (uint32_t i = 0; i < p->n; i++) {
-        const bs_pv *a = &p->v[i], *b = &p->v[(i + 1) % p->n];
-        area += (bs_i128)a->x * b->y - (bs_i128)b->x * a->y;
+    for (uint32_t i = 0; i < n; i++) {
+        const bs_pv *a = &v[i], *b = &v[i + 1 < n ? i + 1 : 0];
+        area += (int64_t)a->x * b->y - (int64_t)b->x * a->y; /* each term < 2^63 */
     }
-    if (area <= 0) p->n = 0;
+    return area;
+}
+
+/* drop_repeats, then empty a polygon of fewer than 3 points or of no positive
+ * area (area: area2 of the polygon) */
+static void tidy_with_area(bs_poly *p, bs_i128 area)
+{
+    drop_repeats(p);
+    if (p->n < 3 || area <= 0) p->n = 0;
+}
+
+void bs_poly_tidy(bs_poly *p)
+{
+    tidy_with_area(p, area2(p->v, p->n));
 }
 
 /* one output of a cut: keep side K (+1 front, -1 back) */
-static int cut(const bs_tree *t, const bs_poly *p, const int8_t *side, const int32_t *cx, const int32_t *cy,
-               uint32_t pl, int K, bs_poly *out)
+static int cut(const bs_poly *p, const int8_t *side, const int32_t *cx, const int32_t *cy, uint32_t pl, int K,
+               bs_poly *out)
 {
-    uint32_t n = p->n;
-    out->n = 0;
+    uint32_t n = p->n, m = 0;
+    /* each vertex gives at most itself and one crossing */
+    if (n > UINT32_MAX / 2 || bs_grow(&out->v, &out->cap, 2 * n, sizeof(bs_pv))) return -1;
+    bs_pv *o = out->v;
     for (uint32_t i = 0; i < n; i++) {
         const bs_pv *cur = &p->v[i];
-        uint32_t j = (i + 1) % n;
-        int sc = side[i], sn = side[j];
+        int sc = side[i], sn = side[i + 1 < n ? i + 1 : 0];
         if (sc == K) {
-            if (bs_poly_push(out, cur->x, cur->y, cur->eline)) return -1;
-            if (sn == -K && bs_poly_push(out, cx[i], cy[i], pl)) return -1; /* leaving */
+            o[m++] = *cur;
+            if (sn == -K) o[m++] = (bs_pv){cx[i], cy[i], pl}; /* leaving */
         } else if (sc == 0) {
-            if (bs_poly_push(out, cur->x, cur->y, sn == -K ? pl : cur->eline)) return -1;
+            o[m++] = (bs_pv){cur->x, cur->y, sn == -K ? pl : cur->eline};
         } else if (sn == K) {
-            if (bs_poly_push(out, cx[i], cy[i], cur->eline)) return -1; /* entering */
+            o[m++] = (bs_pv){cx[i], cy[i], cur->eline}; /* entering */
         }
     }
-    (void)t;
-    bs_poly_tidy(out);
+    out->n = m;
+    tidy_with_area(out, area2(o, m));
     return 0;
 }
 
@@ -78,29 +96,33 @@ static int split_core(const bs_tree *t, const bs_poly *p, uint32_t pl, uint32_t 
     if (back) back->n = 0;
     uint32_t n = p->n;
     if (n == 0) return 0;
-    int8_t sbuf[64];
-    int32_t xbuf[64], ybuf[64];
-    int8_t *side = sbuf;
-    int32_t *cx = xbuf, *cy = ybuf;
-    if (n > 64) {
-        side = malloc(n);
-        cx = malloc(sizeof *cx * n);
-        cy = malloc(sizeof *cy * n);
-        if (!side || !cx || !cy) {
-            free(side == sbuf ? NULL : side);
-            free(cx == xbuf ? NULL : cx);
-            free(cy == ybuf ? NULL : cy);
-            return -1;
-        }
+    int32_t buf[3 * 64];
+    int32_t *cx = buf, *cy = buf + 64;
+    int8_t *side = (int8_t *)(buf + 128);
+    if (n > 64) { /* one block: the crossings' x, y, then the sides */
+        cx = malloc((sizeof *cx * 2 + 1) * (size_t)n);
+        if (!cx) return -1;
+        cy = cx + n;
+        side = (int8_t *)(cy + n);
     }
     int nf = 0, nb = 0;
+    const bs_pline *L = &t->plines[pl];
+    if (L->small) { /* bs_side with the line held in registers */
+        const int64_t x0 = L->x, y0 = L->y, dx = L->rdx, dy = L->rdy, thr = L->thr;
+        for (uint32_t i = 0; i < n; i++) {
+            int64_t c = (p->v[i].x - x0) * dy - (p->v[i].y - y0) * dx;
+            int sd = (c > thr) - (c < -thr);
+            side[i] = (int8_t)(rev ? -sd : sd);
+        }
+    } else {
+        for (uint32_t i = 0; i < n; i++) side[i] = (int8_t)bs_side(L, rev, p->v[i].x, p->v[i].y);
+    }
     for (uint32_t i = 0; i < n; i++) {
-        side[i] = (int8_t)bs_side(&t->plines[pl], rev, p->v[i].x, p->v[i].y);
         nf += side[i] > 0;
         nb += side[i] < 0;
     }
-    for (uint32_t i = 0; i < n; i++) {
-        uint32_t j = (i + 1) % n;
+    for (uint32_t i = 0; i < n && nf && nb; i++) {
+        uint32_t j = i + 1 < n ? i + 1 : 0;
         if (side[i] * side[j] < 0) {
             if (bs_intersect(t->plines, p->v[i].eline, pl, &cx[i], &cy[i])) {
                 /* edge parallel to the line yet crossing it: only by rounding; use the midpoint */
@@ -120,7 +142,7 @@ static int split_core(const bs_tree *t, const bs_poly *p, uint32_t pl, uint32_t 
                 rc = -1;
             }
         } else if (nf > 0) {
-            rc = cut(t, p, side, cx, cy, pl, +1, front);
+            rc = cut(p, side, cx, cy, pl, +1, front);
         }
     }
     if (back && rc == 0) {
@@ -133,14 +155,10 @@ static int split_core(const bs_tree *t, const bs_poly *p, uint32_t pl, uint32_t 
                 rc = -1;
             }
         } else if (nb > 0) {
-            rc = cut(t, p, side, cx, cy, pl, -1, back);
+            rc = cut(p, side, cx, cy, pl, -1, back);
         }
     }
-    if (side != sbuf) {
-        free(side);
-        free(cx);
-        free(cy);
-    }
+    if (cx != buf) free(cx);
     return rc;
 }
 
