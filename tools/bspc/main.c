@@ -1,5 +1,6 @@
 /* main.c - build/bspc, the BSP compiler's command line:
  *   bspc INPUT [-o OUT] [--split fewest|balanced|mixed] [--flat] [--stats] [--needs] [--config FILE.h] [-v]
+ *   bspc WAD --all [-o DIR] [--split S] [--flat] [--stats] [-v]
  *   bspc --list WAD
  * INPUT is a text scene (docs/scene-format.md) or file.wad:MAP01 / file.wad:E1M1. */
 #include <errno.h>
@@ -15,6 +16,7 @@ static void usage(FILE *f)
 {
     fputs("usage: bspc INPUT [-o OUT] [--split fewest|balanced|mixed] [--flat] [--stats]\n"
           "            [--needs] [--config FILE.h] [-v]\n"
+          "       bspc WAD --all [-o DIR] [--split S] [--flat] [--stats] [-v]\n"
           "       bspc --list WAD\n"
           "\n"
           "Compiles a scene into a BSP blob (firmware/scene_format.h).\n"
@@ -34,6 +36,10 @@ static void usage(FILE *f)
           "                   (firmware/build_config.h); INPUT may then also be a compiled\n"
           "                   scene (.bsc), whose needs record is used as it is\n"
           "  -v               progress and warnings on stderr\n"
+          "  --all            compile every map of the WAD given as INPUT, each to\n"
+          "                   DIR/file-MAP.bsc (-o DIR, default the current folder);\n"
+          "                   --stats prints one JSON object per map, a line each. A map\n"
+          "                   refused is reported and the others still compiled (exit 1)\n"
           "  --list WAD       print the names of the maps in WAD on one line\n"
           "  --help           this text\n",
           f);
@@ -113,10 +119,79 @@ static int config_from_compiled(const char *in, const char *config)
     return rc;
 }
 
+static void print_stats(const char *map, const bspc_stats *st)
+{
+    printf("{");
+    if (map) printf("\"map\": \"%s\", ", map);
+    printf("\"input_walls\": %u, \"segs\": %u, \"splits\": %u, \"leaves\": %u, \"nodes\": %u, "
+           "\"vertices\": %u, \"max_depth\": %u, \"mean_depth\": %.3f, \"build_ms\": %.3f, "
+           "\"models\": %u, \"objects\": %u, \"features\": %u, \"max_edges\": %u, \"max_surfaces\": %u, "
+           "\"all_edges\": %u, \"all_surfaces\": %u}\n",
+           st->input_walls, st->segs, st->splits, st->leaves, st->nodes, st->vertices, st->max_depth, st->mean_depth,
+           st->build_ms, st->models, st->objects, st->needs.needs.features, st->needs.needs.edges,
+           st->needs.needs.surfaces, st->needs.all_edges, st->needs.all_surfaces);
+}
+
+/* Write blob[0..len) to path whole, or remove what was written. */
+static int write_blob(const char *path, const uint8_t *blob, size_t len)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f) {
+        fprintf(stderr, "bspc: %s: cannot write: %s\n", path, strerror(errno));
+        return 1;
+    }
+    size_t wrote = fwrite(blob, 1, len, f);
+    if (fclose(f) || wrote != len) {
+        fprintf(stderr, "bspc: %s: write failed\n", path);
+        remove(path);
+        return 1;
+    }
+    return 0;
+}
+
+/* --all: every map of the WAD, each into dir; 0 when all compiled. */
+static int compile_all(const char *wad, const char *dir, const bspc_options *opt, int want_stats)
+{
+    char maps[16384], err[512];
+    int n = bspc_list_maps(wad, maps, sizeof maps, err, sizeof err);
+    if (n < 0) {
+        fprintf(stderr, "bspc: %s\n", err);
+        return 1;
+    }
+    if (n == 0) {
+        fprintf(stderr, "bspc: %s: no maps in it\n", wad);
+        return 1;
+    }
+    int done = 0, refused = 0;
+    for (char *map = strtok(maps, " "); map; map = strtok(NULL, " ")) {
+        char spec[1200], base[1100], out[2400];
+        snprintf(spec, sizeof spec, "%s:%s", wad, map);
+        default_out(spec, base, sizeof base);
+        snprintf(out, sizeof out, "%s/%s", dir, base);
+        uint8_t *blob = NULL;
+        size_t len = 0;
+        bspc_stats st;
+        if (bspc_compile(spec, opt, &blob, &len, &st, err, sizeof err)) {
+            fprintf(stderr, "bspc: %s\n", err);
+            refused++;
+            continue;
+        }
+        int rc = write_blob(out, blob, len);
+        free(blob);
+        if (rc) return 1; /* the folder is not writable: the next maps would fail alike */
+        done++;
+        if (opt->verbose) fprintf(stderr, "bspc: wrote %s (%zu bytes, %d of %d)\n", out, len, done + refused, n);
+        if (want_stats) print_stats(map, &st);
+    }
+    fprintf(stderr, "bspc: %s: %d of %d maps compiled into %s%s\n", wad, done, n, dir,
+            refused ? " (the others refused, above)" : "");
+    return refused ? 1 : 0;
+}
+
 int main(int argc, char **argv)
 {
     const char *in = NULL, *outp = NULL;
-    int want_stats = 0, want_needs = 0;
+    int want_stats = 0, want_needs = 0, all = 0;
     const char *config = NULL;
     bspc_options opt = bspc_defaults();
     for (int i = 1; i < argc; i++) {
@@ -132,6 +207,8 @@ int main(int argc, char **argv)
             want_stats = 1;
         } else if (strcmp(a, "--needs") == 0) {
             want_needs = 1;
+        } else if (strcmp(a, "--all") == 0) {
+            all = 1;
         } else if (strcmp(a, "--config") == 0) {
             if (++i >= argc) {
                 fprintf(stderr, "bspc: --config needs a file name\n");
@@ -180,6 +257,17 @@ int main(int argc, char **argv)
         usage(stderr);
         return 2;
     }
+    if (all) {
+        if (want_needs || config) {
+            fprintf(stderr, "bspc: --all compiles every map; --needs and --config take one (WAD:MAP)\n");
+            return 2;
+        }
+        if (bspc_spec(in, NULL) != BSPC_SPEC_WAD) {
+            fprintf(stderr, "bspc: --all: %s is not a WAD file name (file.wad)\n", in);
+            return 2;
+        }
+        return compile_all(in, outp ? outp : ".", &opt, want_stats);
+    }
     if (config && scene_file_probe(in)) return config_from_compiled(in, config);
     char outbuf[1100];
     if (!outp) {
@@ -209,28 +297,10 @@ int main(int argc, char **argv)
             return 1;
         }
     }
-    FILE *f = fopen(outp, "wb");
-    if (!f) {
-        fprintf(stderr, "bspc: %s: cannot write: %s\n", outp, strerror(errno));
-        free(blob);
-        return 1;
-    }
-    size_t wrote = fwrite(blob, 1, len, f);
-    int cerr = fclose(f);
+    int rc = write_blob(outp, blob, len);
     free(blob);
-    if (wrote != len || cerr) {
-        fprintf(stderr, "bspc: %s: write failed\n", outp);
-        remove(outp);
-        return 1;
-    }
+    if (rc) return 1;
     if (opt.verbose) fprintf(stderr, "bspc: wrote %s (%zu bytes)\n", outp, len);
-    if (want_stats)
-        printf("{\"input_walls\": %u, \"segs\": %u, \"splits\": %u, \"leaves\": %u, \"nodes\": %u, "
-               "\"vertices\": %u, \"max_depth\": %u, \"mean_depth\": %.3f, \"build_ms\": %.3f, "
-               "\"models\": %u, \"objects\": %u, \"features\": %u, \"max_edges\": %u, \"max_surfaces\": %u, "
-               "\"all_edges\": %u, \"all_surfaces\": %u}\n",
-               st.input_walls, st.segs, st.splits, st.leaves, st.nodes, st.vertices, st.max_depth, st.mean_depth,
-               st.build_ms, st.models, st.objects, st.needs.needs.features, st.needs.needs.edges,
-               st.needs.needs.surfaces, st.needs.all_edges, st.needs.all_surfaces);
+    if (want_stats) print_stats(NULL, &st);
     return 0;
 }
