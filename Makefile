@@ -11,6 +11,8 @@ SDL_CFLAGS := $(shell sdl2-config --cflags 2>/dev/null)
 SDL_LIBS   := $(shell sdl2-config --libs 2>/dev/null)
 # host/png.c, linked into every program that takes HOST_LIB or host/png.c
 PNG_LIBS   := $(shell pkg-config --libs libpng 2>/dev/null || echo -lpng)
+# zlib's crc32, bspc's checksum of its blobs (tools/bspc/crc_fast.c)
+ZLIB_LIBS  := $(shell pkg-config --libs zlib 2>/dev/null || echo -lz)
 
 WARN     := -Wall -Wextra -Wshadow -Wstrict-prototypes -Wno-missing-field-initializers
 INC      := -Ifirmware -Ihal -Ihal/null -Ihal/sdl -Ihal/serial -Itools/bspc -Ihost
@@ -68,7 +70,7 @@ $(1)/obj/$(GEN)/%.o: $(GEN)/%.c
 	$$(CC) $$(BASE) $(2) $$(FW_FLAGS) -c $$< -o $$@
 
 $(1)/bspc: $(call objs,$(1)/obj,tools/bspc/main.c $(BSPC_LIB) tools/bspc/crc_fast.c firmware/scene.c)
-	$$(CC) $(2) $$^ -o $$@ -lm
+	$$(CC) $(2) $$^ -o $$@ $$(ZLIB_LIBS) -lm
 $(1)/render: $(call objs,$(1)/obj,host/render.c $(HOST_ENG) $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC))
 	$$(CC) $(2) $$^ -o $$@ $$(PNG_LIBS) -lm
 $(1)/emu: $(call objs,$(1)/obj,host/emu.c $(HOST_ENG) $(GEN)/default_scene.c $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(SDL_SRC))

@@ -10,6 +10,7 @@ PACKAGES=(
   gcc make libc6-dev          # host build
   libsdl2-dev                 # hal/sdl: the host window
   libpng-dev                  # host/png.c: the PNG files of build/render, emu, display, fltool
+  zlib1g-dev                  # bspc's checksum of its blobs (tools/bspc/crc_fast.c)
   libcmocka-dev               # C unit tests
   gcc-arm-none-eabi           # Cortex-M build (firmware, no-float check)
   qemu-system-arm             # the Cortex-M3 board (mps2-an385) the firmware runs on in tests

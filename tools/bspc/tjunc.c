@@ -109,7 +109,9 @@ static int find_on_segment(const grid *g, const int32_t *px, const int32_t *py, 
     if (cx1 >= g->nx) cx1 = g->nx - 1;
     if (cy1 >= g->ny) cy1 = g->ny - 1;
     /* walk only the cells near the segment: for each row, the columns its
-     * bounding strip crosses (a long diagonal touches few cells per row) */
+     * bounding strip crosses (a long diagonal touches few cells per row; the
+     * range is widened by a cell, so rounding in it loses no point) */
+    const double per_y = dy ? 1.0 / (double)dy : 0, per_cell = 1.0 / (double)((int64_t)1 << g->shift);
     for (int64_t cy = cy0; cy <= cy1; cy++) {
         int64_t rx0 = cx0, rx1 = cx1;
         if (dy != 0 && dx != 0) {
@@ -118,11 +120,11 @@ static int find_on_segment(const grid *g, const int32_t *px, const int32_t *py, 
             int64_t yhi = ylo + ((int64_t)1 << g->shift) + 2 * BS_TJ_TOL;
             if (ylo < y0) ylo = y0;
             if (yhi > y1) yhi = y1;
-            double t0 = ((double)ylo - ay) / (double)dy, t1 = ((double)yhi - ay) / (double)dy;
+            double t0 = ((double)ylo - ay) * per_y, t1 = ((double)yhi - ay) * per_y;
             double xa = ax + t0 * (double)dx, xb = ax + t1 * (double)dx;
             double lo = xa < xb ? xa : xb, hi = xa > xb ? xa : xb;
-            int64_t c0 = (int64_t)((lo - (double)g->x0) / (double)((int64_t)1 << g->shift)) - 1;
-            int64_t c1 = (int64_t)((hi - (double)g->x0) / (double)((int64_t)1 << g->shift)) + 1;
+            int64_t c0 = (int64_t)((lo - (double)g->x0) * per_cell) - 1;
+            int64_t c1 = (int64_t)((hi - (double)g->x0) * per_cell) + 1;
             if (c0 > rx0) rx0 = c0;
             if (c1 < rx1) rx1 = c1;
         }
