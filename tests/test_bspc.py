@@ -92,16 +92,20 @@ def test_text_scene_out_of_range(tmp_path, values, line, message):
     assert not (tmp_path / "bad.bsc").exists()
 
 
-def wad_room(path, x0, y0, x1, y1, floor, ceil):
-    """A PWAD whose MAP01 is one rectangular one-sided room."""
+def room_lumps(x0, y0, x1, y1, floor=0, ceil=128):
+    """The lumps of a map that is one rectangular one-sided room, after its marker."""
     import struct
     verts = [(x0, y0), (x0, y1), (x1, y1), (x1, y0)]
-    linedefs = b"".join(struct.pack("<HHHHHHH", i, (i + 1) % 4, 1, 0, 0, i, 0xFFFF) for i in range(4))
-    sides = b"".join(struct.pack("<hh8s8s8sH", 0, 0, b"-", b"-", b"STARTAN3", 0) for _ in range(4))
-    sectors = struct.pack("<hh8s8shhh", floor, ceil, b"FLOOR4_8", b"CEIL3_5", 160, 0, 0)
-    things = struct.pack("<hhhHH", (x0 + x1) // 2, (y0 + y1) // 2, 0, 1, 7)
-    vertexes = b"".join(struct.pack("<hh", x, y) for x, y in verts)
-    write_pwad_map(path, things, linedefs, sides, vertexes, sectors)
+    return [(b"THINGS", struct.pack("<hhhHH", (x0 + x1) // 2, (y0 + y1) // 2, 0, 1, 7)),
+            (b"LINEDEFS", b"".join(struct.pack("<HHHHHHH", i, (i + 1) % 4, 1, 0, 0, i, 0xFFFF) for i in range(4))),
+            (b"SIDEDEFS", b"".join(struct.pack("<hh8s8s8sH", 0, 0, b"-", b"-", b"STARTAN3", 0) for _ in range(4))),
+            (b"VERTEXES", b"".join(struct.pack("<hh", x, y) for x, y in verts)),
+            (b"SECTORS", struct.pack("<hh8s8shhh", floor, ceil, b"FLOOR4_8", b"CEIL3_5", 160, 0, 0))]
+
+
+def wad_room(path, x0, y0, x1, y1, floor, ceil):
+    """A PWAD whose MAP01 is one rectangular one-sided room."""
+    write_pwad_map(path, *(data for _, data in room_lumps(x0, y0, x1, y1, floor, ceil)))
 
 
 @pytest.mark.parametrize("room, message", [
@@ -221,3 +225,54 @@ def test_generated_scenes_compile_in_few_instructions(tmp_path, case, bound):
     import bench_bsp  # noqa: E402 (tools/ is not a package)
     make = {"grid": bench_bsp.grid_scene, "zigzag": bench_bsp.zigzag_scene}[case]
     assert compile_instructions(tmp_path, f"{case}.scene", make()) < bound
+
+
+# ---- every map of a WAD in one run (bspc WAD --all) ----------------------------------------------
+
+def write_pwad(path, maps):
+    """A PWAD of maps {name: lumps}, in order."""
+    import struct
+    lumps = []
+    for name, parts in maps.items():
+        lumps += [(name.encode(), b"")] + parts
+    body, directory, pos = b"", b"", 12
+    for name, data in lumps:
+        directory += struct.pack("<II8s", pos, len(data), name)
+        body += data
+        pos += len(data)
+    path.write_bytes(b"PWAD" + struct.pack("<II", len(lumps), pos) + body + directory)
+
+
+def test_all_maps_of_a_wad_in_one_run(tmp_path):
+    """Each map's blob is the one a run for that map alone writes, under the default name, and --stats
+    gives a line per map naming it."""
+    wad = tmp_path / "pair.wad"
+    write_pwad(wad, {"MAP01": room_lumps(0, 0, 256, 256), "MAP02": room_lumps(-512, 0, 0, 384)})
+    out = tmp_path / "out"
+    out.mkdir()
+    proc = run([program("bspc"), wad, "--all", "-o", out, "--stats"])
+    lines = [json.loads(x) for x in proc.stdout.splitlines()]
+    assert [x["map"] for x in lines] == ["MAP01", "MAP02"] and all(x["leaves"] >= 1 for x in lines)
+    assert "2 of 2 maps compiled" in proc.stderr
+    for m in ("MAP01", "MAP02"):
+        run([program("bspc"), f"{wad}:{m}", "-o", tmp_path / f"{m}.bsc"])
+        assert (out / f"pair-{m}.bsc").read_bytes() == (tmp_path / f"{m}.bsc").read_bytes()
+
+
+def test_all_maps_go_on_past_a_refused_one(tmp_path):
+    wad = tmp_path / "mixed.wad"
+    write_pwad(wad, {"MAP01": room_lumps(-32768, 0, 256, 256), "MAP02": room_lumps(0, 0, 256, 256)})
+    proc = run([program("bspc", sanitized=True), wad, "--all", "-o", tmp_path], check=False)
+    assert proc.returncode == 1
+    assert "mixed.wad:MAP01: vertex 0: x = -32768 out of range" in proc.stderr, proc.stderr
+    assert "1 of 2 maps compiled" in proc.stderr
+    assert not (tmp_path / "mixed-MAP01.bsc").exists() and (tmp_path / "mixed-MAP02.bsc").stat().st_size > 0
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["scene.scene", "--all"], "is not a WAD file name"),
+    (["freedoom2.wad", "--all", "--needs"], "--needs and --config take one"),
+])
+def test_all_maps_refuses_what_it_cannot_do(args, needle):
+    proc = run([program("bspc"), *args], check=False)
+    assert proc.returncode == 2 and needle in proc.stderr, proc.stderr
