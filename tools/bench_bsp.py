@@ -2,10 +2,12 @@
 """bench_bsp.py - BSP build benchmark over the 68 Freedoom maps (make bench-bsp).
 
 Runs build/bspc --stats on every map of freedoom1.wad (E1M1..E4M9) and
-freedoom2.wad (MAP01..MAP32) with each split strategy, runs zdbsp and glbsp on
-the same WADs when they are installed, reads the nodes shipped inside the
-Freedoom WADs, and prints one table of totals: splits, leaves (subsectors),
-max depth and build time. A second table times bspc on three generated scenes
+freedoom2.wad (MAP01..MAP32) with each split strategy (one process per map),
+then bspc --all (one process per WAD, as zdbsp and glbsp run) and zdbsp
+--repeat times each, taking turns, and glbsp once, when they are installed;
+reads the nodes shipped inside the Freedoom WADs, and prints one table of
+totals: splits, leaves (subsectors), max depth and build time (wall clock and
+the processes' user + system time; the median of the repeats). A second table times bspc on three generated scenes
 that once took seconds (a grid of 3,600 sectors, a room with a 10,000-wall
 zigzag side, a convex 10,000-gon room). The tables go to stdout and to
 build/bench-bsp.md.
@@ -129,11 +131,26 @@ def wad_totals(maps_by_wad, built_paths):
     return tot
 
 
+def bspc_totals():
+    return {"maps": 0, "splits": 0, "tjunc": 0, "segs": 0, "leaves": 0, "max_depth": 0,
+            "build_ms": 0.0, "failed": []}
+
+
+def add_stats(tot, st, lumps):
+    tot["maps"] += 1
+    tot["splits"] += st["splits"]
+    tot["segs"] += st["segs"]
+    tot["tjunc"] += st["segs"] - st["splits"] - sides_of(lumps, True)
+    tot["leaves"] += st["leaves"]
+    tot["max_depth"] = max(tot["max_depth"], st["max_depth"])
+    tot["build_ms"] += st["build_ms"]
+
+
 def run_bspc(bspc, wads, maps_by_wad, strategy, tmp):
-    tot = {"maps": 0, "splits": 0, "tjunc": 0, "segs": 0, "leaves": 0, "max_depth": 0,
-           "build_ms": 0.0, "failed": []}
+    """bspc on each map, one process per map"""
+    tot = bspc_totals()
     out = os.path.join(tmp, "out.bsc")
-    t0 = time.perf_counter()
+    c0, t0 = children_cpu(), time.perf_counter()
     for wadname, maps in maps_by_wad.items():
         for m, lumps in maps.items():
             spec = f"{wads[wadname]}:{m}"
@@ -142,31 +159,47 @@ def run_bspc(bspc, wads, maps_by_wad, strategy, tmp):
             if r.returncode != 0:
                 tot["failed"].append(f"{wadname}:{m}: {r.stderr.strip()}")
                 continue
-            st = json.loads(r.stdout)
-            tot["maps"] += 1
-            tot["splits"] += st["splits"]
-            tot["segs"] += st["segs"]
-            tot["tjunc"] += st["segs"] - st["splits"] - sides_of(lumps, True)
-            tot["leaves"] += st["leaves"]
-            tot["max_depth"] = max(tot["max_depth"], st["max_depth"])
-            tot["build_ms"] += st["build_ms"]
-    tot["wall_s"] = time.perf_counter() - t0
+            add_stats(tot, json.loads(r.stdout), lumps)
+    tot["wall_s"], tot["cpu_s"] = time.perf_counter() - t0, children_cpu() - c0
+    return tot
+
+
+def run_bspc_all(bspc, wads, maps_by_wad, strategy, tmp):
+    """bspc --all on each WAD, one process per WAD"""
+    tot = bspc_totals()
+    outdir = os.path.join(tmp, "all")
+    os.makedirs(outdir, exist_ok=True)
+    c0, t0 = children_cpu(), time.perf_counter()
+    for wadname, maps in maps_by_wad.items():
+        r = subprocess.run([bspc, wads[wadname], "--all", "--split", strategy, "--stats", "-o", outdir],
+                           capture_output=True, text=True)
+        if r.returncode != 0:
+            tot["failed"].append(f"{wadname}: {r.stderr.strip()[-200:]}")
+        for line in r.stdout.splitlines():
+            st = json.loads(line)
+            add_stats(tot, st, maps[st["map"]])
+    tot["wall_s"], tot["cpu_s"] = time.perf_counter() - t0, children_cpu() - c0
     return tot
 
 
 def run_external(cmd_for, wads, tmp, label):
-    built, wall = {}, 0.0
+    """another builder on each WAD: (the WADs it wrote or None, wall s, cpu s)"""
+    built = {}
+    c0, t0 = children_cpu(), time.perf_counter()
     for wadname, path in wads.items():
         outp = os.path.join(tmp, f"{label}-{wadname}")
-        t0 = time.perf_counter()
         r = subprocess.run(cmd_for(path, outp), capture_output=True, text=True)
-        wall += time.perf_counter() - t0
         if r.returncode != 0 or not os.path.isfile(outp):
             print(f"bench-bsp: {label} failed on {wadname}: {r.stderr.strip()[:200]}",
                   file=sys.stderr)
-            return None, wall
+            return None, time.perf_counter() - t0, children_cpu() - c0
         built[wadname] = outp
-    return built, wall
+    return built, time.perf_counter() - t0, children_cpu() - c0
+
+
+def median(xs):
+    xs = sorted(xs)
+    return xs[len(xs) // 2] if len(xs) % 2 else (xs[len(xs) // 2 - 1] + xs[len(xs) // 2]) / 2
 
 
 # ---- generated scenes (text format, docs/scene-format.md) --------------------
@@ -270,7 +303,11 @@ def main():
     ap.add_argument("--bspc", default="build/bspc")
     ap.add_argument("--out", default="build/bench-bsp.md")
     ap.add_argument("--strategies", default="fewest,balanced,mixed")
+    ap.add_argument("--repeat", type=int, default=3,
+                    help="runs of bspc --all and zdbsp, taking turns; their medians are shown")
     args = ap.parse_args()
+    if args.repeat < 1:
+        ap.error("--repeat must be at least 1")
 
     wads = {w: find_wad(w) for w in WADS}
     missing = [w for w, p in wads.items() if not p]
@@ -291,34 +328,52 @@ def main():
             if t["failed"]:
                 note += f"; {len(t['failed'])} map(s) failed: " + "; ".join(t["failed"][:3])
             rows.append((f"bspc --split {s}", t["maps"], t["splits"], t["tjunc"], t["segs"],
-                         t["leaves"], t["max_depth"], f"{t['wall_s']:.2f}", note))
-        if shutil.which("zdbsp"):
-            built, wall = run_external(lambda i, o: ["zdbsp", "-o", o, i], wads, tmp, "zdbsp")
-            if built:
-                t = wad_totals(maps_by_wad, built)
-                rows.append(("zdbsp (defaults)", t["maps"], t["splits"], "-", t["segs"], t["leaves"],
-                             t["max_depth"], f"{wall:.2f}", "whole WADs, with blockmap and reject"))
+                         t["leaves"], t["max_depth"], f"{t['wall_s']:.2f}", f"{t['cpu_s']:.2f}",
+                         "one process per map; " + note))
+        # the whole-WAD runs, in turns, so that a busy moment weighs on both alike
+        zd = shutil.which("zdbsp")
+        walls = {"all": [], "zdbsp": []}
+        cpus = {"all": [], "zdbsp": []}
+        built = None
+        for _ in range(args.repeat):
+            t = run_bspc_all(args.bspc, wads, maps_by_wad, "mixed", tmp)
+            walls["all"].append(t["wall_s"])
+            cpus["all"].append(t["cpu_s"])
+            if zd:
+                built, wall, cpu = run_external(lambda i, o: ["zdbsp", "-o", o, i], wads, tmp, "zdbsp")
+                walls["zdbsp"].append(wall)
+                cpus["zdbsp"].append(cpu)
+        note = f"one process per WAD, median of {args.repeat}"
+        if t["failed"]:
+            note += f"; {len(t['failed'])} failed: " + "; ".join(t["failed"][:2])
+        rows.append(("bspc --all (mixed)", t["maps"], t["splits"], t["tjunc"], t["segs"], t["leaves"],
+                     t["max_depth"], f"{median(walls['all']):.2f}", f"{median(cpus['all']):.2f}", note))
+        if built:
+            z = wad_totals(maps_by_wad, built)
+            rows.append(("zdbsp (defaults)", z["maps"], z["splits"], "-", z["segs"], z["leaves"],
+                         z["max_depth"], f"{median(walls['zdbsp']):.2f}", f"{median(cpus['zdbsp']):.2f}",
+                         f"one process per WAD, median of {args.repeat}; with blockmap and reject"))
         if shutil.which("glbsp"):
-            built, wall = run_external(lambda i, o: ["glbsp", "-q", "-n", i, "-o", o], wads, tmp,
-                                       "glbsp")
+            built, wall, cpu = run_external(lambda i, o: ["glbsp", "-q", "-n", i, "-o", o], wads, tmp,
+                                            "glbsp")
             if built:
                 t = wad_totals(maps_by_wad, built)
                 rows.append(("glbsp -n (normal nodes)", t["maps"], t["splits"], "-", t["segs"],
-                             t["leaves"], t["max_depth"], f"{wall:.2f}",
-                             "whole WADs, also builds GL nodes"))
+                             t["leaves"], t["max_depth"], f"{wall:.2f}", f"{cpu:.2f}",
+                             "one process per WAD; also builds GL nodes"))
         t = wad_totals(maps_by_wad, None)
         rows.append(("nodes shipped in Freedoom", t["maps"], t["splits"], "-", t["segs"],
-                     t["leaves"], t["max_depth"], "-", "read from the WADs"))
+                     t["leaves"], t["max_depth"], "-", "-", "read from the WADs"))
         gen_rows = run_generated(args.bspc, tmp)
 
     head = ("builder", "maps", "splits", "T-junction splits", "segs", "leaves", "max depth",
-            "time (s)", "notes")
+            "time (s)", "cpu (s)", "notes")
     lines = [f"# BSP build over the {nmaps} Freedoom maps", "",
              "splits: segs cut by partitions (for the other builders: segs - linedef sides). "
              "bspc also splits segs at T-junctions (vertices on a seg's interior, and split "
              "points made on one side of a two-sided line), counted apart; the others do not. "
-             "time: wall clock, process start and WAD reading included (bspc: one process per "
-             "map; zdbsp, glbsp: one per WAD).", "",
+             "time: wall clock, process start and WAD reading included; cpu: the processes' "
+             "user + system time.", "",
              *table(head, rows), "", "## Generated scenes", "",
              "bspc (default strategy, one process each) on scenes made by tools/bench_bsp.py. "
              "time: wall clock; cpu: user + system time of the bspc process.", "",
