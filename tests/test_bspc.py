@@ -276,3 +276,17 @@ def test_all_maps_go_on_past_a_refused_one(tmp_path):
 def test_all_maps_refuses_what_it_cannot_do(args, needle):
     proc = run([program("bspc"), *args], check=False)
     assert proc.returncode == 2 and needle in proc.stderr, proc.stderr
+
+
+def test_all_maps_share_textures_and_write_what_single_runs_write(tmp_path):
+    """The textures kept from one map for the next (the look cache) give each map the blob a run of
+    its own gives, warnings and all."""
+    out = tmp_path / "all"
+    out.mkdir()
+    proc = run([program("bspc"), "freedoom2.wad", "--all", "-o", out, "-v"])
+    assert "32 of 32 maps compiled" in proc.stderr
+    for m in ("MAP01", "MAP02", "MAP17", "MAP32"):
+        one = run([program("bspc"), f"freedoom2.wad:{m}", "-o", tmp_path / "one.bsc", "-v"])
+        assert (out / f"freedoom2-{m}.bsc").read_bytes() == (tmp_path / "one.bsc").read_bytes(), m
+        warned = [x for x in one.stderr.splitlines() if "unknown" in x]
+        assert all(w in proc.stderr for w in warned), m

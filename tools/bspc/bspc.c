@@ -17,6 +17,7 @@ bspc_options bspc_defaults(void)
     o.split = BSPC_SPLIT_MIXED;
     o.verbose = 0;
     o.flat = 0;
+    o.look_cache = NULL;
     return o;
 }
 

@@ -11,10 +11,16 @@
 
 typedef enum { BSPC_SPLIT_FEWEST, BSPC_SPLIT_BALANCED, BSPC_SPLIT_MIXED } bspc_split;
 
+/* Textures kept between the compiles of the maps of one WAD (look_cache.c). */
+typedef struct bspc_look_cache bspc_look_cache;
+bspc_look_cache *bspc_look_cache_new(void);
+void bspc_look_cache_free(bspc_look_cache *c);
+
 typedef struct {
-    bspc_split split; /* default BSPC_SPLIT_MIXED */
-    int verbose;      /* progress and warnings on stderr */
-    int flat;         /* leave a WAD map's look out (docs/textures.md): flat colours only */
+    bspc_split split;            /* default BSPC_SPLIT_MIXED */
+    int verbose;                 /* progress and warnings on stderr */
+    int flat;                    /* leave a WAD map's look out (docs/textures.md): flat colours only */
+    bspc_look_cache *look_cache; /* NULL, or textures kept from the maps compiled before */
 } bspc_options;
 
 typedef struct {

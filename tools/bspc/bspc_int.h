@@ -176,9 +176,9 @@ typedef struct {
     char name[9];
 } bs_wadlump;
 typedef struct bs_wadlook bs_wadlook;
-int bs_look_open(FILE *f, size_t flen, const bs_wadlump *dir, uint32_t ndir, const char *map, bs_scene *s,
-                 uint32_t nsectors, uint32_t nlinedefs, const bspc_options *opt, bs_wadlook **out, char *err,
-                 size_t errlen);
+int bs_look_open(FILE *f, const char *wadpath, size_t flen, const bs_wadlump *dir, uint32_t ndir, const char *map,
+                 bs_scene *s, uint32_t nsectors, uint32_t nlinedefs, const bspc_options *opt, bs_wadlook **out,
+                 char *err, size_t errlen);
 /* Sector i from its SECTORS record: plane textures and flat colours. */
 int bs_look_sector(bs_wadlook *L, uint32_t i, const uint8_t rec[26], char *err, size_t errlen);
 /* Side k of scene line li (vertices and sectors set) from its SIDEDEFS record

@@ -266,7 +266,10 @@ int main(int argc, char **argv)
             fprintf(stderr, "bspc: --all: %s is not a WAD file name (file.wad)\n", in);
             return 2;
         }
-        return compile_all(in, outp ? outp : ".", &opt, want_stats);
+        opt.look_cache = bspc_look_cache_new(); /* without one, each map composes its textures */
+        int rc = compile_all(in, outp ? outp : ".", &opt, want_stats);
+        bspc_look_cache_free(opt.look_cache);
+        return rc;
     }
     if (config && scene_file_probe(in)) return config_from_compiled(in, config);
     char outbuf[1100];

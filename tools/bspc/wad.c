@@ -572,8 +572,8 @@ static int wad_load_map(wad_map *m, const char *map, bs_scene *s)
     int64_t marker = wad_find_marker(m, map);
     if (marker < 0 || wad_read_map_lumps(m, (uint32_t)marker)) return -1;
     if (m->cnt[L_SECTORS] == 0) return bs_fail(m->err, m->errlen, "%s: map has no sectors", m->display);
-    if (bs_look_open(m->f, m->len, m->dir, m->nlumps, m->want, s, m->cnt[L_SECTORS], m->cnt[L_LINEDEFS], m->opt,
-                     &m->look, m->err, m->errlen))
+    if (bs_look_open(m->f, m->wadpath, m->len, m->dir, m->nlumps, m->want, s, m->cnt[L_SECTORS], m->cnt[L_LINEDEFS],
+                     m->opt, &m->look, m->err, m->errlen))
         return -1;
     if (wad_load_sectors(m, s) || wad_load_vertexes(m, s) || wad_load_linedefs(m, s) || wad_check_vertexes(m, s) ||
         wad_load_player(m, s))

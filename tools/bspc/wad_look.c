@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "bspc_int.h"
+#include "look_cache.h"
 #include "name_table.h"
 
 enum { KIND_WALL, KIND_FLAT };
@@ -66,6 +67,7 @@ struct bs_wadlook {
     uint32_t bad_entry;       /* ... at this entry */
     uint8_t def_palette[768]; /* the flat-shaded palette (bs_palette), for things.txt's colours */
     int have_def_palette;
+    const char *wadpath; /* the file, as the look cache knows it */
 };
 
 enum { BAD_NONE, BAD_COUNT, BAD_ENTRY };
@@ -184,6 +186,23 @@ static int store(bs_wadlook *L, const char *name, const uint8_t *pic, uint32_t w
     x->reserved2 = 0;
     for (int k = 0; k < 3; k++) L->mean[lk->ntex][k] = (double)sum[k] / ((double)cols * h);
     x->colour = nearest(lk->palette, L->mean[lk->ntex][0], L->mean[lk->ntex][1], L->mean[lk->ntex][2]);
+    lk->ntexels += n;
+    *out = (uint16_t)lk->ntex++;
+    return 0;
+}
+
+/* Append a texture kept from an earlier map of the WAD: what store gave then. */
+static int store_kept(bs_wadlook *L, const lc_entry *e, uint16_t *out, char *err, size_t errlen)
+{
+    bs_look *lk = L->lk;
+    if (lk->ntex >= SCN_TEX_NONE) return bs_fail(err, errlen, "%s: more than %u textures", L->wad, SCN_TEX_NONE);
+    uint32_t n = (1u << e->rec.wbits) << e->rec.hbits;
+    if ((uint64_t)lk->ntexels + n > UINT32_MAX / 2 || bs_grow(&lk->texels, &lk->txcap, lk->ntexels + n, 1) ||
+        bs_grow(&lk->tex, &lk->tcap, lk->ntex + 1, sizeof *lk->tex))
+        return bs_fail(err, errlen, "%s: out of memory", L->wad);
+    memcpy(lk->texels + lk->ntexels, e->texels, n);
+    lk->tex[lk->ntex] = e->rec;
+    lk->tex[lk->ntex].first = lk->ntexels;
     lk->ntexels += n;
     *out = (uint16_t)lk->ntex++;
     return 0;
@@ -441,7 +460,18 @@ static int texture(bs_wadlook *L, const char *name, int kind, uint16_t *out, cha
             *out = L->used[i].tex;
             return 0;
         }
-    int f = kind == KIND_WALL ? compose_wall(L, name, out, err, errlen) : compose_flat(L, name, out, err, errlen);
+    bspc_look_cache *cache = L->opt->look_cache;
+    const lc_entry *e = cache ? lc_find(cache, L->wadpath, kind, name) : NULL;
+    int f;
+    if (e) {
+        f = e->known && store_kept(L, e, out, err, errlen) ? -1 : e->known;
+    } else {
+        f = kind == KIND_WALL ? compose_wall(L, name, out, err, errlen) : compose_flat(L, name, out, err, errlen);
+        /* a cache out of memory only makes the next map compose it again */
+        if (cache && f >= 0)
+            (void)lc_put(cache, kind, name, f, f ? &L->lk->tex[*out] : NULL,
+                         f ? L->lk->texels + L->lk->tex[*out].first : NULL);
+    }
     if (f < 0) return -1;
     if (f == 0)
         bs_warn(L->opt, "%s: unknown %s '%s': drawn flat", L->wad, kind == KIND_WALL ? "texture" : "flat", name);
@@ -486,9 +516,9 @@ static const char *sky_for(const char *map)
     return sky[0];
 }
 
-int bs_look_open(FILE *f, size_t flen, const bs_wadlump *dir, uint32_t ndir, const char *map, bs_scene *s,
-                 uint32_t nsectors, uint32_t nlinedefs, const bspc_options *opt, bs_wadlook **out, char *err,
-                 size_t errlen)
+int bs_look_open(FILE *f, const char *wadpath, size_t flen, const bs_wadlump *dir, uint32_t ndir, const char *map,
+                 bs_scene *s, uint32_t nsectors, uint32_t nlinedefs, const bspc_options *opt, bs_wadlook **out,
+                 char *err, size_t errlen)
 {
     *out = NULL;
     bs_wadlook tmp = {f,      flen, dir, ndir, s->name, opt, s, &s->look, NULL, 0, {NULL, NULL},
@@ -500,6 +530,7 @@ int bs_look_open(FILE *f, size_t flen, const bs_wadlump *dir, uint32_t ndir, con
         at[i] = find_lump(&tmp, need[i], 0, ndir);
         if (at[i] == ndir) snprintf(missing + strlen(missing), sizeof missing - strlen(missing), " %s", need[i]);
     }
+    tmp.wadpath = wadpath;
     if (missing[0]) {
         bs_note(opt, "%s: no%s in the WAD: the scene is flat-shaded", s->name, missing);
         return 0;
