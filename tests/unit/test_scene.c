@@ -191,6 +191,48 @@ static void test_tree_must_be_a_tree(void **state)
     free(b);
 }
 
+/* Nodes on the longest path from node n down to a leaf, walked here on the blob's
+ * own records (a tree the loader has accepted). */
+static uint32_t depth_below(const scn_node *nodes, uint32_t n)
+{
+    uint32_t deepest = 0;
+    for (int c = 0; c < 2; c++) {
+        uint32_t ch = nodes[n].child[c];
+        if (ch & SCN_LEAF_BIT) continue;
+        uint32_t d = depth_below(nodes, ch);
+        if (d > deepest) deepest = d;
+    }
+    return deepest + 1;
+}
+
+/* The header's max_depth sizes the walkers' stacks: the loader measures the tree
+ * and refuses a header that claims less than the longest root-to-leaf path, and
+ * takes one that claims exactly it. */
+static void test_depth_must_cover_the_tree(void **state)
+{
+    (void)state;
+    uint8_t *b = malloc(blob_len);
+    memcpy(b, blob, blob_len);
+    scn_header *h = (scn_header *)(void *)b;
+    const scn_node *nodes = (const scn_node *)(const void *)(b + h->sec[SCN_SEC_NODES].offset);
+    assert_false(h->root & SCN_LEAF_BIT);
+    uint32_t depth = depth_below(nodes, h->root);
+    assert_true(depth >= 3); /* default.scene: a tree deep enough that every level counts */
+    assert_int_equal(h->max_depth, depth);
+    scene_error err;
+    for (uint32_t claim = 1; claim < depth; claim++) {
+        h->max_depth = claim;
+        fix_crc(b, blob_len);
+        assert_int_equal(load_copy(b, blob_len, &err), SCENE_ERR_TREE);
+        assert_int_equal(err.section, -1);
+        assert_int_equal(err.index, SCENE_FIELD_MAX_DEPTH);
+    }
+    h->max_depth = depth;
+    fix_crc(b, blob_len);
+    assert_int_equal(load_copy(b, blob_len, &err), SCENE_OK);
+    free(b);
+}
+
 /* ---- models, objects, doors ---- */
 
 typedef struct {
@@ -427,6 +469,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_good_blob_loads),    cmocka_unit_test(test_header_damage),
         cmocka_unit_test(test_body_damage),        cmocka_unit_test(test_tree_must_be_a_tree),
+        cmocka_unit_test(test_depth_must_cover_the_tree),
         cmocka_unit_test(test_objects_blob_loads), cmocka_unit_test(test_object_damage),
         cmocka_unit_test(test_object_body_damage), cmocka_unit_test(test_object_count_limit),
     };
