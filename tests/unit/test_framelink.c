@@ -847,7 +847,8 @@ static void pattern(uint8_t *p, uint32_t n, int pat)
 
 /* fl_reader over a buffer of exactly cap bytes (malloc'd, so that ASan sees a
  * byte past it): messages up to cap bytes arrive whole, one more is refused as
- * too long and writes nothing, and the reader takes the next message. */
+ * too long and writes nothing past the buffer, leaves no bytes to be read, and the
+ * reader takes the next message. */
 static void test_reader_bound(void **state)
 {
     (void)state;
@@ -873,6 +874,7 @@ static void test_reader_bound(void **state)
                     assert_memory_equal(rbuf, msg, n);
                 } else {
                     assert_int_equal(res, -(int)FL_R_LONG);
+                    assert_int_equal(rd.len, 0); /* nothing of the refused segment is left to read */
                 }
                 assert_true(rd.len <= cap);
                 for (res = 0; i < s.len; i++) res = fl_reader_byte(&rd, s.p[i]), got += res == 1;
