@@ -56,6 +56,8 @@ TESTS = {
     "firmware/objects.c": [GOLDEN, "test_objects"],
     "firmware/obj_draw.c": [GOLDEN, "test_objects"],
     "firmware/engine.c": [GOLDEN, "test_objects", "test_ranges", "test_scene"],
+    "firmware/surfaces.c": ["test_surfaces", *RENDERER],
+    "firmware/eye.c": ["test_eye", *RENDERER],
     "firmware/": RENDERER,
 }
 
