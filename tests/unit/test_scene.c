@@ -467,11 +467,15 @@ static void test_object_count_limit(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_good_blob_loads),    cmocka_unit_test(test_header_damage),
-        cmocka_unit_test(test_body_damage),        cmocka_unit_test(test_tree_must_be_a_tree),
+        cmocka_unit_test(test_good_blob_loads),
+        cmocka_unit_test(test_header_damage),
+        cmocka_unit_test(test_body_damage),
+        cmocka_unit_test(test_tree_must_be_a_tree),
         cmocka_unit_test(test_depth_must_cover_the_tree),
-        cmocka_unit_test(test_objects_blob_loads), cmocka_unit_test(test_object_damage),
-        cmocka_unit_test(test_object_body_damage), cmocka_unit_test(test_object_count_limit),
+        cmocka_unit_test(test_objects_blob_loads),
+        cmocka_unit_test(test_object_damage),
+        cmocka_unit_test(test_object_body_damage),
+        cmocka_unit_test(test_object_count_limit),
     };
     return cmocka_run_group_tests_name("scene", tests, setup, teardown);
 }
