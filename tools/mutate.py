@@ -11,8 +11,11 @@ file's tests need are rebuilt there, and those tests run with a timeout:
   timeout    a test ran past its timeout (counted as caught: the mutant never finishes)
   survived   every test passed
   no-build   the mutant does not compile (not counted in the score, not in the sample)
+  equivalent the mutant is in EQUIVALENT: it cannot change what the program does (the table gives
+             why); it is not built or run, it counts in the sample, and is reported apart
 
-The score is (killed + timeout) / (killed + timeout + survived). It writes build/mutate/report.md (the
+The score is (killed + timeout) / (killed + timeout + survived + equivalent), the raw score; the score
+excluding equivalents leaves them out of the denominator. Both are reported. It writes build/mutate/report.md (the
 counts per file and every survivor with its diff), build/mutate/results.json and, unless --no-doc,
 the "mutate" section of docs/benchmarks.md. A benchmark, not part of make test.
 """
@@ -60,6 +63,28 @@ TESTS = {
     "firmware/eye.c": ["test_eye", *RENDERER],
     "firmware/": RENDERER,
 }
+
+
+# Mutants shown to be equivalent, keyed by file and the original and mutated lines (stripped), so an
+# entry follows its line when code above it moves and lapses when the line changes. Each reason is the
+# argument that no input tells the mutant apart from the original.
+EQUIVALENT = {
+    ("firmware/collide_sight.c", "(void)state;", "/*(void)state;*/"):
+        "a cast to void that only silences the unused-parameter warning: no code either way",
+    ("firmware/direct.c", "for (int y = face.top; y < face.bottom; y++) {",
+     "for (int y = face.top; y != face.bottom; y++) {"):
+        "draw_face's rows: face_build keeps a face only when top < bottom, and y steps by one from top, "
+        "so y < bottom and y != bottom agree on every row",
+    ("hal/serial/fl_codec.c",
+     "enc_colour(r, s->c, SET_KEEP, col, j + 1 < rn ? (ref->pk[j + 1] & 0xFF) : -1,",
+     "enc_colour(r, s->c, SET_KEEP, col, j + 1 != rn ? (ref->pk[j + 1] & 0xFF) : -1,"):
+        "enc_op's branch reads ref->pk[j], so j < rn there (j == rn is the branch above): j + 1 <= rn, "
+        "where j + 1 < rn and j + 1 != rn agree",
+}
+
+
+def equivalent_reason(rel, original, mutant):
+    return EQUIVALENT.get((rel, original.strip(), mutant.strip()))
 
 
 def tests_for(rel):
@@ -243,6 +268,14 @@ def try_mutants(args, every, tree, originals, base, log, results, start):
         if sum(r["status"] != "no-build" for r in results) >= args.sample:
             break
         rel, n, text, rule = m
+        why = equivalent_reason(rel, originals[rel][n - 1], text)
+        if why:
+            results.append({"file": rel, "line": n, "mutant": text.rstrip("\n"), "rule": rule,
+                            "original": originals[rel][n - 1].rstrip("\n"), "status": "equivalent", "by": None,
+                            "seconds": 0, "reason": why})
+            done = sum(r["status"] != "no-build" for r in results)
+            print(f"[{done}/{args.sample}] {rel}:{n} equivalent (EQUIVALENT)", flush=True)
+            continue
         lines = list(originals[rel])
         lines[n - 1] = text
         path = tree / rel
@@ -275,41 +308,47 @@ def try_mutants(args, every, tree, originals, base, log, results, start):
 
 
 def counts(rows):
-    c = {k: 0 for k in ("killed", "timeout", "survived", "no-build")}
+    c = {k: 0 for k in ("killed", "timeout", "survived", "equivalent", "no-build")}
     for r in rows:
         c[r["status"]] += 1
     return c
 
 
-def score_of(c):
-    scored = c["killed"] + c["timeout"] + c["survived"]
+def score_of(c, equivalents=True):
+    """(score, denominator): caught over every sampled mutant, or (equivalents=False) over those not
+    known to be equivalent."""
+    scored = c["killed"] + c["timeout"] + c["survived"] + (c["equivalent"] if equivalents else 0)
     return (c["killed"] + c["timeout"]) / scored if scored else 0.0, scored
 
 
 def report(args, out, files, total, results, elapsed):
     c = counts(results)
     score, scored = score_of(c)
+    score_ne, scored_ne = score_of(c, equivalents=False)
     command = "make mutate" + (f" MUTATE_SAMPLE={args.sample}" if args.sample != DEFAULT_SAMPLE else "") + \
         (f" MUTATE_SEED={args.seed}" if args.seed != DEFAULT_SEED else "")
     summary = [f"Mutants of {len(files)} files (firmware/, firmware/dfu/, hal/serial/): {total}, made by "
                f"universalmutator's regexp rules ({', '.join(RULES)}). A seeded shuffle (seed {args.seed}) "
                f"picks them; {scored} that built were run against the fast tests of their file "
                f"(tools/mutate.py's TESTS: cmocka unit tests, and the golden CRC-32s of "
-               f"tests/scenes/default.scene's views in the five render modes of tests/test_golden.py), "
+               f"tests/golden/frames.json's views, tests/scenes/default.scene's and freedoom2.wad MAP01's textured "
+               f"ones with objects, in the five render modes of tests/test_golden.py), "
                f"built with ASan and UBSan.",
                "",
-               f"**Score: {score:.1%}** of {scored} mutants caught (killed {c['killed']}, timed out "
-               f"{c['timeout']}, survived {c['survived']}); {c['no-build']} more did not compile and are "
-               f"not counted. Run time {fmt_time(elapsed)}.",
+               f"**Score: {score_ne:.1%}** of the {scored_ne} mutants not known to be equivalent caught "
+               f"(killed {c['killed']}, timed out {c['timeout']}, survived {c['survived']}); raw score "
+               f"{score:.1%} of all {scored} sampled, counting the {c['equivalent']} equivalent ones "
+               f"(tools/mutate.py's EQUIVALENT, each with its reason below) as not caught. {c['no-build']} more "
+               f"did not compile and are not counted. Run time {fmt_time(elapsed)}.",
                "",
-               "| file | mutants | caught | survived | no-build |",
-               "| --- | ---: | ---: | ---: | ---: |"]
+               "| file | mutants | caught | survived | equivalent | no-build |",
+               "| --- | ---: | ---: | ---: | ---: | ---: |"]
     for rel in files:
         rows = [r for r in results if r["file"] == rel]
         if rows:
             k = counts(rows)
             summary.append(f"| {rel} | {len(rows) - k['no-build']} | {k['killed'] + k['timeout']} | "
-                           f"{k['survived']} | {k['no-build']} |")
+                           f"{k['survived']} | {k['equivalent']} | {k['no-build']} |")
     survivors = [r for r in results if r["status"] == "survived"]
     body = [f"# Mutation testing\n\nCommand: `{command}` (tools/mutate.py), "
             f"{time.strftime('%Y-%m-%d')}.\n", *summary, "", "## Survivors", ""]
@@ -318,15 +357,27 @@ def report(args, out, files, total, results, elapsed):
                  "```diff", f"-{r['original']}", f"+{r['mutant']}", "```", ""]
     if not survivors:
         body.append("None.")
+    equivalents = sorted((r for r in results if r["status"] == "equivalent"), key=lambda r: (r["file"], r["line"]))
+    body += ["", "## Equivalent mutants (not run)", ""]
+    for r in equivalents:
+        body += [f"{r['file']}:{r['line']}: {r['reason']}", "```diff", f"-{r['original']}", f"+{r['mutant']}",
+                 "```", ""]
+    if not equivalents:
+        body.append("None.")
     (out / "report.md").write_text("\n".join(body) + "\n")
     (out / "results.json").write_text(json.dumps({"seed": args.seed, "sample": args.sample, "mutants": total,
-                                                   "score": score, "counts": c, "seconds": round(elapsed),
+                                                   "score": score, "score_excluding_equivalents": score_ne, "counts": c, "seconds": round(elapsed),
                                                    "results": results}, indent=1) + "\n")
     surv_lines = [f"- {r['file']}:{r['line']}: `{r['original'].strip()}` -> `{r['mutant'].strip()}`"
                   for r in sorted(survivors, key=lambda r: (r["file"], r["line"]))]
+    eq_lines = [f"- {r['file']}:{r['line']}: `{r['original'].strip()}` -> `{r['mutant'].strip()}`: {r['reason']}"
+                for r in sorted(results, key=lambda r: (r["file"], r["line"])) if r["status"] == "equivalent"]
     (out / "summary.md").write_text("\n".join(summary) + "\n\nSurvivors (the diffs are in build/mutate/report.md):\n\n"
-                                    + ("\n".join(surv_lines) if surv_lines else "None.") + "\n")
-    print(f"mutate: score {score:.1%} ({c['killed'] + c['timeout']} of {scored} caught; {c['survived']} survived, "
+                                    + ("\n".join(surv_lines) if surv_lines else "None.")
+                                    + "\n\nEquivalent (not run):\n\n" + ("\n".join(eq_lines) if eq_lines else "None.")
+                                    + "\n")
+    print(f"mutate: score {score_ne:.1%} excluding {c['equivalent']} equivalent, raw {score:.1%} "
+          f"({c['killed'] + c['timeout']} of {scored} caught; {c['survived']} survived, "
           f"{c['no-build']} did not build) in {fmt_time(elapsed)}; report in {out / 'report.md'}")
     if not args.no_doc:
         sys.path.insert(0, str(ROOT / "tools"))
