@@ -61,6 +61,7 @@ TESTS = {
     "firmware/engine.c": [GOLDEN, "test_objects", "test_ranges", "test_scene"],
     "firmware/surfaces.c": ["test_surfaces", *RENDERER],
     "firmware/eye.c": ["test_eye", *RENDERER],
+    "firmware/texture.c": ["test_texture", *RENDERER],
     "firmware/": RENDERER,
 }
 
