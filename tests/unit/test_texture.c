@@ -25,22 +25,24 @@ static const uint8_t TALL_BITS[] = {FLAT_BITS, 7, 8, 9};
 static uint8_t lights[SCN_LIGHT_MAPS * 256];
 static uint8_t texels[NTEX << (FLAT_BITS + 9)];
 
-static void test_floor_texels_follow_the_format(void **state)
+static scn_texture tex[NTEX];
+static scene sc;
+
+/* The flat and its taller copies in one scene with light tables that keep the
+ * texel (the pixels are the texels read); every texel below 0x80. */
+static int setup(void **state)
 {
     (void)state;
-    /* light tables that keep the texel, so the pixels are the texels read */
     for (int t = 0; t < SCN_LIGHT_MAPS; t++)
         for (int c = 0; c < 256; c++) lights[t * 256 + c] = (uint8_t)c;
-    scn_texture tex[NTEX];
     uint32_t first = 0;
     for (size_t k = 0; k < NTEX; k++) {
         tex[k] = (scn_texture){first, FLAT_BITS, TALL_BITS[k], 0, 0, (uint16_t)(1u << TALL_BITS[k]), 0};
         for (uint32_t u = 0; u < 1u << FLAT_BITS; u++)
-            for (uint32_t v = 0; v < 1u << TALL_BITS[k]; v++) /* no two texels of the flat alike */
-                texels[first + (u << TALL_BITS[k] | v)] = (uint8_t)(((v & 63) * 64 + u) * 37 >> 4);
+            for (uint32_t v = 0; v < 1u << TALL_BITS[k]; v++) /* rows repeat every 64 */
+                texels[first + (u << TALL_BITS[k] | v)] = (uint8_t)((((v & 63) * 64 + u) * 37 >> 5) & 0x7F);
         first += 1u << (FLAT_BITS + TALL_BITS[k]);
     }
-    scene sc;
     memset(&sc, 0, sizeof sc);
     sc.lights = lights;
     sc.nlights = SCN_LIGHT_MAPS;
@@ -48,6 +50,12 @@ static void test_floor_texels_follow_the_format(void **state)
     sc.ntextures = NTEX;
     sc.texels = texels;
     sc.ntexels = first;
+    return 0;
+}
+
+static void test_floor_texels_follow_the_format(void **state)
+{
+    (void)state;
     static const int32_t angles[] = {0, 33, 90, 200, 271};
     uint32_t differ = 0;
     for (size_t a = 0; a < sizeof angles / sizeof angles[0]; a++) {
@@ -69,10 +77,45 @@ static void test_floor_texels_follow_the_format(void **state)
     assert_true(differ > 0); /* the floor shows the texture, not one colour */
 }
 
+/* tex_span fills pixels [x0, x1) of the row and no other, for spans that start
+ * and end anywhere within the subdivisions a wall is sampled at. */
+static void test_span_writes_only_its_pixels(void **state)
+{
+    (void)state;
+    camera cam = {U(3) + 777, U(-5) + 4321, U(41), U(10), 0};
+    view_xform v;
+    view_setup(&v, &cam);
+    /* a wall 200 units east of the eye, across the view (its front faces west) */
+    scn_vertex a = {U(200), U(1000)};
+    scn_side sd = {0, -(1 << 30), 0, 0, {0, 0, 0}, 0, 0};
+    static const int starts[] = {0, 1, 5, 7, 8, 13, 100, 155, 312, 317, 319};
+    for (size_t k = 0; k < NTEX; k++) {
+        tex_paint paints[2] = {tex_wall(&sc, &v, &sd, (uint32_t)k, &a, U(128), 160, 0),
+                               tex_plane(&sc, &v, (uint32_t)k, 0, 160, 0)};
+        for (int pi = 0; pi < 2; pi++)
+            for (int y = VIEW_H / 2 + 3; y < VIEW_H; y += 17)
+                for (size_t i = 0; i < sizeof starts / sizeof starts[0]; i++)
+                    for (int x1 = starts[i] + 1; x1 <= VIEW_W; x1 += 1 + x1 / 16) {
+                        int x0 = starts[i];
+                        uint8_t row[VIEW_W + 16];
+                        memset(row, 0xFF, sizeof row);
+                        tex_span(&paints[pi], y, x0, x1, row);
+                        for (int x = 0; x < VIEW_W + 16; x++)
+                            if (x < x0 || x >= x1) {
+                                if (row[x] != 0xFF) fprintf(stderr, "paint %d: [%d, %d) wrote %d\n", pi, x0, x1, x);
+                                assert_int_equal(row[x], 0xFF);
+                            } else {
+                                assert_true(row[x] < 0x80);
+                            }
+                    }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_floor_texels_follow_the_format),
+        cmocka_unit_test(test_span_writes_only_its_pixels),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return cmocka_run_group_tests(tests, setup, NULL);
 }
