@@ -233,6 +233,39 @@ static void test_depth_must_cover_the_tree(void **state)
     free(b);
 }
 
+/* A partition's direction: each component must be negatable (the side tests
+ * negate them), so INT32_MIN is refused, and both 0 is no line at all; the
+ * refusal names the node. Any other value loads (and renders, load_copy). */
+static void test_node_direction_range(void **state)
+{
+    (void)state;
+    uint8_t *b = malloc(blob_len);
+    const scn_header *h = (const scn_header *)(const void *)blob;
+    uint32_t nn = h->sec[SCN_SEC_NODES].count;
+    assert_true(nn >= 2);
+    static const int32_t bad[][2] = {{INT32_MIN, 1}, {1, INT32_MIN}, {INT32_MIN, 0}, {0, INT32_MIN}, {0, 0}};
+    for (uint32_t i = 0; i < nn; i += nn - 1) { /* the first node and the last */
+        for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+            memcpy(b, blob, blob_len);
+            scn_node *nodes = (scn_node *)(void *)(b + h->sec[SCN_SEC_NODES].offset);
+            nodes[i].dx = bad[k][0];
+            nodes[i].dy = bad[k][1];
+            fix_crc(b, blob_len);
+            scene_error err;
+            assert_int_equal(load_copy(b, blob_len, &err), SCENE_ERR_RANGE);
+            assert_int_equal(err.section, SCN_SEC_NODES);
+            assert_int_equal(err.index, i);
+        }
+        memcpy(b, blob, blob_len);
+        scn_node *nodes = (scn_node *)(void *)(b + h->sec[SCN_SEC_NODES].offset);
+        nodes[i].dx = INT32_MIN + 1; /* the most negative that negates */
+        fix_crc(b, blob_len);
+        scene_error err;
+        assert_int_equal(load_copy(b, blob_len, &err), SCENE_OK);
+    }
+    free(b);
+}
+
 /* ---- models, objects, doors ---- */
 
 typedef struct {
@@ -472,6 +505,7 @@ int main(void)
         cmocka_unit_test(test_body_damage),
         cmocka_unit_test(test_tree_must_be_a_tree),
         cmocka_unit_test(test_depth_must_cover_the_tree),
+        cmocka_unit_test(test_node_direction_range),
         cmocka_unit_test(test_objects_blob_loads),
         cmocka_unit_test(test_object_damage),
         cmocka_unit_test(test_object_body_damage),
