@@ -1089,10 +1089,27 @@ static void test_engine(void **state)
     assert_int_equal(e->world.ceil[g], U(112));
     eng_render(e, ids);
     assert_true(count_id(RAST_ID(RAST_KIND_OBJECT, 1)) > 0);
+    /* an object in the frustum: every mode that has an object pass says it ran */
+    static const render_mode passes[] = {RENDER_DIRECT, RENDER_SPANS};
+    for (size_t k = 0; k < sizeof passes / sizeof passes[0]; k++) {
+        e->mode = passes[k];
+        eng_render(e, ids);
+        assert_true(count_id(RAST_ID(RAST_KIND_OBJECT, 1)) > 0);
+        assert_int_equal(e->stats.object_pass, 1);
+    }
     e->mode = RENDER_PAINTER;
     eng_step(e, 0, 50);
     assert_int_equal(e->stats.refused, 0);
     assert_true(e->stats.object_faces > 0);
+    /* the present key steps through every present mode, one a press, and round */
+    hal_present_mode first = e->present;
+    uint32_t seen = 0;
+    for (int i = 0; i < HAL_PRESENT_COUNT; i++) {
+        seen |= 1u << e->present;
+        eng_step(e, HAL_KEY_NEXT_PRESENT, 0);
+    }
+    assert_int_equal(seen, (1u << HAL_PRESENT_COUNT) - 1);
+    assert_int_equal(e->present, first);
     free(work);
     free(e);
     unload(&l);
