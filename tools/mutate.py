@@ -81,6 +81,19 @@ EQUIVALENT = {
      "enc_colour(r, s->c, SET_KEEP, col, j + 1 != rn ? (ref->pk[j + 1] & 0xFF) : -1,"):
         "enc_op's branch reads ref->pk[j], so j < rn there (j == rn is the branch above): j + 1 <= rn, "
         "where j + 1 < rn and j + 1 != rn agree",
+    ("firmware/scene.c", "for (uint32_t i = 0; i < s->nsectors; i++) {",
+     "for (uint32_t i = 0; i != s->nsectors; i++) {"):
+        "i counts up by one from 0 and nothing else changes it: i < n and i != n end the loop at the same i",
+    ("firmware/spans.c", "screen_pt a = pts[i], b = pts[(i + 1 == n) ? 0 : i + 1];",
+     "screen_pt a = pts[i], b = pts[(i + 1 >= n) ? 0 : i + 1];"):
+        "inside for (i = 0; i < n; i++): i + 1 <= n, where i + 1 == n and i + 1 >= n agree",
+    ("firmware/dfu/dfu_proto.c",
+     'return status < sizeof status_texts / sizeof status_texts[0] ? status_texts[status] : "unknown status code";',
+     'return status < sizeof status_texts / sizeof status_texts[(0-1)] ? status_texts[status] : "unknown status code";'):
+        "sizeof does not evaluate its operand: status_texts[-1] has the element type, the same size as "
+        "status_texts[0]",
+    ("firmware/obj_draw.c", "#define NORM_HI ((int64_t)1 << 30)", "#define NORM_HI ((int64_t)1 <!= 30)"):
+        "NORM_HI is never expanded (obj_draw.c and every header): the macro's text is never compiled",
 }
 
 

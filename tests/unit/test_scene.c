@@ -266,6 +266,28 @@ static void test_node_direction_range(void **state)
     free(b);
 }
 
+/* The features a scene needs follow from what it holds: textures exactly when it
+ * has a look (a flat scene needs none), objects exactly when it has models. */
+static void test_derived_features(void **state)
+{
+    (void)state;
+    uint32_t *aligned = malloc(blob_len + 4);
+    memcpy(aligned, blob, blob_len);
+    scene s;
+    scene_error err;
+    assert_int_equal(scene_load(&s, aligned, (uint32_t)blob_len, &err), SCENE_OK);
+    assert_null(s.look);
+    uint32_t flat = scene_derived_features(&s);
+    assert_int_equal(flat & SCN_NEED_TEXTURES, 0);
+    assert_int_equal(flat & SCN_NEED_OBJECTS, s.nmodels ? SCN_NEED_OBJECTS : 0);
+    scn_look look;
+    memset(&look, 0, sizeof look);
+    scene t = s;
+    t.look = &look;
+    assert_int_equal(scene_derived_features(&t), flat | SCN_NEED_TEXTURES);
+    free(aligned);
+}
+
 /* ---- models, objects, doors ---- */
 
 typedef struct {
@@ -506,6 +528,7 @@ int main(void)
         cmocka_unit_test(test_tree_must_be_a_tree),
         cmocka_unit_test(test_depth_must_cover_the_tree),
         cmocka_unit_test(test_node_direction_range),
+        cmocka_unit_test(test_derived_features),
         cmocka_unit_test(test_objects_blob_loads),
         cmocka_unit_test(test_object_damage),
         cmocka_unit_test(test_object_body_damage),
