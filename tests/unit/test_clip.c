@@ -63,6 +63,12 @@ static void test_clip_all_outside(void **state)
     clip_poly q = {3, {{0, 0, 1000}, {100, 0, 1000}, {0, 100, 1000}}};
     assert_int_equal(clip_polygon(&q, &v, CLIP_ALL), 3); /* wholly inside: untouched */
     assert_int_equal(q.v[1].x, 100);
+    /* fewer than 3 vertices is no area, wholly inside or not, whatever planes clip it */
+    for (int n = 0; n < 3; n++)
+        for (unsigned mask = 0; mask <= CLIP_ALL; mask++) {
+            clip_poly d = {n, {{0, 0, 1000}, {100, 0, 1000}, {0, 100, 1000}}};
+            assert_int_equal(clip_polygon(&d, &v, mask), 0);
+        }
 }
 
 /* Count, per pixel, how many times polygons wrote it, through the id buffer. */
