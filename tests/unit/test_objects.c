@@ -975,6 +975,30 @@ static void test_door_motion(void **state)
     unload(&l);
 }
 
+/* A door triggers for a player standing in its sector, however far from its
+ * walls: room a made a door (ceiling 64, open 128), the player in its middle,
+ * 128 units from every wall (reach: OBJ_DOOR_REACH). */
+static void test_door_over_the_player(void **state)
+{
+    (void)state;
+    loaded l;
+    load_text(&l, TWO_ROOMS);
+    uint32_t a = sector_named(&l, U(128), U(128));
+    scn_sector *sec = (scn_sector *)(void *)&l.s.sectors[a];
+    sec->flags |= SCN_SECTOR_DOOR;
+    sec->ceil_h = U(64);
+    sec->open_h = U(128);
+    assert_true(128 > OBJ_DOOR_REACH); /* the walls are all out of reach */
+    uint8_t *mem = malloc(obj_state_bytes(&l.s));
+    world_state w;
+    assert_int_equal(obj_init(&w, &l.s, mem, obj_state_bytes(&l.s)), 0);
+    assert_int_equal(w.ceil[a], U(64));
+    obj_update(&w, &l.s, 100, 100, U(128), U(128));
+    assert_true(w.ceil[a] > U(64));
+    free(mem);
+    unload(&l);
+}
+
 /* The state keeps motion for door sectors only, in sector order: with doors at
  * sectors a (0), b (1) and gap (3), a player in a and near the gap moves those
  * two and leaves b closed, whatever slot each door has. */
@@ -1132,6 +1156,7 @@ int main(void)
         cmocka_unit_test(test_work_bound),
         cmocka_unit_test(test_paths),
         cmocka_unit_test(test_door_motion),
+        cmocka_unit_test(test_door_over_the_player),
         cmocka_unit_test(test_door_slots),
         cmocka_unit_test(test_door_collision),
         cmocka_unit_test(test_engine),
