@@ -54,7 +54,7 @@ TESTS = {
     "firmware/scene.c": [GOLDEN, "test_bsp", "test_scene"],
     "firmware/camera.c": [GOLDEN, "test_collide", "test_objects"],
     "firmware/collide.c": ["test_collide", "test_objects"],
-    "firmware/collide_geom.c": ["test_collide", "test_objects"],
+    "firmware/collide_geom.c": ["test_collide_geom", "test_collide", "test_objects"],
     "firmware/collide_sight.c": ["test_collide", "test_objects"],
     "firmware/objects.c": [GOLDEN, "test_objects"],
     "firmware/obj_draw.c": [GOLDEN, "test_objects"],
