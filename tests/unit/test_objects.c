@@ -425,6 +425,38 @@ static void test_object_hides_wall(void **state)
     unload(&l);
 }
 
+/* Seen from outside the room and above its ceiling, through the backs of its
+ * walls and ceiling (culled), a box floating through the ceiling stands against
+ * the void above the horizon: no world surface decides those pixels during the
+ * walk, so the direct renderer draws them after it. Both renderers draw the
+ * same ids, pixel for pixel, and the box shows. */
+static void test_object_against_the_void(void **state)
+{
+    (void)state;
+    loaded l;
+    load_text(&l, ROOM);
+    models_reset();
+    uint32_t m = model_begin();
+    add_box(m, 40, 40, 64, 0, 0, 0, 40);
+    attach(&l.s);
+    placed p;
+    memset(&p, 0, sizeof p);
+    place(&p, 0, m, 256, 100, 150, 30, 40, 40, 64);
+    static uint32_t spans_ids[VIEW_W * VIEW_H];
+    static const double views[][3] = {{256, -200, 90}, {-150, 60, 10}, {300, -90, 100}};
+    for (size_t k = 0; k < sizeof views / sizeof views[0]; k++) {
+        camera c = cam_at(views[k][0], views[k][1], 200, views[k][2], 0);
+        draw(&l.s, &p.w, &c, RENDER_SPANS);
+        memcpy(spans_ids, ids, sizeof spans_ids);
+        int shown = count_id(p.id[0]);
+        assert_true(shown > 500);
+        draw(&l.s, &p.w, &c, RENDER_DIRECT);
+        assert_int_equal(count_id(p.id[0]), shown);
+        assert_memory_equal(ids, spans_ids, sizeof spans_ids);
+    }
+    unload(&l);
+}
+
 /* Behind a solid wall in another room: not drawn, and when its room's leaves are
  * not visited, not even considered. Through the gap, the part behind the blocks
  * stays hidden. */
@@ -1144,6 +1176,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_resting_on_floor),
         cmocka_unit_test(test_object_hides_wall),
+        cmocka_unit_test(test_object_against_the_void),
         cmocka_unit_test(test_object_behind_wall),
         cmocka_unit_test(test_two_objects_overlap),
         cmocka_unit_test(test_straddle),
