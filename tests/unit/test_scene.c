@@ -406,6 +406,43 @@ static const damage damages[] = {
     {"colour anything", F_FACE, 4, FLD(scn_face, colour), 255, 0, SCENE_OK, -1, 0},
 };
 
+/* An object's whole path must stay in the coordinate box [-SCN_COORD_MAX,
+ * SCN_COORD_MAX] units, both ends closed: a still object exactly on either edge
+ * loads, one raw unit beyond is refused naming it; a circling one is measured
+ * by its circle's reach. */
+static void test_object_box_edges(void **state)
+{
+    (void)state;
+    const int64_t box = (int64_t)SCN_COORD_MAX << 16;
+    uint8_t *b = malloc(oblob_len);
+    for (int axis = 0; axis < 2; axis++)
+        for (int side = -1; side <= 1; side += 2)
+            for (int64_t beyond = 0; beyond <= 1; beyond++) {
+                for (uint32_t i = 0; i < 2; i++) { /* 0: the crate, still; 1: the ship, circling */
+                    memcpy(b, oblob, oblob_len);
+                    oview v = oview_of(b);
+                    int64_t reach = v.o[i].path == SCN_PATH_CIRCLE ? v.o[i].pa : 0;
+                    assert_int_equal(v.o[i].path, i == 0 ? SCN_PATH_NONE : SCN_PATH_CIRCLE);
+                    fx_t at = (fx_t)(side * (box - reach + beyond));
+                    if (axis == 0)
+                        v.o[i].x = at;
+                    else
+                        v.o[i].y = at;
+                    fix_crc(b, oblob_len);
+                    scene_error err;
+                    scene_status st = load_copy(b, oblob_len, &err);
+                    if (beyond) {
+                        assert_int_equal(st, SCENE_ERR_RANGE);
+                        assert_int_equal(err.section, SCN_SEC_OBJECTS);
+                        assert_int_equal(err.index, i);
+                    } else {
+                        assert_int_equal(st, SCENE_OK);
+                    }
+                }
+            }
+    free(b);
+}
+
 static void test_object_damage(void **state)
 {
     (void)state;
@@ -529,6 +566,7 @@ int main(void)
         cmocka_unit_test(test_depth_must_cover_the_tree),
         cmocka_unit_test(test_node_direction_range),
         cmocka_unit_test(test_derived_features),
+        cmocka_unit_test(test_object_box_edges),
         cmocka_unit_test(test_objects_blob_loads),
         cmocka_unit_test(test_object_damage),
         cmocka_unit_test(test_object_body_damage),
