@@ -82,6 +82,25 @@ static void fill(const screen_pt *pts, int n, uint32_t id)
     rast_convex(&t, pts, n, &paint, id);
 }
 
+/* A polygon reaching above the screen's top edge: while its first sample row is
+ * still row 0 (under half a row above), it draws rows 0 .. 9 as a polygon on the
+ * screen would; beyond that it breaks rast_convex's contract (vertices on the
+ * screen) and draws nothing, touching no row outside the screen (the sanitizers
+ * watch the row tables on the stack). */
+static void test_rows_above_the_top(void **state)
+{
+    (void)state;
+    static const int32_t tops[] = {0, -16384, -32767, -32768, -65536, -98304, -98305, -3 * 65536};
+    for (size_t k = 0; k < sizeof tops / sizeof tops[0]; k++) {
+        hal_null_reset();
+        hal_perf_reset();
+        screen_pt q[4] = {{0, tops[k]}, {VIEW_W_FX, tops[k]}, {VIEW_W_FX, 10 * 65536}, {0, 10 * 65536}};
+        fill(q, 4, 9);
+        uint64_t want = rast_first_sample(tops[k]) == 0 ? 10 * VIEW_W : 0;
+        assert_int_equal(hal_perf_event(HAL_EV_PIXELS), want);
+    }
+}
+
 static void test_full_screen_quad(void **state)
 {
     (void)state;
@@ -142,9 +161,8 @@ static void test_shared_edges_exactly_once(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_clip_inside_planes),
-        cmocka_unit_test(test_clip_all_outside),
-        cmocka_unit_test(test_full_screen_quad),
+        cmocka_unit_test(test_clip_inside_planes),        cmocka_unit_test(test_clip_all_outside),
+        cmocka_unit_test(test_rows_above_the_top),        cmocka_unit_test(test_full_screen_quad),
         cmocka_unit_test(test_shared_edges_exactly_once),
     };
     return cmocka_run_group_tests_name("clip", tests, NULL, NULL);
