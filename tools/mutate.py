@@ -15,7 +15,8 @@ file's tests need are rebuilt there, and those tests run with a timeout:
              why); it is not built or run, it counts in the sample, and is reported apart
 
 The score is (killed + timeout) / (killed + timeout + survived + equivalent), the raw score; the score
-excluding equivalents leaves them out of the denominator. Both are reported. It writes build/mutate/report.md (the
+excluding equivalents leaves them out of the denominator. Both are reported. A survivor in UNREACHED
+(code the host build does not compile or reach) stays a survivor; the report says where that code runs. It writes build/mutate/report.md (the
 counts per file and every survivor with its diff), build/mutate/results.json and, unless --no-doc,
 the "mutate" section of docs/benchmarks.md. A benchmark, not part of make test.
 """
@@ -96,6 +97,30 @@ EQUIVALENT = {
     ("firmware/obj_draw.c", "#define NORM_HI ((int64_t)1 << 30)", "#define NORM_HI ((int64_t)1 <!= 30)"):
         "NORM_HI is never expanded (obj_draw.c and every header): the macro's text is never compiled",
 }
+
+
+# Mutants in code that the host build the fast tests run does not compile or reach, keyed as EQUIVALENT.
+# They are not equivalent: they stay survivors and count against the score; the report says where
+# the code runs, so that a reader does not look for a missing host test.
+UNREACHED = {
+    ("hal/serial/fl_codec.c", '"    cmpeq   r7, %[bc]\\n"', '/*"    cmpeq   r7, %[bc]\\n"*/'):
+        "Cortex-M3 assembly (__ARM_ARCH_7M__ && __thumb2__): compiled only for the M3 firmware, whose "
+        "tests run under QEMU (tests/test_firmware.py and the link tests), not among the fast ones",
+    ("firmware/raster.c",
+     "int64_t step = floor_div(dx * (2 << RAST_STEP_BITS) + dy, 2 * dy) * (1 << (16 - RAST_STEP_BITS));",
+     "int64_t step = floor_div(dx * (0 << RAST_STEP_BITS) + dy, 2 * dy) * (1 << (16 - RAST_STEP_BITS));"):
+        "compiled only with RAST_STEP_BITS > 0, a precision knob of make report (mk/report.mk); the "
+        "default build steps edges exactly",
+    ("firmware/engine.c", "return (e->world.ceil || e->world.objs) ? &e->world : 0;",
+     "return (e->world.ceil || e->world.objs) ? &e->world : 1;"):
+        "the 0 arm runs only in a build without objects and doors (CFG_OBJECTS and CFG_DOORS 0: the "
+        "firmware built for a scene that needs neither); the host build has both, so obj_init always "
+        "sets ceil and objs",
+}
+
+
+def unreached_note(rel, original, mutant):
+    return UNREACHED.get((rel, original.strip(), mutant.strip()))
 
 
 def equivalent_reason(rel, original, mutant):
@@ -368,7 +393,9 @@ def report(args, out, files, total, results, elapsed):
     body = [f"# Mutation testing\n\nCommand: `{command}` (tools/mutate.py), "
             f"{time.strftime('%Y-%m-%d')}.\n", *summary, "", "## Survivors", ""]
     for r in sorted(survivors, key=lambda r: (r["file"], r["line"])):
-        body += [f"{r['file']}:{r['line']} (tests: {', '.join(args.tests or tests_for(r['file']))})",
+        note = unreached_note(r["file"], r["original"], r["mutant"])
+        body += [f"{r['file']}:{r['line']} (tests: {', '.join(args.tests or tests_for(r['file']))})"
+                 + (f": not reached by the fast tests: {note}" if note else ""),
                  "```diff", f"-{r['original']}", f"+{r['mutant']}", "```", ""]
     if not survivors:
         body.append("None.")
@@ -383,8 +410,11 @@ def report(args, out, files, total, results, elapsed):
     (out / "results.json").write_text(json.dumps({"seed": args.seed, "sample": args.sample, "mutants": total,
                                                    "score": score, "score_excluding_equivalents": score_ne, "counts": c, "seconds": round(elapsed),
                                                    "results": results}, indent=1) + "\n")
-    surv_lines = [f"- {r['file']}:{r['line']}: `{r['original'].strip()}` -> `{r['mutant'].strip()}`"
-                  for r in sorted(survivors, key=lambda r: (r["file"], r["line"]))]
+    surv_lines = []
+    for r in sorted(survivors, key=lambda r: (r["file"], r["line"])):
+        note = unreached_note(r["file"], r["original"], r["mutant"])
+        surv_lines.append(f"- {r['file']}:{r['line']}: `{r['original'].strip()}` -> `{r['mutant'].strip()}`"
+                          + (f" (not reached by the fast tests: {note})" if note else ""))
     eq_lines = [f"- {r['file']}:{r['line']}: `{r['original'].strip()}` -> `{r['mutant'].strip()}`: {r['reason']}"
                 for r in sorted(results, key=lambda r: (r["file"], r["line"])) if r["status"] == "equivalent"]
     (out / "summary.md").write_text("\n".join(summary) + "\n\nSurvivors (the diffs are in build/mutate/report.md):\n\n"
