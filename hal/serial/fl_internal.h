@@ -50,7 +50,8 @@ void fl_writer_message(fl_writer *w, uint8_t type, uint32_t frame_no, const uint
 
 /* Reader: feed one byte. Returns 0 (nothing yet), 1 (a segment ended with a
  * structurally complete message of r->len bytes in r->buf) or -reason (a
- * non-empty segment ended and was bad). */
+ * non-empty segment ended and was bad; r->len is then 0: no part of it can be
+ * taken for a message). */
 void fl_reader_init(fl_reader *r, uint8_t *buf, uint32_t cap);
 int fl_reader_byte(fl_reader *r, uint8_t b);
 

@@ -63,6 +63,12 @@ static void test_clip_all_outside(void **state)
     clip_poly q = {3, {{0, 0, 1000}, {100, 0, 1000}, {0, 100, 1000}}};
     assert_int_equal(clip_polygon(&q, &v, CLIP_ALL), 3); /* wholly inside: untouched */
     assert_int_equal(q.v[1].x, 100);
+    /* fewer than 3 vertices is no area, wholly inside or not, whatever planes clip it */
+    for (int n = 0; n < 3; n++)
+        for (unsigned mask = 0; mask <= CLIP_ALL; mask++) {
+            clip_poly d = {n, {{0, 0, 1000}, {100, 0, 1000}, {0, 100, 1000}}};
+            assert_int_equal(clip_polygon(&d, &v, mask), 0);
+        }
 }
 
 /* Count, per pixel, how many times polygons wrote it, through the id buffer. */
@@ -74,6 +80,48 @@ static void fill(const screen_pt *pts, int n, uint32_t id)
     rast_target t = {&s, ids};
     tex_paint paint = tex_flat(1);
     rast_convex(&t, pts, n, &paint, id);
+}
+
+/* A polygon that breaks the contract (convex): a zig-zag across the near plane,
+ * each vertex on the other side from the last, as many as allowed. Clipping it
+ * would make one and a half times as many vertices; the clipper keeps to its
+ * arrays (the sanitizers watch them) and gives at most CLIP_MAX_VERTS. */
+static void test_zigzag_keeps_to_its_arrays(void **state)
+{
+    (void)state;
+    view_xform v = flat_view(0);
+    for (unsigned mask = CLIP_NEAR; mask <= CLIP_ALL; mask += CLIP_ALL - CLIP_NEAR)
+        for (int first = 0; first < 2; first++) /* starting inside, and outside */
+            for (int n0 = 3; n0 <= CLIP_MAX_VERTS - 5; n0++) {
+                clip_poly p;
+                p.n = n0;
+                for (int i = 0; i < p.n; i++) {
+                    p.v[i].x = (i - p.n / 2) * 64;
+                    p.v[i].y = 0;
+                    p.v[i].z = (i + first) % 2 ? -4096 : 4096;
+                }
+                int n = clip_polygon(&p, &v, mask);
+                assert_true(n <= CLIP_MAX_VERTS);
+            }
+}
+
+/* A polygon reaching above the screen's top edge: while its first sample row is
+ * still row 0 (under half a row above), it draws rows 0 .. 9 as a polygon on the
+ * screen would; beyond that it breaks rast_convex's contract (vertices on the
+ * screen) and draws nothing, touching no row outside the screen (the sanitizers
+ * watch the row tables on the stack). */
+static void test_rows_above_the_top(void **state)
+{
+    (void)state;
+    static const int32_t tops[] = {0, -16384, -32767, -32768, -65536, -98304, -98305, -3 * 65536};
+    for (size_t k = 0; k < sizeof tops / sizeof tops[0]; k++) {
+        hal_null_reset();
+        hal_perf_reset();
+        screen_pt q[4] = {{0, tops[k]}, {VIEW_W_FX, tops[k]}, {VIEW_W_FX, 10 * 65536}, {0, 10 * 65536}};
+        fill(q, 4, 9);
+        uint64_t want = rast_first_sample(tops[k]) == 0 ? 10 * VIEW_W : 0;
+        assert_int_equal(hal_perf_event(HAL_EV_PIXELS), want);
+    }
 }
 
 static void test_full_screen_quad(void **state)
@@ -136,10 +184,9 @@ static void test_shared_edges_exactly_once(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_clip_inside_planes),
-        cmocka_unit_test(test_clip_all_outside),
-        cmocka_unit_test(test_full_screen_quad),
-        cmocka_unit_test(test_shared_edges_exactly_once),
+        cmocka_unit_test(test_clip_inside_planes),         cmocka_unit_test(test_clip_all_outside),
+        cmocka_unit_test(test_zigzag_keeps_to_its_arrays), cmocka_unit_test(test_rows_above_the_top),
+        cmocka_unit_test(test_full_screen_quad),           cmocka_unit_test(test_shared_edges_exactly_once),
     };
     return cmocka_run_group_tests_name("clip", tests, NULL, NULL);
 }

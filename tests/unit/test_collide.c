@@ -824,6 +824,30 @@ static void test_map01_sight(void **state)
 
 /* ------------------------------------------------------------ camera */
 
+/* Under a ceiling lower than the eye's height (a door shut on the eye, a crusher)
+ * the floor wins over the ceiling gap: the eye stays 41 above the floor it
+ * stands on, never sinking into it, standing or turning. */
+static void test_camera_floor_wins_under_a_low_ceiling(void **state)
+{
+    (void)state;
+    static const int ceils[] = {0, 8, 32, 44};
+    for (size_t k = 0; k < sizeof ceils / sizeof ceils[0]; k++) {
+        loaded l;
+        int f[] = {16, 16}, c[] = {16 + ceils[k], 16 + ceils[k]};
+        load_chain(&l, 2, f, c);
+        cam_state cam;
+        cam_start(&cam, &l.s);
+        assert_int_equal(cam.view.z, U(16 + 41));
+        for (int i = 0; i < 20; i++) {
+            cam_move(&cam, &l.s, NULL, i < 10 ? 0 : HAL_KEY_TURN_LEFT, 28);
+            assert_int_equal(cam.eye_floor, U(16));
+            assert_int_equal(cam.view.z, U(16 + 41));
+        }
+        unload(&l);
+    }
+}
+
+
 static void test_camera_walks_and_climbs(void **state)
 {
     (void)state;
@@ -890,6 +914,7 @@ int main(void)
         cmocka_unit_test(test_all_maps_random_walk),
         cmocka_unit_test(test_map01_sight),
         cmocka_unit_test(test_camera_walks_and_climbs),
+        cmocka_unit_test(test_camera_floor_wins_under_a_low_ceiling),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -807,6 +807,49 @@ static void test_framing(void **state)
 }
 
 
+/* ---- any address ------------------------------------------------------------ */
+
+/* The frame check, the transition estimate and the coded picture depend on the
+ * pixels only, not on where they lie: the scans read whole words only where both
+ * frames are word-aligned (UBSan halts on a misaligned word read), bytes
+ * elsewhere, and the two must agree. Every offset within two words. */
+static void test_any_address(void **state)
+{
+    (void)state;
+    uint8_t *px = malloc(FL_FRAME_BYTES), *base = malloc(FL_FRAME_BYTES);
+    uint8_t *upx = malloc(FL_FRAME_BYTES + 32), *ubase = malloc(FL_FRAME_BYTES + 32);
+    uint8_t *out = malloc(1 << 18), *out2 = malloc(1 << 18);
+    for (int i = 0; i < FL_FRAME_BYTES; i++) {
+        int x = i % FL_W, y = i / FL_W;
+        px[i] = (uint8_t)(x > 100 + y / 2 ? (x / 9) & 7 : (y / 7) & 3);
+        base[i] = (uint8_t)(rnd() % 50 == 0 ? rnd() & 7 : px[i]);
+    }
+    static fl_coder c0;
+    uint32_t check, check2;
+    uint32_t n = fl_code_picture(&c0, px, base, out, 1 << 18, &check);
+    assert_true(n > 0);
+    uint32_t est = fl_estimate_transitions(px, base), est0 = fl_estimate_transitions(px, NULL);
+    for (int off = 0; off < 2 * (int)sizeof(long); off++)
+        for (int boff = 0; boff < 2 * (int)sizeof(long); boff += off ? 2 * (int)sizeof(long) : 1) {
+            memcpy(upx + off, px, FL_FRAME_BYTES);
+            memcpy(ubase + boff, base, FL_FRAME_BYTES);
+            assert_int_equal(fl_frame_check(upx + off), check);
+            assert_int_equal(fl_estimate_transitions(upx + off, NULL), est0);
+            assert_int_equal(fl_estimate_transitions(upx + off, ubase + boff), est);
+            static fl_coder cu; /* fresh, as c0 was */
+            memset(&cu, 0, sizeof cu);
+            assert_int_equal(fl_code_picture(&cu, upx + off, ubase + boff, out2, 1 << 18, &check2), n);
+            assert_memory_equal(out2, out, n);
+            assert_int_equal(check2, check);
+        }
+    free(px);
+    free(base);
+    free(upx);
+    free(ubase);
+    free(out);
+    free(out2);
+}
+
 /* ---- every reader's bound: messages of cap - 1, cap and cap + 1 bytes ---------- */
 
 /* COBS as docs/frame-link.md writes it, independent of fl_writer: blocks of at
@@ -847,7 +890,8 @@ static void pattern(uint8_t *p, uint32_t n, int pat)
 
 /* fl_reader over a buffer of exactly cap bytes (malloc'd, so that ASan sees a
  * byte past it): messages up to cap bytes arrive whole, one more is refused as
- * too long and writes nothing, and the reader takes the next message. */
+ * too long and writes nothing past the buffer, leaves no bytes to be read, and the
+ * reader takes the next message. */
 static void test_reader_bound(void **state)
 {
     (void)state;
@@ -873,6 +917,7 @@ static void test_reader_bound(void **state)
                     assert_memory_equal(rbuf, msg, n);
                 } else {
                     assert_int_equal(res, -(int)FL_R_LONG);
+                    assert_int_equal(rd.len, 0); /* nothing of the refused segment is left to read */
                 }
                 assert_true(rd.len <= cap);
                 for (res = 0; i < s.len; i++) res = fl_reader_byte(&rd, s.p[i]), got += res == 1;
@@ -1240,6 +1285,7 @@ int main(void)
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_forged_pictures),
         cmocka_unit_test(test_framing),
+        cmocka_unit_test(test_any_address),
         cmocka_unit_test(test_single_pixel_detected),
         cmocka_unit_test(test_direct_stuffing),
         cmocka_unit_test(test_page_flipping),

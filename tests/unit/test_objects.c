@@ -425,6 +425,38 @@ static void test_object_hides_wall(void **state)
     unload(&l);
 }
 
+/* Seen from outside the room and above its ceiling, through the backs of its
+ * walls and ceiling (culled), a box floating through the ceiling stands against
+ * the void above the horizon: no world surface decides those pixels during the
+ * walk, so the direct renderer draws them after it. Both renderers draw the
+ * same ids, pixel for pixel, and the box shows. */
+static void test_object_against_the_void(void **state)
+{
+    (void)state;
+    loaded l;
+    load_text(&l, ROOM);
+    models_reset();
+    uint32_t m = model_begin();
+    add_box(m, 40, 40, 64, 0, 0, 0, 40);
+    attach(&l.s);
+    placed p;
+    memset(&p, 0, sizeof p);
+    place(&p, 0, m, 256, 100, 150, 30, 40, 40, 64);
+    static uint32_t spans_ids[VIEW_W * VIEW_H];
+    static const double views[][3] = {{256, -200, 90}, {-150, 60, 10}, {300, -90, 100}};
+    for (size_t k = 0; k < sizeof views / sizeof views[0]; k++) {
+        camera c = cam_at(views[k][0], views[k][1], 200, views[k][2], 0);
+        draw(&l.s, &p.w, &c, RENDER_SPANS);
+        memcpy(spans_ids, ids, sizeof spans_ids);
+        int shown = count_id(p.id[0]);
+        assert_true(shown > 500);
+        draw(&l.s, &p.w, &c, RENDER_DIRECT);
+        assert_int_equal(count_id(p.id[0]), shown);
+        assert_memory_equal(ids, spans_ids, sizeof spans_ids);
+    }
+    unload(&l);
+}
+
 /* Behind a solid wall in another room: not drawn, and when its room's leaves are
  * not visited, not even considered. Through the gap, the part behind the blocks
  * stays hidden. */
@@ -975,6 +1007,30 @@ static void test_door_motion(void **state)
     unload(&l);
 }
 
+/* A door triggers for a player standing in its sector, however far from its
+ * walls: room a made a door (ceiling 64, open 128), the player in its middle,
+ * 128 units from every wall (reach: OBJ_DOOR_REACH). */
+static void test_door_over_the_player(void **state)
+{
+    (void)state;
+    loaded l;
+    load_text(&l, TWO_ROOMS);
+    uint32_t a = sector_named(&l, U(128), U(128));
+    scn_sector *sec = (scn_sector *)(void *)&l.s.sectors[a];
+    sec->flags |= SCN_SECTOR_DOOR;
+    sec->ceil_h = U(64);
+    sec->open_h = U(128);
+    assert_true(128 > OBJ_DOOR_REACH); /* the walls are all out of reach */
+    uint8_t *mem = malloc(obj_state_bytes(&l.s));
+    world_state w;
+    assert_int_equal(obj_init(&w, &l.s, mem, obj_state_bytes(&l.s)), 0);
+    assert_int_equal(w.ceil[a], U(64));
+    obj_update(&w, &l.s, 100, 100, U(128), U(128));
+    assert_true(w.ceil[a] > U(64));
+    free(mem);
+    unload(&l);
+}
+
 /* The state keeps motion for door sectors only, in sector order: with doors at
  * sectors a (0), b (1) and gap (3), a player in a and near the gap moves those
  * two and leaves b closed, whatever slot each door has. */
@@ -1089,10 +1145,27 @@ static void test_engine(void **state)
     assert_int_equal(e->world.ceil[g], U(112));
     eng_render(e, ids);
     assert_true(count_id(RAST_ID(RAST_KIND_OBJECT, 1)) > 0);
+    /* an object in the frustum: every mode that has an object pass says it ran */
+    static const render_mode passes[] = {RENDER_DIRECT, RENDER_SPANS};
+    for (size_t k = 0; k < sizeof passes / sizeof passes[0]; k++) {
+        e->mode = passes[k];
+        eng_render(e, ids);
+        assert_true(count_id(RAST_ID(RAST_KIND_OBJECT, 1)) > 0);
+        assert_int_equal(e->stats.object_pass, 1);
+    }
     e->mode = RENDER_PAINTER;
     eng_step(e, 0, 50);
     assert_int_equal(e->stats.refused, 0);
     assert_true(e->stats.object_faces > 0);
+    /* the present key steps through every present mode, one a press, and round */
+    hal_present_mode first = e->present;
+    uint32_t seen = 0;
+    for (int i = 0; i < HAL_PRESENT_COUNT; i++) {
+        seen |= 1u << e->present;
+        eng_step(e, HAL_KEY_NEXT_PRESENT, 0);
+    }
+    assert_int_equal(seen, (1u << HAL_PRESENT_COUNT) - 1);
+    assert_int_equal(e->present, first);
     free(work);
     free(e);
     unload(&l);
@@ -1103,6 +1176,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_resting_on_floor),
         cmocka_unit_test(test_object_hides_wall),
+        cmocka_unit_test(test_object_against_the_void),
         cmocka_unit_test(test_object_behind_wall),
         cmocka_unit_test(test_two_objects_overlap),
         cmocka_unit_test(test_straddle),
@@ -1115,6 +1189,7 @@ int main(void)
         cmocka_unit_test(test_work_bound),
         cmocka_unit_test(test_paths),
         cmocka_unit_test(test_door_motion),
+        cmocka_unit_test(test_door_over_the_player),
         cmocka_unit_test(test_door_slots),
         cmocka_unit_test(test_door_collision),
         cmocka_unit_test(test_engine),

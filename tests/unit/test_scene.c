@@ -191,6 +191,103 @@ static void test_tree_must_be_a_tree(void **state)
     free(b);
 }
 
+/* Nodes on the longest path from node n down to a leaf, walked here on the blob's
+ * own records (a tree the loader has accepted). */
+static uint32_t depth_below(const scn_node *nodes, uint32_t n)
+{
+    uint32_t deepest = 0;
+    for (int c = 0; c < 2; c++) {
+        uint32_t ch = nodes[n].child[c];
+        if (ch & SCN_LEAF_BIT) continue;
+        uint32_t d = depth_below(nodes, ch);
+        if (d > deepest) deepest = d;
+    }
+    return deepest + 1;
+}
+
+/* The header's max_depth sizes the walkers' stacks: the loader measures the tree
+ * and refuses a header that claims less than the longest root-to-leaf path, and
+ * takes one that claims exactly it. */
+static void test_depth_must_cover_the_tree(void **state)
+{
+    (void)state;
+    uint8_t *b = malloc(blob_len);
+    memcpy(b, blob, blob_len);
+    scn_header *h = (scn_header *)(void *)b;
+    const scn_node *nodes = (const scn_node *)(const void *)(b + h->sec[SCN_SEC_NODES].offset);
+    assert_false(h->root & SCN_LEAF_BIT);
+    uint32_t depth = depth_below(nodes, h->root);
+    assert_true(depth >= 3); /* default.scene: a tree deep enough that every level counts */
+    assert_int_equal(h->max_depth, depth);
+    scene_error err;
+    for (uint32_t claim = 1; claim < depth; claim++) {
+        h->max_depth = claim;
+        fix_crc(b, blob_len);
+        assert_int_equal(load_copy(b, blob_len, &err), SCENE_ERR_TREE);
+        assert_int_equal(err.section, -1);
+        assert_int_equal(err.index, SCENE_FIELD_MAX_DEPTH);
+    }
+    h->max_depth = depth;
+    fix_crc(b, blob_len);
+    assert_int_equal(load_copy(b, blob_len, &err), SCENE_OK);
+    free(b);
+}
+
+/* A partition's direction: each component must be negatable (the side tests
+ * negate them), so INT32_MIN is refused, and both 0 is no line at all; the
+ * refusal names the node. Any other value loads (and renders, load_copy). */
+static void test_node_direction_range(void **state)
+{
+    (void)state;
+    uint8_t *b = malloc(blob_len);
+    const scn_header *h = (const scn_header *)(const void *)blob;
+    uint32_t nn = h->sec[SCN_SEC_NODES].count;
+    assert_true(nn >= 2);
+    static const int32_t bad[][2] = {{INT32_MIN, 1}, {1, INT32_MIN}, {INT32_MIN, 0}, {0, INT32_MIN}, {0, 0}};
+    for (uint32_t i = 0; i < nn; i += nn - 1) { /* the first node and the last */
+        for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+            memcpy(b, blob, blob_len);
+            scn_node *nodes = (scn_node *)(void *)(b + h->sec[SCN_SEC_NODES].offset);
+            nodes[i].dx = bad[k][0];
+            nodes[i].dy = bad[k][1];
+            fix_crc(b, blob_len);
+            scene_error err;
+            assert_int_equal(load_copy(b, blob_len, &err), SCENE_ERR_RANGE);
+            assert_int_equal(err.section, SCN_SEC_NODES);
+            assert_int_equal(err.index, i);
+        }
+        memcpy(b, blob, blob_len);
+        scn_node *nodes = (scn_node *)(void *)(b + h->sec[SCN_SEC_NODES].offset);
+        nodes[i].dx = INT32_MIN + 1; /* the most negative that negates */
+        fix_crc(b, blob_len);
+        scene_error err;
+        assert_int_equal(load_copy(b, blob_len, &err), SCENE_OK);
+    }
+    free(b);
+}
+
+/* The features a scene needs follow from what it holds: textures exactly when it
+ * has a look (a flat scene needs none), objects exactly when it has models. */
+static void test_derived_features(void **state)
+{
+    (void)state;
+    uint32_t *aligned = malloc(blob_len + 4);
+    memcpy(aligned, blob, blob_len);
+    scene s;
+    scene_error err;
+    assert_int_equal(scene_load(&s, aligned, (uint32_t)blob_len, &err), SCENE_OK);
+    assert_null(s.look);
+    uint32_t flat = scene_derived_features(&s);
+    assert_int_equal(flat & SCN_NEED_TEXTURES, 0);
+    assert_int_equal(flat & SCN_NEED_OBJECTS, s.nmodels ? SCN_NEED_OBJECTS : 0);
+    scn_look look;
+    memset(&look, 0, sizeof look);
+    scene t = s;
+    t.look = &look;
+    assert_int_equal(scene_derived_features(&t), flat | SCN_NEED_TEXTURES);
+    free(aligned);
+}
+
 /* ---- models, objects, doors ---- */
 
 typedef struct {
@@ -309,6 +406,43 @@ static const damage damages[] = {
     {"colour anything", F_FACE, 4, FLD(scn_face, colour), 255, 0, SCENE_OK, -1, 0},
 };
 
+/* An object's whole path must stay in the coordinate box [-SCN_COORD_MAX,
+ * SCN_COORD_MAX] units, both ends closed: a still object exactly on either edge
+ * loads, one raw unit beyond is refused naming it; a circling one is measured
+ * by its circle's reach. */
+static void test_object_box_edges(void **state)
+{
+    (void)state;
+    const int64_t box = (int64_t)SCN_COORD_MAX << 16;
+    uint8_t *b = malloc(oblob_len);
+    for (int axis = 0; axis < 2; axis++)
+        for (int side = -1; side <= 1; side += 2)
+            for (int64_t beyond = 0; beyond <= 1; beyond++) {
+                for (uint32_t i = 0; i < 2; i++) { /* 0: the crate, still; 1: the ship, circling */
+                    memcpy(b, oblob, oblob_len);
+                    oview v = oview_of(b);
+                    int64_t reach = v.o[i].path == SCN_PATH_CIRCLE ? v.o[i].pa : 0;
+                    assert_int_equal(v.o[i].path, i == 0 ? SCN_PATH_NONE : SCN_PATH_CIRCLE);
+                    fx_t at = (fx_t)(side * (box - reach + beyond));
+                    if (axis == 0)
+                        v.o[i].x = at;
+                    else
+                        v.o[i].y = at;
+                    fix_crc(b, oblob_len);
+                    scene_error err;
+                    scene_status st = load_copy(b, oblob_len, &err);
+                    if (beyond) {
+                        assert_int_equal(st, SCENE_ERR_RANGE);
+                        assert_int_equal(err.section, SCN_SEC_OBJECTS);
+                        assert_int_equal(err.index, i);
+                    } else {
+                        assert_int_equal(st, SCENE_OK);
+                    }
+                }
+            }
+    free(b);
+}
+
 static void test_object_damage(void **state)
 {
     (void)state;
@@ -425,10 +559,18 @@ static void test_object_count_limit(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_good_blob_loads),    cmocka_unit_test(test_header_damage),
-        cmocka_unit_test(test_body_damage),        cmocka_unit_test(test_tree_must_be_a_tree),
-        cmocka_unit_test(test_objects_blob_loads), cmocka_unit_test(test_object_damage),
-        cmocka_unit_test(test_object_body_damage), cmocka_unit_test(test_object_count_limit),
+        cmocka_unit_test(test_good_blob_loads),
+        cmocka_unit_test(test_header_damage),
+        cmocka_unit_test(test_body_damage),
+        cmocka_unit_test(test_tree_must_be_a_tree),
+        cmocka_unit_test(test_depth_must_cover_the_tree),
+        cmocka_unit_test(test_node_direction_range),
+        cmocka_unit_test(test_derived_features),
+        cmocka_unit_test(test_object_box_edges),
+        cmocka_unit_test(test_objects_blob_loads),
+        cmocka_unit_test(test_object_damage),
+        cmocka_unit_test(test_object_body_damage),
+        cmocka_unit_test(test_object_count_limit),
     };
     return cmocka_run_group_tests_name("scene", tests, setup, teardown);
 }
