@@ -278,6 +278,16 @@ def test_all_maps_refuses_what_it_cannot_do(args, needle):
     assert proc.returncode == 2 and needle in proc.stderr, proc.stderr
 
 
+@pytest.mark.parametrize("where, needle", [("none", "No such file or directory"), ("file", "not a folder")])
+def test_all_maps_needs_a_folder_to_write_to(tmp_path, where, needle):
+    out = tmp_path / where
+    if where == "file":
+        out.write_text("x")
+    proc = run([program("bspc"), "freedoom2.wad", "--all", "-o", out], check=False)
+    assert proc.returncode == 1 and proc.stderr == f"bspc: {out}: {needle}\n", proc.stderr
+    assert list(tmp_path.iterdir()) == ([out] if where == "file" else [])
+
+
 def test_all_maps_share_textures_and_write_what_single_runs_write(tmp_path):
     """The textures kept from one map for the next (the look cache) give each map the blob a run of
     its own gives, warnings and all."""

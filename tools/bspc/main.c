@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "bspc.h"
 #include "scene.h"
@@ -153,6 +154,12 @@ static int write_blob(const char *path, const uint8_t *blob, size_t len)
 static int compile_all(const char *wad, const char *dir, const bspc_options *opt, int want_stats)
 {
     char maps[16384], err[512];
+    struct stat st_dir;
+    int found = stat(dir, &st_dir) == 0;
+    if (!found || !S_ISDIR(st_dir.st_mode)) {
+        fprintf(stderr, "bspc: %s: %s\n", dir, found ? "not a folder" : strerror(errno));
+        return 1;
+    }
     int n = bspc_list_maps(wad, maps, sizeof maps, err, sizeof err);
     if (n < 0) {
         fprintf(stderr, "bspc: %s\n", err);
