@@ -70,7 +70,7 @@ $(1)/obj/$(GEN)/%.o: $(GEN)/%.c
 	$$(CC) $$(BASE) $(2) $$(FW_FLAGS) -c $$< -o $$@
 
 $(1)/bspc: $(call objs,$(1)/obj,tools/bspc/main.c $(BSPC_LIB) tools/bspc/crc_fast.c firmware/scene.c)
-	$$(CC) $(2) $$^ -o $$@ $$(ZLIB_LIBS) -lm
+	$$(CC) $(2) $$^ -o $$@ $$(ZLIB_LIBS) -lm -pthread
 $(1)/render: $(call objs,$(1)/obj,host/render.c $(HOST_ENG) $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC))
 	$$(CC) $(2) $$^ -o $$@ $$(PNG_LIBS) -lm
 $(1)/emu: $(call objs,$(1)/obj,host/emu.c $(HOST_ENG) $(GEN)/default_scene.c $(HOST_LIB) $(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(SDL_SRC))

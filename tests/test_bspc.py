@@ -300,3 +300,27 @@ def test_all_maps_share_textures_and_write_what_single_runs_write(tmp_path):
         assert (out / f"freedoom2-{m}.bsc").read_bytes() == (tmp_path / "one.bsc").read_bytes(), m
         warned = [x for x in one.stderr.splitlines() if "unknown" in x]
         assert all(w in proc.stderr for w in warned), m
+
+
+def test_all_maps_on_several_threads_write_what_one_writes(tmp_path):
+    """-j 3: the same files and the same --stats lines (but the build times) as one thread, sanitized."""
+    runs = {}
+    for j in (1, 3):
+        out = tmp_path / f"j{j}"
+        out.mkdir()
+        proc = run([program("bspc", sanitized=j > 1), "freedoom1.wad", "--all", "-o", out, "-j", j, "--stats"])
+        assert "36 of 36 maps compiled" in proc.stderr and "Sanitizer" not in proc.stderr
+        stats = [re.sub(r'"build_ms": [0-9.]+', "", x) for x in proc.stdout.splitlines()]
+        runs[j] = (stats, {p.name: p.read_bytes() for p in out.iterdir()})
+    assert runs[1] == runs[3]
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["freedoom2.wad:MAP01", "-j", "2"], "-j is for --all"),
+    (["freedoom2.wad", "--all", "-j", "0"], "-j needs a number of maps to compile at once, 1 to 64"),
+    (["freedoom2.wad", "--all", "-j", "2x"], "-j needs a number"),
+    (["freedoom2.wad", "--all", "-j"], "-j needs a number"),
+])
+def test_all_maps_threads_option_is_checked(args, needle):
+    proc = run([program("bspc"), *args], check=False)
+    assert proc.returncode == 2 and needle in proc.stderr, proc.stderr

@@ -2,15 +2,16 @@
 """bench_bsp.py - BSP build benchmark over the 68 Freedoom maps (make bench-bsp).
 
 Runs build/bspc --stats on every map of freedoom1.wad (E1M1..E4M9) and
-freedoom2.wad (MAP01..MAP32) with each split strategy (one process per map),
-then bspc --all (one process per WAD, as zdbsp and glbsp run) and zdbsp
---repeat times each, taking turns, and glbsp once, when they are installed;
-reads the nodes shipped inside the Freedoom WADs, and prints one table of
-totals: splits, leaves (subsectors), max depth and build time (wall clock and
-the processes' user + system time; the median of the repeats). A second table times bspc on three generated scenes
-that once took seconds (a grid of 3,600 sectors, a room with a 10,000-wall
-zigzag side, a convex 10,000-gon room). The tables go to stdout and to
-build/bench-bsp.md.
+freedoom2.wad (MAP01..MAP32) with each split strategy, one process per map.
+Then it runs bspc --all (one process per WAD, as zdbsp and glbsp run), bspc
+--all -j JOBS (that many maps at once) and zdbsp, --repeat times each in
+turns, and glbsp once, when they are installed. It reads the nodes shipped
+inside the Freedoom WADs and prints one table of totals: splits, leaves
+(subsectors), max depth and build time (wall clock and the processes' user +
+system time; for the runs in turns, the medians). A second table times bspc
+on three generated scenes that once took seconds (a grid of 3,600 sectors, a
+room with a 10,000-wall zigzag side, a convex 10,000-gon room). The tables go
+to stdout and to build/bench-bsp.md.
 
 For the other builders the figures come from the lumps they write:
 splits = SEGS - linedef sides, leaves = SSECTORS, depth from NODES.
@@ -164,15 +165,15 @@ def run_bspc(bspc, wads, maps_by_wad, strategy, tmp):
     return tot
 
 
-def run_bspc_all(bspc, wads, maps_by_wad, strategy, tmp):
-    """bspc --all on each WAD, one process per WAD"""
+def run_bspc_all(bspc, wads, maps_by_wad, strategy, tmp, jobs=1):
+    """bspc --all -j jobs on each WAD, one process per WAD"""
     tot = bspc_totals()
-    outdir = os.path.join(tmp, "all")
+    outdir = os.path.join(tmp, f"all{jobs}")
     os.makedirs(outdir, exist_ok=True)
     c0, t0 = children_cpu(), time.perf_counter()
     for wadname, maps in maps_by_wad.items():
-        r = subprocess.run([bspc, wads[wadname], "--all", "--split", strategy, "--stats", "-o", outdir],
-                           capture_output=True, text=True)
+        r = subprocess.run([bspc, wads[wadname], "--all", "-j", str(jobs), "--split", strategy, "--stats",
+                            "-o", outdir], capture_output=True, text=True)
         if r.returncode != 0:
             tot["failed"].append(f"{wadname}: {r.stderr.strip()[-200:]}")
         for line in r.stdout.splitlines():
@@ -305,9 +306,11 @@ def main():
     ap.add_argument("--strategies", default="fewest,balanced,mixed")
     ap.add_argument("--repeat", type=int, default=3,
                     help="runs of bspc --all and zdbsp, taking turns; their medians are shown")
+    ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
+                    help="bspc --all -j JOBS gets a row too when above 1 (default: the processors)")
     args = ap.parse_args()
-    if args.repeat < 1:
-        ap.error("--repeat must be at least 1")
+    if args.repeat < 1 or args.jobs < 1:
+        ap.error("--repeat and --jobs must be at least 1")
 
     wads = {w: find_wad(w) for w in WADS}
     missing = [w for w, p in wads.items() if not p]
@@ -332,10 +335,14 @@ def main():
                          "one process per map; " + note))
         # the whole-WAD runs, in turns, so that a busy moment weighs on both alike
         zd = shutil.which("zdbsp")
-        walls = {"all": [], "zdbsp": []}
-        cpus = {"all": [], "zdbsp": []}
+        walls = {"all": [], "allj": [], "zdbsp": []}
+        cpus = {"all": [], "allj": [], "zdbsp": []}
         built = None
         for _ in range(args.repeat):
+            if args.jobs > 1:
+                tj = run_bspc_all(args.bspc, wads, maps_by_wad, "mixed", tmp, args.jobs)
+                walls["allj"].append(tj["wall_s"])
+                cpus["allj"].append(tj["cpu_s"])
             t = run_bspc_all(args.bspc, wads, maps_by_wad, "mixed", tmp)
             walls["all"].append(t["wall_s"])
             cpus["all"].append(t["cpu_s"])
@@ -348,6 +355,10 @@ def main():
             note += f"; {len(t['failed'])} failed: " + "; ".join(t["failed"][:2])
         rows.append(("bspc --all (mixed)", t["maps"], t["splits"], t["tjunc"], t["segs"], t["leaves"],
                      t["max_depth"], f"{median(walls['all']):.2f}", f"{median(cpus['all']):.2f}", note))
+        if args.jobs > 1:
+            rows.append((f"bspc --all -j {args.jobs} (mixed)", tj["maps"], tj["splits"], tj["tjunc"], tj["segs"],
+                         tj["leaves"], tj["max_depth"], f"{median(walls['allj']):.2f}",
+                         f"{median(cpus['allj']):.2f}", f"{args.jobs} maps at once; " + note))
         if built:
             z = wad_totals(maps_by_wad, built)
             rows.append(("zdbsp (defaults)", z["maps"], z["splits"], "-", z["segs"], z["leaves"],

@@ -1,9 +1,10 @@
 /* main.c - build/bspc, the BSP compiler's command line:
  *   bspc INPUT [-o OUT] [--split fewest|balanced|mixed] [--flat] [--stats] [--needs] [--config FILE.h] [-v]
- *   bspc WAD --all [-o DIR] [--split S] [--flat] [--stats] [-v]
+ *   bspc WAD --all [-o DIR] [-j N] [--split S] [--flat] [--stats] [-v]
  *   bspc --list WAD
  * INPUT is a text scene (docs/scene-format.md) or file.wad:MAP01 / file.wad:E1M1. */
 #include <errno.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,11 +14,13 @@
 #include "scene.h"
 #include "scene_file.h"
 
+#define MAX_JOBS 64 /* -j: maps compiled at once */
+
 static void usage(FILE *f)
 {
     fputs("usage: bspc INPUT [-o OUT] [--split fewest|balanced|mixed] [--flat] [--stats]\n"
           "            [--needs] [--config FILE.h] [-v]\n"
-          "       bspc WAD --all [-o DIR] [--split S] [--flat] [--stats] [-v]\n"
+          "       bspc WAD --all [-o DIR] [-j N] [--split S] [--flat] [--stats] [-v]\n"
           "       bspc --list WAD\n"
           "\n"
           "Compiles a scene into a BSP blob (firmware/scene_format.h).\n"
@@ -41,6 +44,9 @@ static void usage(FILE *f)
           "                   DIR/file-MAP.bsc (-o DIR, default the current folder);\n"
           "                   --stats prints one JSON object per map, a line each. A map\n"
           "                   refused is reported and the others still compiled (exit 1)\n"
+          "  -j N             with --all: compile N maps at once (default 1); the files\n"
+          "                   and --stats are the same for any N (-v's warnings may come\n"
+          "                   in another order)\n"
           "  --list WAD       print the names of the maps in WAD on one line\n"
           "  --help           this text\n",
           f);
@@ -133,25 +139,72 @@ static void print_stats(const char *map, const bspc_stats *st)
            st->needs.needs.surfaces, st->needs.all_edges, st->needs.all_surfaces);
 }
 
-/* Write blob[0..len) to path whole, or remove what was written. */
-static int write_blob(const char *path, const uint8_t *blob, size_t len)
+/* Write blob[0..len) to path whole, or remove what was written and say why. */
+static int write_blob(const char *path, const uint8_t *blob, size_t len, char *err, size_t errlen)
 {
     FILE *f = fopen(path, "wb");
     if (!f) {
-        fprintf(stderr, "bspc: %s: cannot write: %s\n", path, strerror(errno));
+        snprintf(err, errlen, "%s: cannot write: %s", path, strerror(errno));
         return 1;
     }
     size_t wrote = fwrite(blob, 1, len, f);
     if (fclose(f) || wrote != len) {
-        fprintf(stderr, "bspc: %s: write failed\n", path);
+        snprintf(err, errlen, "%s: write failed", path);
         remove(path);
         return 1;
     }
     return 0;
 }
 
-/* --all: every map of the WAD, each into dir; 0 when all compiled. */
-static int compile_all(const char *wad, const char *dir, const bspc_options *opt, int want_stats)
+/* One map of a --all run, and what became of it. */
+typedef struct {
+    const char *map;
+    char out[2400];
+    int failed;    /* refused, or not written: msg says why */
+    char msg[512];
+    size_t len;
+    bspc_stats st;
+} map_job;
+
+/* The maps of a --all run, taken in turn by its workers. */
+typedef struct {
+    const char *wad;
+    bspc_options opt;
+    map_job *jobs;
+    int n, next;
+    pthread_mutex_t lock;
+} batch;
+
+static void compile_job(map_job *j, const char *wad, const bspc_options *opt)
+{
+    char spec[1200];
+    snprintf(spec, sizeof spec, "%s:%s", wad, j->map);
+    uint8_t *blob = NULL;
+    j->failed = bspc_compile(spec, opt, &blob, &j->len, &j->st, j->msg, sizeof j->msg) != 0;
+    if (!j->failed) j->failed = write_blob(j->out, blob, j->len, j->msg, sizeof j->msg);
+    free(blob);
+}
+
+/* A worker: maps until none is left, with textures kept from one to the next. */
+static void *batch_worker(void *arg)
+{
+    batch *b = arg;
+    bspc_options opt = b->opt;
+    opt.look_cache = bspc_look_cache_new(); /* without one, each map composes its textures */
+    for (;;) {
+        pthread_mutex_lock(&b->lock);
+        int i = b->next < b->n ? b->next++ : -1;
+        pthread_mutex_unlock(&b->lock);
+        if (i < 0) break;
+        compile_job(&b->jobs[i], b->wad, &opt);
+    }
+    bspc_look_cache_free(opt.look_cache);
+    return NULL;
+}
+
+/* --all: every map of the WAD, each into dir, by jobs workers at once; what
+ * they print comes in the maps' order. 0 when all compiled. */
+static int compile_all(const char *wad, const char *dir, const bspc_options *opt, int jobs, int want_stats)
 {
     char maps[16384], err[512];
     struct stat st_dir;
@@ -169,36 +222,48 @@ static int compile_all(const char *wad, const char *dir, const bspc_options *opt
         fprintf(stderr, "bspc: %s: no maps in it\n", wad);
         return 1;
     }
-    int done = 0, refused = 0;
-    for (char *map = strtok(maps, " "); map; map = strtok(NULL, " ")) {
-        char spec[1200], base[1100], out[2400];
+    batch b = {wad, *opt, calloc((size_t)n, sizeof(map_job)), n, 0, PTHREAD_MUTEX_INITIALIZER};
+    if (!b.jobs) {
+        fprintf(stderr, "bspc: out of memory\n");
+        return 1;
+    }
+    int k = 0;
+    char *save = NULL;
+    for (char *map = strtok_r(maps, " ", &save); map && k < n; map = strtok_r(NULL, " ", &save), k++) {
+        char spec[1200], base[1100];
         snprintf(spec, sizeof spec, "%s:%s", wad, map);
         default_out(spec, base, sizeof base);
-        snprintf(out, sizeof out, "%s/%s", dir, base);
-        uint8_t *blob = NULL;
-        size_t len = 0;
-        bspc_stats st;
-        if (bspc_compile(spec, opt, &blob, &len, &st, err, sizeof err)) {
-            fprintf(stderr, "bspc: %s\n", err);
-            refused++;
+        b.jobs[k].map = map;
+        snprintf(b.jobs[k].out, sizeof b.jobs[k].out, "%s/%s", dir, base);
+    }
+    b.n = k;
+    if (jobs > b.n) jobs = b.n;
+    pthread_t th[MAX_JOBS];
+    int started = 0;
+    while (started < jobs - 1 && pthread_create(&th[started], NULL, batch_worker, &b) == 0) started++;
+    batch_worker(&b); /* this thread works too (alone, when no thread could start) */
+    for (int t = 0; t < started; t++) pthread_join(th[t], NULL);
+    int done = 0;
+    for (int i = 0; i < b.n; i++) {
+        const map_job *j = &b.jobs[i];
+        if (j->failed) {
+            fprintf(stderr, "bspc: %s\n", j->msg);
             continue;
         }
-        int rc = write_blob(out, blob, len);
-        free(blob);
-        if (rc) return 1; /* the folder is not writable: the next maps would fail alike */
         done++;
-        if (opt->verbose) fprintf(stderr, "bspc: wrote %s (%zu bytes, %d of %d)\n", out, len, done + refused, n);
-        if (want_stats) print_stats(map, &st);
+        if (opt->verbose) fprintf(stderr, "bspc: wrote %s (%zu bytes, %d of %d)\n", j->out, j->len, i + 1, b.n);
+        if (want_stats) print_stats(j->map, &j->st);
     }
-    fprintf(stderr, "bspc: %s: %d of %d maps compiled into %s%s\n", wad, done, n, dir,
-            refused ? " (the others refused, above)" : "");
-    return refused ? 1 : 0;
+    fprintf(stderr, "bspc: %s: %d of %d maps compiled into %s%s\n", wad, done, b.n, dir,
+            done < b.n ? " (the others refused, above)" : "");
+    free(b.jobs);
+    return done < b.n ? 1 : 0;
 }
 
 int main(int argc, char **argv)
 {
     const char *in = NULL, *outp = NULL;
-    int want_stats = 0, want_needs = 0, all = 0;
+    int want_stats = 0, want_needs = 0, all = 0, jobs = 1;
     const char *config = NULL;
     bspc_options opt = bspc_defaults();
     for (int i = 1; i < argc; i++) {
@@ -216,6 +281,14 @@ int main(int argc, char **argv)
             want_needs = 1;
         } else if (strcmp(a, "--all") == 0) {
             all = 1;
+        } else if (strcmp(a, "-j") == 0) {
+            char *end = NULL;
+            long v = ++i < argc ? strtol(argv[i], &end, 10) : 0;
+            if (!end || *end || end == argv[i] || v < 1 || v > MAX_JOBS) {
+                fprintf(stderr, "bspc: -j needs a number of maps to compile at once, 1 to %d\n", MAX_JOBS);
+                return 2;
+            }
+            jobs = (int)v;
         } else if (strcmp(a, "--config") == 0) {
             if (++i >= argc) {
                 fprintf(stderr, "bspc: --config needs a file name\n");
@@ -264,6 +337,10 @@ int main(int argc, char **argv)
         usage(stderr);
         return 2;
     }
+    if (jobs > 1 && !all) {
+        fprintf(stderr, "bspc: -j is for --all (one scene compiles on one thread)\n");
+        return 2;
+    }
     if (all) {
         if (want_needs || config) {
             fprintf(stderr, "bspc: --all compiles every map; --needs and --config take one (WAD:MAP)\n");
@@ -273,10 +350,7 @@ int main(int argc, char **argv)
             fprintf(stderr, "bspc: --all: %s is not a WAD file name (file.wad)\n", in);
             return 2;
         }
-        opt.look_cache = bspc_look_cache_new(); /* without one, each map composes its textures */
-        int rc = compile_all(in, outp ? outp : ".", &opt, want_stats);
-        bspc_look_cache_free(opt.look_cache);
-        return rc;
+        return compile_all(in, outp ? outp : ".", &opt, jobs, want_stats);
     }
     if (config && scene_file_probe(in)) return config_from_compiled(in, config);
     char outbuf[1100];
@@ -307,9 +381,12 @@ int main(int argc, char **argv)
             return 1;
         }
     }
-    int rc = write_blob(outp, blob, len);
+    int rc = write_blob(outp, blob, len, err, sizeof err);
     free(blob);
-    if (rc) return 1;
+    if (rc) {
+        fprintf(stderr, "bspc: %s\n", err);
+        return 1;
+    }
     if (opt.verbose) fprintf(stderr, "bspc: wrote %s (%zu bytes)\n", outp, len);
     if (want_stats) print_stats(NULL, &st);
     return 0;
