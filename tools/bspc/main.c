@@ -160,7 +160,7 @@ static int write_blob(const char *path, const uint8_t *blob, size_t len, char *e
 typedef struct {
     const char *map;
     char out[2400];
-    int failed;    /* refused, or not written: msg says why */
+    int failed; /* refused, or not written: msg says why */
     char msg[512];
     size_t len;
     bspc_stats st;
