@@ -49,6 +49,8 @@ void bs_note(const bspc_options *opt, const char *fmt, ...)
     ;
 /* Grow *p (element size sz) so that it holds at least need elements. 0 or -1. */
 int bs_grow(void *pp, uint32_t *cap, uint32_t need, size_t sz);
+/* FNV-1a of a NUL-terminated name: the hash of the compiler's name lookups. */
+uint32_t bs_name_hash(const char *s);
 /* A 16.16 value as exact decimal text (fxtext_format), for messages. */
 const char *bs_fxstr(int32_t v, char buf[32]);
 double bs_now_ms(void);

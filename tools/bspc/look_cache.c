@@ -31,13 +31,6 @@ void bspc_look_cache_free(bspc_look_cache *c)
     free(c);
 }
 
-static uint32_t hash_of(const char *t)
-{
-    uint32_t h = 2166136261u; /* FNV-1a */
-    while (*t) h = (h ^ (uint8_t)*t++) * 16777619u;
-    return h;
-}
-
 const lc_entry *lc_find(bspc_look_cache *c, const char *wad, int kind, const char *name)
 {
     if (strcmp(c->wad, wad) != 0) {
@@ -45,7 +38,7 @@ const lc_entry *lc_find(bspc_look_cache *c, const char *wad, int kind, const cha
         snprintf(c->wad, sizeof c->wad, "%s", wad);
         return NULL;
     }
-    uint32_t h = hash_of(name);
+    uint32_t h = bs_name_hash(name);
     for (uint32_t i = 0; i < c->n; i++)
         if (c->e[i].hash == h && c->e[i].kind == kind && strcmp(c->e[i].name, name) == 0) return &c->e[i];
     return NULL;
@@ -58,7 +51,7 @@ int lc_put(bspc_look_cache *c, int kind, const char *name, int known, const scn_
     memset(e, 0, sizeof *e);
     memcpy(e->name, name, strlen(name) + 1);
     e->kind = kind;
-    e->hash = hash_of(name);
+    e->hash = bs_name_hash(name);
     e->known = known;
     if (known) {
         size_t n = ((size_t)1 << rec->wbits) << rec->hbits;

@@ -4,12 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static uint32_t hash8(const char *s)
-{
-    uint32_t h = 2166136261u; /* FNV-1a */
-    for (int i = 0; i < 8 && s[i]; i++) h = (h ^ (uint8_t)s[i]) * 16777619u;
-    return h;
-}
+#include "bspc_int.h"
 
 int nt_init(name_table *t, uint32_t n)
 {
@@ -28,23 +23,25 @@ void nt_free(name_table *t)
     t->e = NULL;
 }
 
-/* the slot of name, or the empty slot where it would go */
+/* the slot of name (at most 8 characters), or the empty slot where it would go */
 static nt_entry *slot_of(const name_table *t, const char *name)
 {
-    for (uint32_t i = hash8(name) & t->mask;; i = (i + 1) & t->mask) {
+    for (uint32_t i = bs_name_hash(name) & t->mask;; i = (i + 1) & t->mask) {
         nt_entry *e = &t->e[i];
-        if (e->value == NT_NONE || strncmp(e->name, name, 8) == 0) return e;
+        if (e->value == NT_NONE || strcmp(e->name, name) == 0) return e;
     }
 }
 
 void nt_put(name_table *t, const char *name, uint32_t value, int replace)
 {
-    nt_entry *e = slot_of(t, name);
-    if (e->value != NT_NONE && !replace) return;
+    char cut[9];
     size_t n = strlen(name);
     if (n > 8) n = 8;
-    memcpy(e->name, name, n);
-    e->name[n] = 0;
+    memcpy(cut, name, n);
+    cut[n] = 0;
+    nt_entry *e = slot_of(t, cut);
+    if (e->value != NT_NONE && !replace) return;
+    memcpy(e->name, cut, n + 1);
     e->value = value;
 }
 

@@ -93,13 +93,6 @@ static int valid_name(const char *t)
     return strlen(t) < 32;
 }
 
-static uint32_t hash_name(const char *t)
-{
-    uint32_t h = 2166136261u; /* FNV-1a */
-    while (*t) h = (h ^ (uint8_t)*t++) * 16777619u;
-    return h;
-}
-
 /* Enter the sectors declared since the last call into p->shash (a name already
  * there keeps its first sector), growing it to at least twice their number. */
 static int sector_index(parser *p)
@@ -117,7 +110,7 @@ static int sector_index(parser *p)
     }
     for (; p->shashed < s->nsectors; p->shashed++) {
         const char *name = s->sectors[p->shashed].name;
-        uint32_t h = hash_name(name) & (p->scap - 1);
+        uint32_t h = bs_name_hash(name) & (p->scap - 1);
         while (p->shash[h] && strcmp(s->sectors[p->shash[h] - 1].name, name) != 0) h = (h + 1) & (p->scap - 1);
         if (!p->shash[h]) p->shash[h] = p->shashed + 1;
     }
@@ -127,7 +120,7 @@ static int sector_index(parser *p)
 /* The first sector named t among those entered (1), or 0. */
 static int named_sector(const parser *p, const char *t, uint32_t *out)
 {
-    for (uint32_t h = hash_name(t) & (p->scap - 1); p->shash[h]; h = (h + 1) & (p->scap - 1))
+    for (uint32_t h = bs_name_hash(t) & (p->scap - 1); p->shash[h]; h = (h + 1) & (p->scap - 1))
         if (strcmp(p->s->sectors[p->shash[h] - 1].name, t) == 0) {
             *out = p->shash[h] - 1;
             return 1;

@@ -21,6 +21,13 @@ int bs_fail(char *err, size_t errlen, const char *fmt, ...)
     return -1;
 }
 
+uint32_t bs_name_hash(const char *s)
+{
+    uint32_t h = 2166136261u;
+    while (*s) h = (h ^ (uint8_t)*s++) * 16777619u;
+    return h;
+}
+
 void bs_warn(const bspc_options *opt, const char *fmt, ...)
 {
     if (!opt || !opt->verbose) return;

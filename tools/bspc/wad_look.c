@@ -26,13 +26,6 @@ typedef struct {
     uint32_t hash; /* of name: most entries are told apart by it alone */
 } used_name;
 
-static uint32_t name_hash(const char *t)
-{
-    uint32_t h = 2166136261u; /* FNV-1a */
-    while (*t) h = (h ^ (uint8_t)*t++) * 16777619u;
-    return h;
-}
-
 struct bs_wadlook {
     FILE *f;
     size_t flen;
@@ -48,8 +41,6 @@ struct bs_wadlook {
     uint32_t tdsize[2];
     used_name *used;
     uint32_t nused, ucap;
-    double (*mean)[3]; /* per stored texture */
-    uint32_t mcap;
     uint32_t nlines_cap; /* sides has room for 2 * nlines_cap */
     const char *sky_name;
     uint8_t neutral;   /* palette index of a mid grey, for parts without a texture */
@@ -150,6 +141,17 @@ static int log2_ceil(uint32_t v)
     return b;
 }
 
+/* Room for one more texture of n texels in the look; 0, or -1 with a message. */
+static int texture_room(bs_wadlook *L, uint32_t n, char *err, size_t errlen)
+{
+    bs_look *lk = L->lk;
+    if (lk->ntex >= SCN_TEX_NONE) return bs_fail(err, errlen, "%s: more than %u textures", L->wad, SCN_TEX_NONE);
+    if ((uint64_t)lk->ntexels + n > UINT32_MAX / 2 || bs_grow(&lk->texels, &lk->txcap, lk->ntexels + n, 1) ||
+        bs_grow(&lk->tex, &lk->tcap, lk->ntex + 1, sizeof *lk->tex))
+        return bs_fail(err, errlen, "%s: out of memory", L->wad);
+    return 0;
+}
+
 /* Append a texture from a column-major w x h picture: 2^floor(log2 w) columns,
  * rows padded to 2^ceil(log2 h) by repeating from the top (docs/textures.md). */
 static int store(bs_wadlook *L, const char *name, const uint8_t *pic, uint32_t w, uint32_t h, uint16_t *out, char *err,
@@ -160,12 +162,8 @@ static int store(bs_wadlook *L, const char *name, const uint8_t *pic, uint32_t w
     if (wb > SCN_TEX_MAX_BITS || hb > SCN_TEX_MAX_BITS)
         return bs_fail(err, errlen, "%s: texture %s is %u x %u, larger than %d x %d", L->wad, name, w, h,
                        1 << SCN_TEX_MAX_BITS, 1 << SCN_TEX_MAX_BITS);
-    if (lk->ntex >= SCN_TEX_NONE) return bs_fail(err, errlen, "%s: more than %u textures", L->wad, SCN_TEX_NONE);
     uint32_t cols = 1u << wb, rows = 1u << hb, n = cols << hb;
-    if ((uint64_t)lk->ntexels + n > UINT32_MAX / 2 || bs_grow(&lk->texels, &lk->txcap, lk->ntexels + n, 1) ||
-        bs_grow(&lk->tex, &lk->tcap, lk->ntex + 1, sizeof *lk->tex) ||
-        bs_grow(&L->mean, &L->mcap, lk->ntex + 1, sizeof *L->mean))
-        return bs_fail(err, errlen, "%s: out of memory", L->wad);
+    if (texture_room(L, n, err, errlen)) return -1;
     uint8_t *t = lk->texels + lk->ntexels;
     uint32_t hist[256] = {0};
     for (uint32_t u = 0; u < cols; u++) {
@@ -184,8 +182,9 @@ static int store(bs_wadlook *L, const char *name, const uint8_t *pic, uint32_t w
     x->reserved = 0;
     x->height = (uint16_t)h;
     x->reserved2 = 0;
-    for (int k = 0; k < 3; k++) L->mean[lk->ntex][k] = (double)sum[k] / ((double)cols * h);
-    x->colour = nearest(lk->palette, L->mean[lk->ntex][0], L->mean[lk->ntex][1], L->mean[lk->ntex][2]);
+    double mean[3];
+    for (int k = 0; k < 3; k++) mean[k] = (double)sum[k] / ((double)cols * h);
+    x->colour = nearest(lk->palette, mean[0], mean[1], mean[2]);
     lk->ntexels += n;
     *out = (uint16_t)lk->ntex++;
     return 0;
@@ -195,11 +194,8 @@ static int store(bs_wadlook *L, const char *name, const uint8_t *pic, uint32_t w
 static int store_kept(bs_wadlook *L, const lc_entry *e, uint16_t *out, char *err, size_t errlen)
 {
     bs_look *lk = L->lk;
-    if (lk->ntex >= SCN_TEX_NONE) return bs_fail(err, errlen, "%s: more than %u textures", L->wad, SCN_TEX_NONE);
     uint32_t n = (1u << e->rec.wbits) << e->rec.hbits;
-    if ((uint64_t)lk->ntexels + n > UINT32_MAX / 2 || bs_grow(&lk->texels, &lk->txcap, lk->ntexels + n, 1) ||
-        bs_grow(&lk->tex, &lk->tcap, lk->ntex + 1, sizeof *lk->tex))
-        return bs_fail(err, errlen, "%s: out of memory", L->wad);
+    if (texture_room(L, n, err, errlen)) return -1;
     memcpy(lk->texels + lk->ntexels, e->texels, n);
     lk->tex[lk->ntex] = e->rec;
     lk->tex[lk->ntex].first = lk->ntexels;
@@ -454,7 +450,7 @@ static int texture(bs_wadlook *L, const char *name, int kind, uint16_t *out, cha
 {
     *out = SCN_TEX_NONE;
     if (!name[0] || strcmp(name, "-") == 0) return 0;
-    uint32_t h = name_hash(name);
+    uint32_t h = bs_name_hash(name);
     for (uint32_t i = 0; i < L->nused; i++)
         if (L->used[i].hash == h && L->used[i].kind == kind && strcmp(L->used[i].name, name) == 0) {
             *out = L->used[i].tex;
@@ -479,7 +475,7 @@ static int texture(bs_wadlook *L, const char *name, int kind, uint16_t *out, cha
         return bs_fail(err, errlen, "%s: out of memory", L->wad);
     used_name *u = &L->used[L->nused++];
     snprintf(u->name, sizeof u->name, "%s", name);
-    u->hash = name_hash(u->name);
+    u->hash = bs_name_hash(u->name);
     u->kind = kind;
     u->tex = *out;
     return 0;
@@ -521,8 +517,8 @@ int bs_look_open(FILE *f, const char *wadpath, size_t flen, const bs_wadlump *di
                  char *err, size_t errlen)
 {
     *out = NULL;
-    bs_wadlook tmp = {f,      flen, dir, ndir, s->name, opt, s, &s->look, NULL, 0, {NULL, NULL},
-                      {0, 0}, NULL, 0,   0,    NULL,    0,   0, NULL,     0};
+    bs_wadlook tmp = {
+        .f = f, .flen = flen, .dir = dir, .ndir = ndir, .wad = s->name, .opt = opt, .s = s, .lk = &s->look};
     static const char *need[] = {"PLAYPAL", "COLORMAP", "PNAMES", "TEXTURE1"};
     uint32_t at[4];
     char missing[64] = "";
@@ -731,7 +727,6 @@ void bs_look_close(bs_wadlook *L)
     free(L->tdef[0]);
     free(L->tdef[1]);
     free(L->used);
-    free(L->mean);
     free(L->flats);
     free(L->sprites);
     nt_free(&L->lumps);
