@@ -76,16 +76,33 @@ def read_png_indexed(path):
     return width, height, b"".join(rows), palette
 
 
-def write_pwad_map(path, things, linedefs, sidedefs, vertexes, sectors):
-    """Write a PWAD holding one Doom-format map, MAP01, from its lumps' bytes."""
-    lumps = [(b"MAP01", b""), (b"THINGS", things), (b"LINEDEFS", linedefs), (b"SIDEDEFS", sidedefs),
-             (b"VERTEXES", vertexes), (b"SECTORS", sectors)]
+def wad_image(lumps, magic=b"PWAD"):
+    """The bytes of a WAD of lumps [(name, bytes)] in order (a name str or bytes), the directory at the end."""
     body, directory, pos = b"", b"", 12
     for name, data in lumps:
-        directory += struct.pack("<II8s", pos, len(data), name)
+        directory += struct.pack("<II8s", pos, len(data), name.encode() if isinstance(name, str) else name)
         body += data
         pos += len(data)
-    Path(path).write_bytes(b"PWAD" + struct.pack("<II", len(lumps), pos) + body + directory)
+    return magic + struct.pack("<II", len(lumps), pos) + body + directory
+
+
+def write_pwad_map(path, things, linedefs, sidedefs, vertexes, sectors):
+    """Write a PWAD holding one Doom-format map, MAP01, from its lumps' bytes."""
+    Path(path).write_bytes(wad_image([("MAP01", b""), ("THINGS", things), ("LINEDEFS", linedefs),
+                                      ("SIDEDEFS", sidedefs), ("VERTEXES", vertexes), ("SECTORS", sectors)]))
+
+
+def room_lumps(x0=0, y0=0, x1=256, y1=256, floor=0, ceil=128):
+    """The lumps of a map that is one rectangular one-sided room, its player in the middle: name -> bytes,
+    in a map's order."""
+    verts = [(x0, y0), (x0, y1), (x1, y1), (x1, y0)]
+    return {
+        "THINGS": struct.pack("<hhhHH", (x0 + x1) // 2, (y0 + y1) // 2, 0, 1, 7),
+        "LINEDEFS": b"".join(struct.pack("<HHHHHHH", i, (i + 1) % 4, 1, 0, 0, i, 0xFFFF) for i in range(4)),
+        "SIDEDEFS": b"".join(struct.pack("<hh8s8s8sH", 0, 0, b"-", b"-", b"STARTAN3", 0) for _ in range(4)),
+        "VERTEXES": b"".join(struct.pack("<hh", x, y) for x, y in verts),
+        "SECTORS": struct.pack("<hh8s8shhh", floor, ceil, b"FLOOR4_8", b"CEIL3_5", 160, 0, 0),
+    }
 
 
 def freedoom(name):

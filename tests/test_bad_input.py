@@ -23,7 +23,7 @@ import zlib
 
 import pytest
 
-from conftest import ROOT, program, run, write_pwad_map
+from conftest import ROOT, program, room_lumps, run, wad_image, write_pwad_map
 
 DEFAULT = ROOT / "tests/scenes/default.scene"
 
@@ -334,27 +334,9 @@ def test_binary_file_is_not_a_text_scene(tmp_path):
 LUMPS = ("THINGS", "LINEDEFS", "SIDEDEFS", "VERTEXES", "SECTORS")
 
 
-def room_lumps():
-    """One rectangular one-sided room, as tests/test_bspc.py's wad_room: lump name -> bytes."""
-    verts = [(0, 0), (0, 256), (256, 256), (256, 0)]
-    return {
-        "THINGS": struct.pack("<hhhHH", 128, 128, 0, 1, 7),
-        "LINEDEFS": b"".join(struct.pack("<HHHHHHH", i, (i + 1) % 4, 1, 0, 0, i, 0xFFFF) for i in range(4)),
-        "SIDEDEFS": b"".join(struct.pack("<hh8s8s8sH", 0, 0, b"-", b"-", b"STARTAN3", 0) for _ in range(4)),
-        "VERTEXES": b"".join(struct.pack("<hh", x, y) for x, y in verts),
-        "SECTORS": struct.pack("<hh8s8shhh", 0, 128, b"FLOOR4_8", b"CEIL3_5", 160, 0, 0),
-    }
-
-
 def wad_bytes(lumps, marker=b"MAP01", magic=b"PWAD"):
     """A WAD of the map marker and the lumps in order (name -> bytes), the directory at the end."""
-    entries = [(marker, b"")] + [(name.encode(), data) for name, data in lumps.items()]
-    body, directory, pos = b"", b"", 12
-    for name, data in entries:
-        directory += struct.pack("<II8s", pos, len(data), name)
-        body += data
-        pos += len(data)
-    return magic + struct.pack("<II", len(entries), pos) + body + directory
+    return wad_image([(marker, b"")] + list(lumps.items()), magic)
 
 
 def without(name):

@@ -6,7 +6,7 @@ import sys
 
 import pytest
 
-from conftest import ROOT, freedoom, program, run, write_pwad_map
+from conftest import ROOT, freedoom, program, room_lumps, run, wad_image, write_pwad_map
 
 MAPS = [f"freedoom1.wad:E{e}M{m}" for e in range(1, 5) for m in range(1, 10)] + \
        [f"freedoom2.wad:MAP{m:02d}" for m in range(1, 33)]
@@ -92,20 +92,9 @@ def test_text_scene_out_of_range(tmp_path, values, line, message):
     assert not (tmp_path / "bad.bsc").exists()
 
 
-def room_lumps(x0, y0, x1, y1, floor=0, ceil=128):
-    """The lumps of a map that is one rectangular one-sided room, after its marker."""
-    import struct
-    verts = [(x0, y0), (x0, y1), (x1, y1), (x1, y0)]
-    return [(b"THINGS", struct.pack("<hhhHH", (x0 + x1) // 2, (y0 + y1) // 2, 0, 1, 7)),
-            (b"LINEDEFS", b"".join(struct.pack("<HHHHHHH", i, (i + 1) % 4, 1, 0, 0, i, 0xFFFF) for i in range(4))),
-            (b"SIDEDEFS", b"".join(struct.pack("<hh8s8s8sH", 0, 0, b"-", b"-", b"STARTAN3", 0) for _ in range(4))),
-            (b"VERTEXES", b"".join(struct.pack("<hh", x, y) for x, y in verts)),
-            (b"SECTORS", struct.pack("<hh8s8shhh", floor, ceil, b"FLOOR4_8", b"CEIL3_5", 160, 0, 0))]
-
-
 def wad_room(path, x0, y0, x1, y1, floor, ceil):
     """A PWAD whose MAP01 is one rectangular one-sided room."""
-    write_pwad_map(path, *(data for _, data in room_lumps(x0, y0, x1, y1, floor, ceil)))
+    write_pwad_map(path, *room_lumps(x0, y0, x1, y1, floor, ceil).values())
 
 
 @pytest.mark.parametrize("room, message", [
@@ -231,16 +220,7 @@ def test_generated_scenes_compile_in_few_instructions(tmp_path, case, bound):
 
 def write_pwad(path, maps):
     """A PWAD of maps {name: lumps}, in order."""
-    import struct
-    lumps = []
-    for name, parts in maps.items():
-        lumps += [(name.encode(), b"")] + parts
-    body, directory, pos = b"", b"", 12
-    for name, data in lumps:
-        directory += struct.pack("<II8s", pos, len(data), name)
-        body += data
-        pos += len(data)
-    path.write_bytes(b"PWAD" + struct.pack("<II", len(lumps), pos) + body + directory)
+    path.write_bytes(wad_image([item for name, lumps in maps.items() for item in [(name, b"")] + list(lumps.items())]))
 
 
 def test_all_maps_of_a_wad_in_one_run(tmp_path):

@@ -7,10 +7,9 @@ import sys
 
 import pytest
 
-from conftest import ROOT, program, run, freedoom
+from conftest import ROOT, program, run, freedoom, wad_image
 
 sys.path.insert(0, str(ROOT / "tools"))
-from fuzz import pwad  # noqa: E402  (a WAD of the lumps given)
 from texture_bytes import flat_names, map_lumps, name8, read_wad, sections, side_texture_names  # noqa: E402
 
 SEC_LOOK, SEC_LIGHTS, SEC_TEXTURES, SEC_TEXELS, SEC_SIDES, SEC_PLANES = range(14, 20)
@@ -228,7 +227,7 @@ def small_wad(freedoom2, before=(), **over):
         if parts[k] is not None:
             out.append((k, parts[k]))
     out += [("F_START", b""), ("FLATA", parts["FLATA"]), ("F_END", b"")]
-    return pwad(out)
+    return wad_image(out)
 
 
 def broken_patch_column():
