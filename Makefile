@@ -121,7 +121,7 @@ $(GEN)/default_scene.c: $(BUILD)/default.bsc $(BUILD)/bin2c
 	$(BUILD)/bin2c default_scene $< > $@
 
 # ---- top-level targets ------------------------------------------------------------
-.PHONY: all deps run test unit pytest nofloat bench bench-faults bench-bsp clean help
+.PHONY: all deps run test unit pytest nofloat bench bench-faults bench-bsp bench-doom clean help
 .DEFAULT_GOAL := all
 
 all: $(PROGRAMS) nofloat
@@ -158,6 +158,8 @@ help:
 	@echo "make mutate     mutation testing of firmware/, firmware/dfu/, hal/serial/ (MUTATE_SAMPLE=N mutants)"
 	@echo "                -> build/mutate/report.md and docs/benchmarks.md; not part of make test"
 	@echo "make bench-bsp  bspc over all 68 Freedoom maps per strategy, beside zdbsp and glbsp"
+	@echo "make bench-doom Chocolate Doom's instructions per frame beside build/render's at 25 player starts"
+	@echo "                (callgrind) -> build/bench-doom.md and docs/benchmarks.md"
 	@echo "make report     error against the reference vs instructions per frame, per render mode and"
 	@echo "                precision-knob configuration (mk/report.mk) -> build/report/report.md and plots;"
 	@echo "                REPORT_CONFIGS=\"default subpix0\" for a few, REPORT_ARGS=\"--views 4\", V=1 shows the compiles"
@@ -204,6 +206,11 @@ test: deps
 
 bench-bsp: deps $(BUILD)/bspc
 	$(PY) tools/bench_bsp.py
+
+# BENCH_DOOM_ARGS: e.g. --mode spans, --map freedoom2.wad:MAP01 (a quick look), -j 1
+BENCH_DOOM_ARGS ?=
+bench-doom: deps $(BUILD)/bspc $(BUILD)/render
+	$(PY) tools/bench_doom.py $(BENCH_DOOM_ARGS)
 
 # BENCH_ARGS: e.g. --frames 10 (the N of (repeat N+1 - repeat 1)/N), -j 1, --views K
 BENCH_ARGS ?=

@@ -176,3 +176,35 @@ def test_document_keeps_sections_no_generator_writes(tmp_path, monkeypatch):
     text = doc.read_text()
     assert "x86 figures" in text and "## bsp figures" in text
     assert text.index("x86 figures") < text.index("## bsp figures")
+
+
+def test_doom_frame_cost_cancels_start_up_and_the_melt():
+    """bench_doom's measure: start-up, level load and the screen melt cost the same in every run, the
+    game's tics the same with and without drawing, so only the drawn frames are left."""
+    import bench_doom
+    l1, l2 = bench_doom.DEMO_TICS
+    start, melt, tic, frame = 70_000_000, 9_000_000, 12_345, 1_331_000
+
+    def run(wad, mapname, tics, how):
+        assert (wad, mapname) == ("/w/freedoom2.wad", "MAP01")
+        return start + tics * tic + ((melt + tics * frame) if how == "noblit" else 0)
+
+    monkey_find = bench_doom.doomcompare.find_wad
+    bench_doom.doomcompare.find_wad = lambda name: "/w/" + name
+    try:
+        cost, runs = bench_doom.chocolate_frame("freedoom2.wad:MAP01", run=run)
+    finally:
+        bench_doom.doomcompare.find_wad = monkey_find
+    assert cost == frame
+    assert sorted(runs) == [(l1, "noblit"), (l1, "nodraw"), (l2, "noblit"), (l2, "nodraw")]
+    # one more instruction in the longer drawn run is 1 / (l2 - l1) more a frame
+    runs[(l2, "noblit")] += l2 - l1
+    assert bench_doom.frame_cost(runs) == frame + 1
+
+
+def test_doom_starts_are_the_bench_maps_and_the_open_ones():
+    import bench_doom
+    maps = bench_doom.start_maps()
+    bench_maps = {v["scene"] for v in bench.load_views() if v["set"] == "bench"}
+    assert len(maps) == len(set(maps)) == 25
+    assert bench_maps <= set(maps) and set(bench_doom.EXTRA_MAPS) <= set(maps)
