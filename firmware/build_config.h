@@ -43,10 +43,17 @@
 #define CFG_MODE_SPANS 1u
 #define CFG_MODE_PAINTER 2u
 #define CFG_MODE_DIRECT 4u
+#define CFG_MODE_COLUMNS 8u
 #ifndef CFG_RENDER_MODES
-#define CFG_RENDER_MODES (CFG_MODE_SPANS | CFG_MODE_PAINTER | CFG_MODE_DIRECT)
+#define CFG_RENDER_MODES (CFG_MODE_SPANS | CFG_MODE_PAINTER | CFG_MODE_DIRECT | CFG_MODE_COLUMNS)
 #endif
 #define CFG_MODE(bit) ((CFG_RENDER_MODES & (bit)) != 0)
+
+/* Mode columns' visplanes (columns.c), 648 bytes each: any number from 2 works,
+ * a full pool is drawn early. */
+#ifndef CFG_COLS_PLANES
+#define CFG_COLS_PLANES 64
+#endif
 
 /* Mode direct's pools for the faces of the objects met in a frame, and their
  * edges (direct.c): any size works, larger ones only save recomputing. */
@@ -84,6 +91,7 @@ _Static_assert(CFG_FACE_VERTS >= 1 && CFG_FACE_VERTS <= SCN_MAX_FACE_VERTS, "CFG
 _Static_assert((CFG_FEATURES & ~SCN_NEED_ALL) == 0, "CFG_FEATURES");
 _Static_assert(CFG_DIRECT_FACES >= 1 && CFG_DIRECT_FACES <= 65535 && CFG_DIRECT_EDGES >= 1 && CFG_DIRECT_EDGES <= 65535,
                "CFG_DIRECT_FACES, CFG_DIRECT_EDGES");
-_Static_assert((CFG_RENDER_MODES & 7u) != 0 && (CFG_RENDER_MODES & ~7u) == 0, "CFG_RENDER_MODES");
+_Static_assert((CFG_RENDER_MODES & 15u) != 0 && (CFG_RENDER_MODES & ~15u) == 0, "CFG_RENDER_MODES");
+_Static_assert(CFG_COLS_PLANES >= 2 && CFG_COLS_PLANES <= 4096, "CFG_COLS_PLANES");
 
 #endif

@@ -1,12 +1,14 @@
 /* render.c - mode dispatch and the parts every mode shares. */
 #include "render.h"
 
+#include "columns.h"
 #include "direct.h"
 #include "painter.h"
 #include "spans.h"
 
-static const char *const mode_names[RENDER_MODE_COUNT] = {"spans", "painter", "direct"};
-static const unsigned mode_bits[RENDER_MODE_COUNT] = {CFG_MODE_SPANS, CFG_MODE_PAINTER, CFG_MODE_DIRECT};
+static const char *const mode_names[RENDER_MODE_COUNT] = {"spans", "painter", "direct", "columns"};
+static const unsigned mode_bits[RENDER_MODE_COUNT] = {CFG_MODE_SPANS, CFG_MODE_PAINTER, CFG_MODE_DIRECT,
+                                                      CFG_MODE_COLUMNS};
 
 static int built(int m)
 {
@@ -61,6 +63,10 @@ uint32_t render_work_bytes(const scene *s, const world_state *w)
         if ((b = direct_work_bytes(s, w)) == 0) return 0;
         need = max_u32(need, b);
     }
+    if (CFG_MODE(CFG_MODE_COLUMNS)) {
+        if ((b = cols_work_bytes(s, w)) == 0) return 0;
+        need = max_u32(need, b);
+    }
     if (CFG_MODE(CFG_MODE_PAINTER)) need = max_u32(need, painter_work_bytes(s, w)); /* 0: none needed */
     return need;
 }
@@ -82,6 +88,9 @@ void render_frame(const scene *s, const world_state *w, const camera *cam, rende
         break;
     case RENDER_SPANS:
         if (CFG_MODE(CFG_MODE_SPANS)) spans_render(s, w, &v, t, st, work ? work->mem : 0, work ? work->bytes : 0);
+        break;
+    case RENDER_COLUMNS:
+        if (CFG_MODE(CFG_MODE_COLUMNS)) cols_render(s, w, &v, t, st, work ? work->mem : 0, work ? work->bytes : 0);
         break;
     default:
         if (CFG_MODE(CFG_MODE_DIRECT)) direct_render(s, w, &v, t, st, work ? work->mem : 0, work ? work->bytes : 0);

@@ -16,6 +16,7 @@ typedef enum {
     RENDER_SPANS,   /* front to back, sorted edge lists and spans, zero overdraw (spans.h) */
     RENDER_PAINTER, /* Listing 62.1: back to front, with overdraw */
     RENDER_DIRECT,  /* front to back, each polygon row filled where free, zero overdraw (direct.h; the default) */
+    RENDER_COLUMNS, /* Doom's: walls down columns, per-column clip, visplanes; direct's with objects (columns.h) */
     RENDER_MODE_COUNT
 } render_mode;
 

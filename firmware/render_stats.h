@@ -28,6 +28,8 @@ typedef struct {
                                * direct: objects whose faces did not fit its pools (worked out again) */
     uint32_t yclip_skipped;   /* polygons inside the top and bottom planes: no y-clipping done */
     uint32_t planes_skipped;  /* floors and ceilings not set up: the eye is level with or beyond them */
+    uint32_t fallback;        /* columns: 1 if the frame was drawn by mode direct (objects in view, or the eye
+                               * outside the world) */
 } render_stats;
 
 #endif

@@ -38,25 +38,29 @@ typedef struct {
     int32_t h;              /* LOOK_PLANE: its height */
 } surf_look;
 
-/* A wall part's paint: its texture, hung by Doom's pegging from the heights
- * the sectors have now (a door's texture moves with the door). */
-static tex_paint part_paint(const scene *sc, const view_xform *v, const surf_look *k)
+tex_paint surf_part_paint(const scene *sc, const view_xform *v, const scn_seg *g, int part, int32_t ff, int32_t fc,
+                          int32_t bf, int32_t bc, uint8_t light, uint8_t colour)
 {
 #if CFG_TEXTURES
-    const scn_side *sd = &sc->sides[k->g->line * 2u + k->g->side];
-    uint32_t tex = sd->tex[k->part];
+    const scn_side *sd = &sc->sides[g->line * 2u + g->side];
+    uint32_t tex = sd->tex[part];
     int32_t top;
-    if (k->part == SCN_PART_MIDDLE)
-        top = (sd->flags & SCN_SIDE_UNPEG_BOTTOM) ? k->ff + tex_height(sc, tex) : k->fc;
-    else if (k->part == SCN_PART_UPPER)
-        top = (sd->flags & SCN_SIDE_UNPEG_TOP) ? k->fc : k->bc + tex_height(sc, tex);
+    if (part == SCN_PART_MIDDLE)
+        top = (sd->flags & SCN_SIDE_UNPEG_BOTTOM) ? ff + tex_height(sc, tex) : fc;
+    else if (part == SCN_PART_UPPER)
+        top = (sd->flags & SCN_SIDE_UNPEG_TOP) ? fc : bc + tex_height(sc, tex);
     else
-        top = (sd->flags & SCN_SIDE_UNPEG_BOTTOM) ? k->fc : k->bf;
-    return tex_wall(sc, v, sd, tex, &sc->verts[k->g->v1], top, k->light, k->colour);
+        top = (sd->flags & SCN_SIDE_UNPEG_BOTTOM) ? fc : bf;
+    return tex_wall(sc, v, sd, tex, &sc->verts[g->v1], top, light, colour);
 #else
-    (void)sc, (void)v;
-    return tex_flat(k->colour);
+    (void)sc, (void)v, (void)g, (void)part, (void)ff, (void)fc, (void)bf, (void)bc, (void)light;
+    return tex_flat(colour);
 #endif
+}
+
+static tex_paint part_paint(const scene *sc, const view_xform *v, const surf_look *k)
+{
+    return surf_part_paint(sc, v, k->g, k->part, k->ff, k->fc, k->bf, k->bc, k->light, k->colour);
 }
 
 static tex_paint paint_of(const scene *sc, const view_xform *v, const surf_sink *sink, const surf_look *k)
@@ -98,10 +102,7 @@ static void emit(const scene *sc, const view_xform *v, clip_poly *p, unsigned ma
     sink->polygon(sink->ctx, s, p->n, &paint, id, seg, zmin, zmax);
 }
 
-/* Front-facing: the eye strictly on the right of a -> b (edge-on is culled).
- * Exact: an eye 1/65536 in front of a wall, looking along it, sees the wall in
- * a few columns, and dropping the offset's low bits would cull it as edge-on. */
-static int faces_eye(const view_xform *v, const scn_vertex *a, const scn_vertex *b)
+int surf_faces_eye(const view_xform *v, const scn_vertex *a, const scn_vertex *b)
 {
     return w128_sign_diff((int64_t)b->x - a->x, v->cy - a->y, (int64_t)b->y - a->y, v->cx - a->x) < 0;
 }
@@ -136,20 +137,13 @@ static void close_columns(const view_xform *v, const scn_vertex *a, const scn_ve
     occ_close(occ, rast_first_sample(xa), rast_first_sample(xb));
 }
 
-/* A sector's ceiling now: obj_ceil's rule, with its test of w made once per leaf
- * (ceil: w->ceil, or NULL for the ceilings as compiled). */
-static inline int32_t ceil_now(const scene *sc, const fx_t *ceil, uint32_t i)
-{
-    return (CFG_DOORS && ceil) ? ceil[i] : sc->sectors[i].ceil_h;
-}
-
 static void seg_parts(const scene *sc, const fx_t *ceil, const view_xform *v, uint32_t gi, unsigned mask,
                       const surf_sink *sink, occ_columns *occ, render_stats *st)
 {
     const scn_seg *g = &sc->segs[gi];
     const scn_vertex *a = &sc->verts[g->v1], *b = &sc->verts[g->v2];
     st->segs++;
-    if (!faces_eye(v, a, b)) {
+    if (!surf_faces_eye(v, a, b)) {
         st->culled++;
         return;
     }
@@ -164,7 +158,7 @@ static void seg_parts(const scene *sc, const fx_t *ceil, const view_xform *v, ui
     const scn_line *l = &sc->lines[g->line];
     uint32_t front_index = l->sector[g->side], back_index = l->sector[g->side ^ 1u];
     const scn_sector *front = &sc->sectors[front_index];
-    int32_t front_ceil = ceil_now(sc, ceil, front_index);
+    int32_t front_ceil = surf_ceil_now(sc, ceil, front_index);
     uint32_t id = RAST_ID(RAST_KIND_WALL, g->line * 2u + g->side);
     const uint8_t *colour = l->color[g->side];
     surf_look k = {LOOK_PART,
@@ -184,7 +178,7 @@ static void seg_parts(const scene *sc, const fx_t *ceil, const view_xform *v, ui
         return;
     }
     const scn_sector *back = &sc->sectors[back_index];
-    int32_t back_ceil = ceil_now(sc, ceil, back_index);
+    int32_t back_ceil = surf_ceil_now(sc, ceil, back_index);
     k.bf = back->floor_h;
     k.bc = back_ceil;
     if (CFG_HEIGHTS && back_ceil < front_ceil) {
@@ -247,7 +241,7 @@ void surf_leaf(const scene *sc, const world_state *w, const view_xform *v, uint3
     st->leaves++;
     if (f->sector != SCN_NONE) {
         const scn_sector *sec = &sc->sectors[f->sector];
-        int32_t top = ceil_now(sc, ceil, f->sector);
+        int32_t top = surf_ceil_now(sc, ceil, f->sector);
         int floor = v->cz > sec->floor_h, ceiling = v->cz < top; /* edge-on or from behind: no plane work */
         st->planes_skipped += (uint32_t)!floor + (uint32_t)!ceiling;
         uint32_t n = f->num_pverts;

@@ -40,4 +40,23 @@ typedef struct {
 void surf_leaf(const scene *s, const world_state *w, const view_xform *v, uint32_t leaf, unsigned clip_mask,
                const surf_sink *sink, occ_columns *occ, render_stats *st);
 
+/* Front-facing: the eye strictly on the right of a -> b (edge-on is culled).
+ * Exact: an eye 1/65536 in front of a wall, looking along it, sees the wall in
+ * a few columns, and dropping the offset's low bits would cull it as edge-on. */
+int surf_faces_eye(const view_xform *v, const scn_vertex *a, const scn_vertex *b);
+
+/* A wall part's paint (part: SCN_PART_*): its texture, hung by Doom's pegging
+ * from the heights the sectors have now (front floor and ceiling, back floor and
+ * ceiling: a door's texture moves with the door), or its flat colour in a build
+ * without textures. light: the front sector's light level. */
+tex_paint surf_part_paint(const scene *sc, const view_xform *v, const scn_seg *g, int part, int32_t ff, int32_t fc,
+                          int32_t bf, int32_t bc, uint8_t light, uint8_t colour);
+
+/* A sector's ceiling now: obj_ceil's rule, with its test of w made once per leaf
+ * (ceil: w->ceil, or NULL for the ceilings as compiled). */
+static inline int32_t surf_ceil_now(const scene *sc, const fx_t *ceil, uint32_t i)
+{
+    return (CFG_DOORS && ceil) ? ceil[i] : sc->sectors[i].ceil_h;
+}
+
 #endif

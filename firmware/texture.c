@@ -205,11 +205,16 @@ static inline const uint8_t *wall_light(const tex_paint *p, uint32_t z)
 /* The exact texture column, row and light where a pixel's ray meets the
  * wall: den and slope are the paint's a + sx b and c + sx d for the pixel's
  * column (2.30, stepped along the span), vk its row's sy 2^22 / 320. */
+static inline __attribute__((always_inline)) uint32_t wall_depth(const tex_paint *p, int64_t den)
+{
+    int64_t d14 = den >> 16; /* 2.14, < 2^15 */
+    return d14 > 0 ? depth_div((uint64_t)p->dist, (uint32_t)d14) : TEX_ZMAX;
+}
+
 static inline __attribute__((always_inline)) wall_sample wall_at(const tex_paint *p, int64_t den, int64_t slope,
                                                                  int32_t vk)
 {
-    int64_t d14 = den >> 16; /* 2.14, < 2^15 */
-    uint32_t z = d14 > 0 ? depth_div((uint64_t)p->dist, (uint32_t)d14) : TEX_ZMAX;
+    uint32_t z = wall_depth(p, den);
     wall_sample s;
     s.u = p->u0 + (uint32_t)(((int64_t)z * (slope >> 16)) >> 14); /* < 2^47 before the shift */
     s.v = p->v0 - (uint32_t)(((int64_t)z * vk) >> 22);            /* < 2^56 */
@@ -267,6 +272,36 @@ static void wall_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
         wall_span_as(p, y, x0, x1, row, (tex_addr){a.texels, a.cmask, 127u, 9u});
     else
         wall_span_as(p, y, x0, x1, row, a);
+}
+
+/* Rows [y0, y1) of column x down a wall: the exact sample of the column's
+ * centre ray (wall_at's depth, texture column and light), then the texture row
+ * stepped down the column, Doom's wall column: one coordinate stepped, the
+ * texture column and the light fixed. */
+static inline __attribute__((always_inline)) void wall_column_as(const tex_paint *p, int x, int y0, int y1,
+                                                                 uint8_t *dst, uint32_t pitch, uint32_t hmask)
+{
+    int32_t sx = 2 * x + 1 - VIEW_W;
+    int64_t den = (int64_t)p->a + (int64_t)sx * p->b, slope = (int64_t)p->c + (int64_t)sx * p->d;
+    int32_t sy = 2 * (VIEW_CY + p->look) - 2 * y0 - 1;
+    uint32_t z = wall_depth(p, den);
+    wall_sample s = wall_at(p, den, slope, sy * 13107);
+    uint32_t dv = (uint32_t)(((int64_t)z * (2 * 13107)) >> 22); /* a row down: sy falls by 2 */
+    const uint8_t *col = p->texels + (((s.u >> 16) & p->wmask) << p->hbits), *light = s.light;
+    uint32_t v = s.v;
+    for (int n = y1 - y0; n > 0; n--) {
+        *dst = light[col[(v >> 16) & hmask]];
+        dst += pitch;
+        v += dv;
+    }
+}
+
+void tex_column(const tex_paint *p, int x, int y0, int y1, uint8_t *dst, uint32_t pitch)
+{
+    if (p->hmask == 127u)
+        wall_column_as(p, x, y0, y1, dst, pitch, 127u);
+    else
+        wall_column_as(p, x, y0, y1, dst, pitch, p->hmask);
 }
 
 /* ---- floors and ceilings: one depth a row (Doom's trick) ---- */

@@ -95,6 +95,11 @@ static inline int32_t tex_height(const scene *sc, uint32_t tex)
 
 /* Pixels [x0, x1) of row y of a textured paint into row[x0 .. x1). */
 void tex_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row);
+
+/* Rows [y0, y1) of screen column x of a wall paint (TEX_WALL) into dst[0],
+ * dst[pitch], ...: the depth, texture column and light exact at the column's
+ * centre, the texture row stepped down it. */
+void tex_column(const tex_paint *p, int x, int y0, int y1, uint8_t *dst, uint32_t pitch);
 #endif
 
 #endif

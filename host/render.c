@@ -35,8 +35,9 @@ static const char usage[] = "usage: render SCENE [--at X,Y[,Z]] [--angle DEG] [o
                             "                     (default: the player start's angle)\n"
                             "  --look PX          vertical shear in pixels, -100..100 (default 0)\n"
                             "  --mode MODE        direct (zero overdraw, the default), spans (zero overdraw,\n"
-                            "                     sorted edge lists) or painter (back to\n"
-                            "                     front, Listing 62.1)\n"
+                            "                     sorted edge lists), painter (back to\n"
+                            "                     front, Listing 62.1) or columns (Doom's: walls down\n"
+                            "                     columns, floors from visplanes; direct's with objects)\n"
                             "  --present P        flip | copy8 | copy16 | copy32 (default flip)\n"
                             "  --split S          BSP split strategy when compiling a source: fewest |\n"
                             "                     balanced | mixed (default mixed)\n"
@@ -198,7 +199,7 @@ static int parse_args(options *o, int argc, char **argv)
             o->cam.look = (int32_t)v;
         } else if (!strcmp(a, "--mode")) {
             int m = render_mode_parse(val);
-            if (m < 0) return die("--mode '%s': unknown mode (have: direct, spans, painter)%s", val, "");
+            if (m < 0) return die("--mode '%s': unknown mode (have: direct, spans, painter, columns)%s", val, "");
             o->mode = (render_mode)m;
         } else if (!strcmp(a, "--present")) {
             int m = hal_present_parse(val);
@@ -591,9 +592,9 @@ static void print_json(const options *o, const engine *e, uint32_t crc, const li
            st->nodes, st->boxes_culled, st->leaves, st->segs, st->culled, st->polygons, st->occluded, st->edges,
            st->spans, e->work.bytes, o->repeat);
     printf("\"object_pass\": %u, \"overflow\": %u, \"flushes\": %u, \"yclip_skipped\": %u, \"planes_skipped\": %u, "
-           "\"features\": %u, \"build_features\": %u, ",
-           st->object_pass, st->overflow, st->flushes, st->yclip_skipped, st->planes_skipped, e->sc.needs->features,
-           (unsigned)CFG_FEATURES);
+           "\"fallback\": %u, \"features\": %u, \"build_features\": %u, ",
+           st->object_pass, st->overflow, st->flushes, st->yclip_skipped, st->planes_skipped, st->fallback,
+           e->sc.needs->features, (unsigned)CFG_FEATURES);
     printf("\"objects_visible\": %u, \"object_faces\": %u, \"objects\": [", st->objects_visible, st->object_faces);
     const world_state *w = &e->world;
     for (uint32_t i = 0; i < w->n; i++) {

@@ -1,0 +1,408 @@
+/* columns.c - render mode "columns" (see columns.h): the world down screen
+ * columns, floors and ceilings from visplanes. */
+#include "columns.h"
+
+#include "bsp_walk.h"
+#include "clip.h"
+#include "direct.h"
+#include "eye.h"
+#include "obj_draw.h"
+#include "surfaces.h"
+
+#define BACKGROUND_COLOUR 0
+#define NO_ROW 0xFFu /* a visplane column with no rows */
+
+/* A sector's floor or ceiling rows, one run per column (Doom's visplane). */
+typedef struct {
+    uint32_t sector;
+    uint8_t ceiling;
+    int16_t minx, maxx;     /* the columns used lie in [minx, maxx]; none while minx > maxx */
+    uint8_t top[VIEW_W];    /* first row of each column, NO_ROW if none */
+    uint8_t bottom[VIEW_W]; /* one past its last */
+} cols_plane;
+
+enum { ROW_CEIL, ROW_FLOOR, ROW_LOW, ROW_HIGH, ROW_UNUSED, ROW_LINES }; /* ROW_UNUSED: a chain not needed */
+
+typedef struct {
+    const scene *sc;
+    const view_xform *v;
+    const rast_target *t;
+    render_stats *st;
+    const fx_t *ceil; /* the ceilings now (doors), or NULL */
+    int textured;
+    occ_columns occ;                            /* columns with no row open */
+    uint8_t open_top[VIEW_W], open_bot[VIEW_W]; /* rows [top, bot) of each column still open */
+    int16_t rows[ROW_LINES][VIEW_W];            /* the seg in hand: where its lines cross each column */
+    uint32_t nplanes;
+    cols_plane planes[CFG_COLS_PLANES];
+} cols_state;
+
+static uint32_t align8(uint64_t n)
+{
+    return (uint32_t)((n + 7u) & ~(uint64_t)7u);
+}
+
+uint32_t cols_work_bytes(const scene *s, const world_state *w)
+{
+    uint32_t direct = direct_work_bytes(s, w), own = align8(sizeof(cols_state));
+    if (direct == 0) return 0;
+    return direct > own ? direct : own;
+}
+
+/* ---- rows of a wall's lines in each column ------------------------------------------- */
+
+static inline int64_t floor_div(int64_t a, int64_t b)
+{
+    int64_t q = a / b;
+    return (a % b < 0) ? q - 1 : q;
+}
+
+static inline int clamp_row(int64_t r)
+{
+    return r < 0 ? 0 : (r > VIEW_H ? VIEW_H : (int)r);
+}
+
+/* rows[c]: the first row whose centre lies at or below the screen edge a -> b
+ * (a.x < b.x), at the centre of each column c of [c0, c1) that the edge spans:
+ * the edge's y there by an exact DDA (floor, 16.16), sampled as the fill rule
+ * samples rows. Screen points are inside [0, 320] x [0, 200] (clip.h), so the
+ * products stay below 2^50. */
+static void edge_rows(screen_pt a, screen_pt b, int c0, int c1, int16_t *rows)
+{
+    int c = rast_first_sample(a.x), end = rast_first_sample(b.x);
+    if (c < c0) c = c0;
+    if (end > c1) end = c1;
+    if (c >= end) return;
+    int64_t dx = (int64_t)b.x - a.x, dy = (int64_t)b.y - a.y;
+    int64_t num = (((int64_t)c << 16) + 32768 - a.x) * dy;
+    int64_t q = floor_div(num, dx), rem = num - q * dx; /* rem in [0, dx) */
+    int64_t step = floor_div(dy * 65536, dx), srem = dy * 65536 - step * dx;
+    int64_t y = a.y + q;
+    for (; c < end; c++) {
+        rows[c] = (int16_t)clamp_row(fx_asr64(y + 32767, 16));
+        y += step;
+        rem += srem;
+        if (rem >= dx) {
+            rem -= dx;
+            y++;
+        }
+    }
+}
+
+/* Where the wall quad from height hb to ht over view points pa, pb meets each
+ * column of [c0, c1): top[c] its first row, bot[c] one past its last (clipped
+ * and projected as every mode clips it, its upper chain walked into top and its
+ * lower chain into bot). A column the clipped quad misses lies wholly above the
+ * screen (a quad above the eye) or below it. */
+static void quad_rows(cols_state *S, view_pt pa, view_pt pb, int32_t hb, int32_t ht, unsigned mask, int c0, int c1,
+                      int16_t *top, int16_t *bot)
+{
+    const view_xform *v = S->v;
+    int16_t miss = (int16_t)(hb >= v->cz ? 0 : (ht <= v->cz ? VIEW_H : clamp_row(VIEW_CY + VIEW_LOOK(v))));
+    for (int c = c0; c < c1; c++) top[c] = bot[c] = miss;
+    if (ht <= hb) return;
+    clip_poly p;
+    p.n = 4;
+    p.v[0] = view_at_height(v, pa, ht);
+    p.v[1] = view_at_height(v, pb, ht);
+    p.v[2] = view_at_height(v, pb, hb);
+    p.v[3] = view_at_height(v, pa, hb);
+    if (!clip_polygon(&p, v, mask)) return;
+    S->st->polygons++;
+    screen_pt s[CLIP_MAX_VERTS];
+    clip_project(v, &p, s);
+    for (int i = 0; i < p.n; i++) { /* clockwise on screen: rightwards along the top, leftwards along the bottom */
+        screen_pt a = s[i], b = s[i + 1 == p.n ? 0 : i + 1];
+        if (a.x < b.x)
+            edge_rows(a, b, c0, c1, top);
+        else if (a.x > b.x)
+            edge_rows(b, a, c0, c1, bot);
+    }
+}
+
+/* ---- drawing ----------------------------------------------------------------------- */
+
+/* Rows [y0, y1) of column x in a paint, counted as the byte writes they are. */
+static void draw_column(const cols_state *S, int x, int y0, int y1, const tex_paint *paint, uint32_t id)
+{
+    if (y0 >= y1) return;
+    const rast_target *t = S->t;
+    int textured = rast_textured_paint(t, paint);
+    uint32_t n = (uint32_t)(y1 - y0);
+    if (t->tally) {
+        uint8_t *dst = t->surf->pixels + (uint32_t)y0 * HAL_WIDTH + (uint32_t)x;
+#if CFG_TEXTURES
+        if (textured)
+            tex_column(paint, x, y0, y1, dst, HAL_WIDTH);
+        else
+#endif
+            for (uint32_t k = 0; k < n; k++) dst[k * HAL_WIDTH] = paint->colour;
+        t->tally->w[0] += n;
+        t->tally->pixels += n;
+    } else {
+        uint8_t col[VIEW_H];
+#if CFG_TEXTURES
+        if (textured)
+            tex_column(paint, x, y0, y1, col, 1);
+        else
+#endif
+            for (uint32_t k = 0; k < n; k++) col[k] = paint->colour;
+        for (uint32_t k = 0; k < n; k++) hal_fill_span(t->surf, y0 + (int)k, x, 1, col[k]);
+    }
+    (void)textured;
+    if (t->ids)
+        for (int y = y0; y < y1; y++) t->ids[y * VIEW_W + x] = id;
+}
+
+static tex_paint plane_paint(const cols_state *S, const cols_plane *p)
+{
+    const scn_sector *sec = &S->sc->sectors[p->sector];
+    uint8_t colour = p->ceiling ? sec->ceil_color : sec->floor_color;
+#if CFG_TEXTURES
+    if (S->textured) {
+        if (p->ceiling && CFG_SKY && (sec->flags & SCN_SECTOR_SKY)) return tex_sky(S->sc, S->v, colour);
+        const scn_plane *pl = &S->sc->planes[p->sector];
+        int32_t h = p->ceiling ? surf_ceil_now(S->sc, S->ceil, p->sector) : sec->floor_h;
+        return tex_plane(S->sc, S->v, p->ceiling ? pl->ceil_tex : pl->floor_tex, h, sec->light, colour);
+    }
+#endif
+    return tex_flat(colour);
+}
+
+/* A visplane's column runs as row spans (Doom's R_MakeSpans): a row's span
+ * starts where the row enters the columns' runs and ends where it leaves. */
+static void draw_plane(const cols_state *S, const cols_plane *p)
+{
+    if (p->minx > p->maxx) return;
+    tex_paint paint = plane_paint(S, p);
+    uint32_t id = RAST_ID(p->ceiling ? RAST_KIND_CEILING : RAST_KIND_FLOOR, p->sector);
+    int16_t start[VIEW_H];
+    int t1 = 0, b1 = 0; /* the previous column's rows [t1, b1) */
+    for (int x = p->minx; x <= p->maxx + 1; x++) {
+        int t2 = 0, b2 = 0;
+        if (x <= p->maxx && p->top[x] != NO_ROW) {
+            t2 = p->top[x];
+            b2 = p->bottom[x];
+        }
+        for (int y = t1; y < b1 && y < t2; y++) rast_span(S->t, y, start[y], x, &paint, id);
+        for (int y = b2 > t1 ? b2 : t1; y < b1; y++) rast_span(S->t, y, start[y], x, &paint, id);
+        for (int y = t2; y < b2 && y < t1; y++) start[y] = (int16_t)x;
+        for (int y = b1 > t2 ? b1 : t2; y < b2; y++) start[y] = (int16_t)x;
+        t1 = t2;
+        b1 = b2;
+    }
+}
+
+/* Every visplane drawn, the pool emptied. */
+static void flush_planes(cols_state *S)
+{
+    for (uint32_t i = 0; i < S->nplanes; i++) draw_plane(S, &S->planes[i]);
+    S->nplanes = 0;
+}
+
+/* The newest visplane of a sector's floor or ceiling if none of columns
+ * [c0, c1) is used in it yet, else a new one (Doom's R_CheckPlane). The caller
+ * has made room for it. */
+static cols_plane *plane_for(cols_state *S, uint32_t sector, int ceiling, int c0, int c1)
+{
+    for (uint32_t i = S->nplanes; i-- > 0;) {
+        cols_plane *p = &S->planes[i];
+        if (p->sector != sector || p->ceiling != ceiling) continue;
+        int lo = c0 > p->minx ? c0 : p->minx, hi = c1 - 1 < p->maxx ? c1 - 1 : p->maxx;
+        int x = lo;
+        while (x <= hi && p->top[x] == NO_ROW) x++;
+        if (x > hi) return p;
+        break;
+    }
+    cols_plane *p = &S->planes[S->nplanes++];
+    p->sector = sector;
+    p->ceiling = (uint8_t)ceiling;
+    p->minx = VIEW_W;
+    p->maxx = -1;
+    for (int x = 0; x < VIEW_W; x++) p->top[x] = NO_ROW;
+    return p;
+}
+
+static inline void plane_rows(cols_plane *p, int x, int y0, int y1)
+{
+    p->top[x] = (uint8_t)y0;
+    p->bottom[x] = (uint8_t)y1;
+    if (x < p->minx) p->minx = (int16_t)x;
+    if (x > p->maxx) p->maxx = (int16_t)x;
+}
+
+/* ---- a seg ------------------------------------------------------------------------- */
+
+typedef struct {
+    uint32_t sector;    /* the front sector */
+    int two_sided;      /* 0: the wall fills the column between floor and ceiling */
+    int upper, lower;   /* two-sided: an upper wall (or sky step), a lower wall */
+    int sky_step;       /* the upper part is more sky (Doom's sky rule) */
+    tex_paint paint[3]; /* SCN_PART_* */
+    uint32_t id;
+    cols_plane *ceil_plane, *floor_plane;
+} seg_look;
+
+static inline int clamp_in(int r, int lo, int hi)
+{
+    return r < lo ? lo : (r > hi ? hi : r);
+}
+
+/* Split the open rows of columns [c0, c1) by the seg's lines, draw its walls,
+ * give the floor and ceiling rows to the front sector's visplanes, and leave
+ * open only the opening. */
+static void seg_columns(cols_state *S, seg_look *k, int c0, int c1)
+{
+    int closed_from = -1;
+    for (int c = c0; c <= c1; c++) {
+        int closed = c < c1 && S->open_top[c] >= S->open_bot[c];
+        if (c < c1 && !closed) {
+            int t = S->open_top[c], b = S->open_bot[c];
+            int fc = clamp_in(S->rows[ROW_CEIL][c], t, b), ff = clamp_in(S->rows[ROW_FLOOR][c], fc, b);
+            int low = k->upper ? clamp_in(S->rows[ROW_LOW][c], fc, ff) : fc;
+            int high = k->lower ? clamp_in(S->rows[ROW_HIGH][c], low, ff) : ff;
+            if (!k->two_sided) low = high = ff;
+            int ceil_end = k->sky_step ? low : fc;
+            if (ceil_end > t) {
+                if (!k->ceil_plane) k->ceil_plane = plane_for(S, k->sector, 1, c0, c1);
+                plane_rows(k->ceil_plane, c, t, ceil_end);
+            }
+            if (ff < b) {
+                if (!k->floor_plane) k->floor_plane = plane_for(S, k->sector, 0, c0, c1);
+                plane_rows(k->floor_plane, c, ff, b);
+            }
+            if (!k->two_sided) {
+                draw_column(S, c, fc, ff, &k->paint[SCN_PART_MIDDLE], k->id);
+            } else {
+                if (!k->sky_step) draw_column(S, c, fc, low, &k->paint[SCN_PART_UPPER], k->id);
+                draw_column(S, c, high, ff, &k->paint[SCN_PART_LOWER], k->id);
+            }
+            S->open_top[c] = (uint8_t)low;
+            S->open_bot[c] = (uint8_t)high;
+            closed = low >= high;
+        }
+        if (closed && closed_from < 0) closed_from = c;
+        if (!closed && closed_from >= 0) {
+            occ_close(&S->occ, closed_from, c);
+            closed_from = -1;
+        }
+    }
+}
+
+static tex_paint part(const cols_state *S, const scn_seg *g, int part, int32_t ff, int32_t fc, int32_t bf, int32_t bc,
+                      uint8_t light, uint8_t colour)
+{
+    return S->textured ? surf_part_paint(S->sc, S->v, g, part, ff, fc, bf, bc, light, colour) : tex_flat(colour);
+}
+
+static void seg(cols_state *S, uint32_t gi, unsigned mask)
+{
+    const scene *sc = S->sc;
+    const view_xform *v = S->v;
+    const scn_seg *g = &sc->segs[gi];
+    const scn_vertex *a = &sc->verts[g->v1], *b = &sc->verts[g->v2];
+    S->st->segs++;
+    if (!surf_faces_eye(v, a, b)) {
+        S->st->culled++;
+        return;
+    }
+    view_pt pa = view_point(v, a->x, a->y, 0), pb = view_point(v, b->x, b->y, 0);
+    int32_t xa, xb;
+    if (!clip_wall_x(v, pa, pb, mask, &xa, &xb)) {
+        S->st->clipped_away++;
+        return;
+    }
+    int c0 = rast_first_sample(xa), c1 = rast_first_sample(xb);
+    c0 = c0 < 0 ? 0 : c0;
+    c1 = c1 > VIEW_W ? VIEW_W : c1;
+    if (c0 >= c1 || occ_hidden(&S->occ, c0, c1)) {
+        S->st->occluded++;
+        return;
+    }
+    const scn_line *l = &sc->lines[g->line];
+    uint32_t fi = l->sector[g->side], bi = l->sector[g->side ^ 1u];
+    const scn_sector *front = &sc->sectors[fi];
+    int32_t ff = front->floor_h, fc = surf_ceil_now(sc, S->ceil, fi), bf = ff, bc = fc;
+    const uint8_t *colour = l->color[g->side];
+    seg_look k = {0};
+    k.sector = fi;
+    k.id = RAST_ID(RAST_KIND_WALL, g->line * 2u + g->side);
+    quad_rows(S, pa, pb, ff, fc, mask, c0, c1, S->rows[ROW_CEIL], S->rows[ROW_FLOOR]);
+    if (CFG_TWO_SIDED && bi != SCN_NONE) {
+        const scn_sector *back = &sc->sectors[bi];
+        k.two_sided = 1;
+        bf = back->floor_h;
+        bc = surf_ceil_now(sc, S->ceil, bi);
+        if (CFG_HEIGHTS && bc < fc) {
+            k.upper = 1;
+            k.sky_step = CFG_SKY && (front->flags & back->flags & SCN_SECTOR_SKY);
+            int32_t low = bc > ff ? bc : ff;
+            quad_rows(S, pa, pb, low, fc, mask, c0, c1, S->rows[ROW_UNUSED], S->rows[ROW_LOW]);
+            k.paint[SCN_PART_UPPER] = part(S, g, SCN_PART_UPPER, ff, fc, bf, bc, front->light, colour[SCN_PART_UPPER]);
+        }
+        if (CFG_HEIGHTS && bf > ff) {
+            k.lower = 1;
+            int32_t high = bf < fc ? bf : fc;
+            quad_rows(S, pa, pb, ff, high, mask, c0, c1, S->rows[ROW_HIGH], S->rows[ROW_UNUSED]);
+            k.paint[SCN_PART_LOWER] = part(S, g, SCN_PART_LOWER, ff, fc, bf, bc, front->light, colour[SCN_PART_LOWER]);
+        }
+    } else {
+        k.paint[SCN_PART_MIDDLE] = part(S, g, SCN_PART_MIDDLE, ff, fc, bf, bc, front->light, colour[SCN_PART_MIDDLE]);
+    }
+    if (S->nplanes + 2 > CFG_COLS_PLANES) flush_planes(S); /* room for this seg's floor and ceiling */
+    seg_columns(S, &k, c0, c1);
+}
+
+static int visit_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
+{
+    cols_state *S = ctx;
+    const scn_leaf *f = &S->sc->leaves[leaf];
+    S->st->leaves++;
+    for (uint32_t i = 0; i < f->num_segs && !occ_full(&S->occ); i++) seg(S, f->first_seg + i, clip_mask);
+    return occ_full(&S->occ);
+}
+
+/* ---- the frame ---------------------------------------------------------------------- */
+
+/* Frames this mode cannot draw exactly: an eye outside the world (a wall may then
+ * be seen from behind and columns do not close), or objects in view. */
+static int needs_direct(const scene *sc, const world_state *w, const view_xform *v)
+{
+    if (!eye_in_world(sc, w, v)) return 1;
+    if (CFG_OBJECTS && w && w->objs)
+        for (uint32_t i = 0; i < w->n; i++)
+            if (w->objs[i].model < sc->nmodels && objd_in_view(sc, &w->objs[i], v)) return 1;
+    return 0;
+}
+
+void cols_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t, render_stats *st,
+                 void *work, uint32_t work_bytes)
+{
+    uint32_t need = cols_work_bytes(sc, w);
+    if (!work || need == 0 || work_bytes < need || needs_direct(sc, w, v)) {
+        st->fallback = work && need && work_bytes >= need;
+        direct_render(sc, w, v, t, st, work, work_bytes);
+        return;
+    }
+    cols_state *S = work;
+    S->sc = sc;
+    S->v = v;
+    S->t = t;
+    S->st = st;
+    S->ceil = w ? w->ceil : 0;
+    S->textured = CFG_TEXTURES && sc->look && !t->flat;
+    S->nplanes = 0;
+    occ_reset(&S->occ);
+    for (int c = 0; c < VIEW_W; c++) {
+        S->open_top[c] = 0;
+        S->open_bot[c] = VIEW_H;
+    }
+    walk_stats ws;
+    walk_tree(sc, v, WALK_FRONT_TO_BACK, visit_leaf, S, &S->occ, &ws);
+    st->nodes = ws.nodes;
+    st->boxes_culled = ws.boxes_culled + ws.boxes_hidden;
+    flush_planes(S);
+    tex_paint background = tex_flat(BACKGROUND_COLOUR);
+    for (int c = 0; c < VIEW_W; c++) /* what no wall's column reached: the background */
+        draw_column(S, c, S->open_top[c], S->open_bot[c], &background, RAST_ID(RAST_KIND_NONE, 0));
+}
