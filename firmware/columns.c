@@ -4,6 +4,7 @@
 
 #include "bsp_walk.h"
 #include "clip.h"
+#include "cover.h"
 #include "direct.h"
 #include "eye.h"
 #include "obj_draw.h"
@@ -23,6 +24,12 @@ typedef struct {
 
 enum { ROW_CEIL, ROW_FLOOR, ROW_LOW, ROW_HIGH, ROW_UNUSED, ROW_LINES }; /* ROW_UNUSED: a chain not needed */
 
+/* The pixels objects may cover, which mode direct draws: rows [top[x], bot[x])
+ * of each column x (empty where top >= bot). */
+typedef struct {
+    uint8_t top[VIEW_W], bot[VIEW_W];
+} cols_region;
+
 typedef struct {
     const scene *sc;
     const view_xform *v;
@@ -33,6 +40,8 @@ typedef struct {
     occ_columns occ;                            /* columns with no row open */
     uint8_t open_top[VIEW_W], open_bot[VIEW_W]; /* rows [top, bot) of each column still open */
     int16_t rows[ROW_LINES][VIEW_W];            /* the seg in hand: where its lines cross each column */
+    const cols_region *objs;                    /* NULL: no object in view */
+    cov_mask cov; /* with objs: set where they may show, so that floors and ceilings leave it */
     uint32_t nplanes;
     cols_plane planes[CFG_COLS_PLANES];
 } cols_state;
@@ -42,11 +51,12 @@ static uint32_t align8(uint64_t n)
     return (uint32_t)((n + 7u) & ~(uint64_t)7u);
 }
 
+/* The work memory: the objects' region, then this mode's state or direct's. */
 uint32_t cols_work_bytes(const scene *s, const world_state *w)
 {
     uint32_t direct = direct_work_bytes(s, w), own = align8(sizeof(cols_state));
-    if (direct == 0) return 0;
-    return direct > own ? direct : own;
+    if (direct == 0 || direct > 0xFFFFF000u) return 0;
+    return align8(sizeof(cols_region)) + (direct > own ? direct : own);
 }
 
 /* ---- rows of a wall's lines in each column ------------------------------------------- */
@@ -123,7 +133,7 @@ static void quad_rows(cols_state *S, view_pt pa, view_pt pb, int32_t hb, int32_t
 /* ---- drawing ----------------------------------------------------------------------- */
 
 /* Rows [y0, y1) of column x in a paint, counted as the byte writes they are. */
-static void draw_column(const cols_state *S, int x, int y0, int y1, const tex_paint *paint, uint32_t id)
+static void put_column(const cols_state *S, int x, int y0, int y1, const tex_paint *paint, uint32_t id)
 {
     if (y0 >= y1) return;
     const rast_target *t = S->t;
@@ -154,6 +164,18 @@ static void draw_column(const cols_state *S, int x, int y0, int y1, const tex_pa
         for (int y = y0; y < y1; y++) t->ids[y * VIEW_W + x] = id;
 }
 
+/* put_column, leaving out the rows objects may cover. */
+static void draw_column(const cols_state *S, int x, int y0, int y1, const tex_paint *paint, uint32_t id)
+{
+    const cols_region *r = S->objs;
+    if (!r || r->top[x] >= r->bot[x] || r->top[x] >= y1 || r->bot[x] <= y0) {
+        put_column(S, x, y0, y1, paint, id);
+        return;
+    }
+    put_column(S, x, y0, r->top[x], paint, id);
+    put_column(S, x, r->bot[x], y1, paint, id);
+}
+
 static tex_paint plane_paint(const cols_state *S, const cols_plane *p)
 {
     const scn_sector *sec = &S->sc->sectors[p->sector];
@@ -169,9 +191,18 @@ static tex_paint plane_paint(const cols_state *S, const cols_plane *p)
     return tex_flat(colour);
 }
 
+/* A row span of a floor or ceiling, leaving out the pixels objects may cover. */
+static inline void plane_span(cols_state *S, int y, int x0, int x1, const tex_paint *paint, uint32_t id)
+{
+    if (S->objs)
+        cov_fill(&S->cov, S->t, y, x0, x1, 0, paint, id);
+    else
+        rast_span(S->t, y, x0, x1, paint, id);
+}
+
 /* A visplane's column runs as row spans (Doom's R_MakeSpans): a row's span
  * starts where the row enters the columns' runs and ends where it leaves. */
-static void draw_plane(const cols_state *S, const cols_plane *p)
+static void draw_plane(cols_state *S, const cols_plane *p)
 {
     if (p->minx > p->maxx) return;
     tex_paint paint = plane_paint(S, p);
@@ -184,8 +215,8 @@ static void draw_plane(const cols_state *S, const cols_plane *p)
             t2 = p->top[x];
             b2 = p->bottom[x];
         }
-        for (int y = t1; y < b1 && y < t2; y++) rast_span(S->t, y, start[y], x, &paint, id);
-        for (int y = b2 > t1 ? b2 : t1; y < b1; y++) rast_span(S->t, y, start[y], x, &paint, id);
+        for (int y = t1; y < b1 && y < t2; y++) plane_span(S, y, start[y], x, &paint, id);
+        for (int y = b2 > t1 ? b2 : t1; y < b1; y++) plane_span(S, y, start[y], x, &paint, id);
         for (int y = t2; y < b2 && y < t1; y++) start[y] = (int16_t)x;
         for (int y = b1 > t2 ? b1 : t2; y < b2; y++) start[y] = (int16_t)x;
         t1 = t2;
@@ -364,33 +395,68 @@ static int visit_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
 
 /* ---- the frame ---------------------------------------------------------------------- */
 
-/* Frames this mode cannot draw exactly: an eye outside the world (a wall may then
- * be seen from behind and columns do not close), or objects in view. */
-static int needs_direct(const scene *sc, const world_state *w, const view_xform *v)
+/* The objects in view and the pixels they may cover (cols_region): 0 if none
+ * is in view, 1 if some are, -1 if one reaches past the near plane, where its
+ * pixels have no bound. */
+static int objects_region(const scene *sc, const world_state *w, const view_xform *v, cols_region *r)
 {
-    if (!eye_in_world(sc, w, v)) return 1;
-    if (CFG_OBJECTS && w && w->objs)
-        for (uint32_t i = 0; i < w->n; i++)
-            if (w->objs[i].model < sc->nmodels && objd_in_view(sc, &w->objs[i], v)) return 1;
-    return 0;
+    int any = 0;
+    for (int x = 0; x < VIEW_W; x++) {
+        r->top[x] = VIEW_H;
+        r->bot[x] = 0;
+    }
+    if (!CFG_OBJECTS || !w || !w->objs) return 0;
+    for (uint32_t i = 0; i < w->n; i++) {
+        const obj_state *o = &w->objs[i];
+        int x0, x1, y0, y1;
+        if (o->model >= sc->nmodels || !objd_in_view(sc, o, v)) continue;
+        int got = objd_screen_box(sc, o, v, &x0, &x1, &y0, &y1);
+        if (got == 0) return -1;
+        if (got < 0) continue;
+        x0 = x0 < 0 ? 0 : x0;
+        x1 = x1 > VIEW_W ? VIEW_W : x1;
+        y0 = clamp_row(y0);
+        y1 = clamp_row(y1);
+        if (x0 >= x1 || y0 >= y1) continue;
+        any = 1;
+        for (int x = x0; x < x1; x++) { /* a column keeps one run: the rows of every box over it, and between */
+            if (y0 < r->top[x]) r->top[x] = (uint8_t)y0;
+            if (y1 > r->bot[x]) r->bot[x] = (uint8_t)y1;
+        }
+    }
+    return any;
 }
 
 void cols_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t, render_stats *st,
                  void *work, uint32_t work_bytes)
 {
     uint32_t need = cols_work_bytes(sc, w);
-    if (!work || need == 0 || work_bytes < need || needs_direct(sc, w, v)) {
+    uint8_t *mem = work;
+    cols_region *region = work;
+    int objects = 0;
+    if (!work || need == 0 || work_bytes < need || !eye_in_world(sc, w, v) ||
+        (objects = objects_region(sc, w, v, region)) < 0) {
+        /* an eye outside the world may see a wall from behind, and columns do not close */
         st->fallback = work && need && work_bytes >= need;
         direct_render(sc, w, v, t, st, work, work_bytes);
         return;
     }
-    cols_state *S = work;
+    mem += align8(sizeof(cols_region));
+    uint32_t nodes = 0, culled = 0;
+    if (objects) { /* the objects and the world about them, exactly, by mode direct */
+        direct_render_within(sc, w, v, t, st, mem, work_bytes - align8(sizeof(cols_region)), region->top, region->bot);
+        nodes = st->nodes;
+        culled = st->boxes_culled;
+    }
+    cols_state *S = (cols_state *)(void *)mem;
     S->sc = sc;
     S->v = v;
     S->t = t;
     S->st = st;
     S->ceil = w ? w->ceil : 0;
     S->textured = CFG_TEXTURES && sc->look && !t->flat;
+    S->objs = objects ? region : 0;
+    if (objects) cov_columns(&S->cov, region->top, region->bot, 0);
     S->nplanes = 0;
     occ_reset(&S->occ);
     for (int c = 0; c < VIEW_W; c++) {
@@ -399,8 +465,8 @@ void cols_render(const scene *sc, const world_state *w, const view_xform *v, con
     }
     walk_stats ws;
     walk_tree(sc, v, WALK_FRONT_TO_BACK, visit_leaf, S, &S->occ, &ws);
-    st->nodes = ws.nodes;
-    st->boxes_culled = ws.boxes_culled + ws.boxes_hidden;
+    st->nodes = nodes + ws.nodes;
+    st->boxes_culled = culled + ws.boxes_culled + ws.boxes_hidden;
     flush_planes(S);
     tex_paint background = tex_flat(BACKGROUND_COLOUR);
     for (int c = 0; c < VIEW_W; c++) /* what no wall's column reached: the background */

@@ -12,6 +12,21 @@ void cov_clear(cov_mask *m)
     m->full_rows = 0;
 }
 
+void cov_columns(cov_mask *m, const uint8_t *top, const uint8_t *bot, int inside)
+{
+    for (int y = 0; y < VIEW_H; y++)
+        for (int i = 0; i < COV_WORDS; i++) m->bits[y][i] = inside ? 0xFFFFFFFFu : 0;
+    for (int x = 0; x < VIEW_W; x++)
+        for (int y = top[x]; y < bot[x]; y++) m->bits[y][x >> 5] ^= 1u << (x & 31);
+    m->full_rows = 0;
+    for (int y = 0; y < VIEW_H; y++) {
+        uint16_t open = 0;
+        for (int i = 0; i < COV_WORDS; i++) open |= (uint16_t)((m->bits[y][i] != 0xFFFFFFFFu) << i);
+        m->open[y] = open;
+        m->full_rows += open == 0;
+    }
+}
+
 /* The first pixel in [x, x1) whose bit, xor flip, is set; x1 if none. */
 static int next_bit(const uint32_t *row, int x, int x1, uint32_t flip)
 {

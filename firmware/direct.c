@@ -268,36 +268,14 @@ static void activate(dr_state *S, dr_obj *o)
 
 /* ---- objects against the leaves ---------------------------------------------------- */
 
-/* Is the object wholly behind what is drawn already? Its box (origin +- its
- * radius, its model's heights) projected: drawn pixels stay drawn, so such an
- * object can never show and is never set up. */
+/* Is the object wholly behind what is drawn already? Drawn pixels stay drawn,
+ * so such an object can never show and is never set up. */
 static int object_hidden(const dr_state *S, const obj_state *os)
 {
-    const scn_model *m = &S->sc->models[os->model];
-    int32_t zlo = INT32_MAX, zhi = INT32_MIN;
-    for (uint32_t i = 0; i < m->num_verts; i++) {
-        int32_t z = S->sc->mverts[m->first_vert + i].z;
-        if (z < zlo) zlo = z;
-        if (z > zhi) zhi = z;
-    }
-    if (zlo > zhi) return 1;
-    int64_t r = m->radius, x0 = (int64_t)os->x - r, x1 = (int64_t)os->x + r, y0 = (int64_t)os->y - r,
-            y1 = (int64_t)os->y + r;
-    if (x0 < INT32_MIN || x1 > INT32_MAX || y0 < INT32_MIN || y1 > INT32_MAX) return 0; /* at the box's edge: no test */
-    int32_t xs[2] = {(int32_t)x0, (int32_t)x1}, ys[2] = {(int32_t)y0, (int32_t)y1};
-    int32_t zs[2] = {os->z + zlo, os->z + zhi};
-    int32_t xmin = INT32_MAX, xmax = INT32_MIN, ymin = INT32_MAX, ymax = INT32_MIN;
-    for (int c = 0; c < 8; c++) {
-        view_pt p = view_point(S->v, xs[c & 1], ys[(c >> 1) & 1], zs[c >> 2]);
-        if (p.z < VIEW_ZNEAR) return 0; /* reaches past the near plane: no bound this way */
-        screen_pt q = view_project(S->v, p);
-        if (q.x < xmin) xmin = q.x;
-        if (q.x > xmax) xmax = q.x;
-        if (q.y < ymin) ymin = q.y;
-        if (q.y > ymax) ymax = q.y;
-    }
-    return cov_box_covered(&S->cov, rast_first_sample(ymin) - 1, rast_first_sample(ymax) + 1,
-                           rast_first_sample(xmin) - 1, rast_first_sample(xmax) + 1);
+    int x0, x1, y0, y1;
+    int r = objd_screen_box(S->sc, os, S->v, &x0, &x1, &y0, &y1);
+    if (r < 0) return 1;
+    return r && cov_box_covered(&S->cov, y0, y1, x0, x1);
 }
 
 /* The first object in the list whose box's west edge is at or east of x. */
@@ -591,6 +569,12 @@ static void list_objects_in_view(dr_state *S)
 void direct_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t, render_stats *st,
                    void *work, uint32_t work_bytes)
 {
+    direct_render_within(sc, w, v, t, st, work, work_bytes, 0, 0);
+}
+
+void direct_render_within(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t,
+                          render_stats *st, void *work, uint32_t work_bytes, const uint8_t *top, const uint8_t *bot)
+{
     uint32_t need = direct_work_bytes(sc, w);
     if (!work || need == 0 || work_bytes < need) {
         st->refused = 1; /* the caller did not provide the memory this frame needs */
@@ -618,14 +602,20 @@ void direct_render(const scene *sc, const world_state *w, const view_xform *v, c
     S->sink.hidden = box_hidden;
     S->sink.ctx = S;
     S->sink.flat = t->flat;
-    cov_clear(&S->cov);
+    walk_stats ws;
     occ_reset(&S->occ);
+    if (top) { /* only the given rows: the rest counts as drawn, columns with none as closed */
+        cov_columns(&S->cov, top, bot, 1);
+        for (int x = 0; x < VIEW_W; x++)
+            if (top[x] >= bot[x]) occ_close(&S->occ, x, x + 1);
+    } else {
+        cov_clear(&S->cov);
+    }
     list_objects_in_view(S);
     st->object_pass = S->nobjs != 0;
     /* solid walls close columns only for an eye inside the world (spans.c says why) */
     S->use_occ = eye_in_world(sc, w, v);
-    walk_stats ws;
-    walk_tree(sc, v, WALK_FRONT_TO_BACK, visit_leaf, S, S->use_occ ? &S->occ : 0, &ws);
+    walk_tree(sc, v, WALK_FRONT_TO_BACK, visit_leaf, S, (S->use_occ || top) ? &S->occ : 0, &ws);
     st->nodes = ws.nodes;
     st->boxes_culled = ws.boxes_culled + ws.boxes_hidden;
     if (CFG_OBJECTS && S->nactive) draw_objects(S);

@@ -41,4 +41,10 @@ uint32_t direct_work_bytes(const scene *s, const world_state *w);
 void direct_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t, render_stats *st,
                    void *work, uint32_t work_bytes);
 
+/* direct_render drawing only rows [top[x], bot[x]) of each column x (bot[x] <=
+ * 200): the pixels elsewhere are left as they are, and columns with no such row
+ * are not walked. Mode columns gives it the pixels objects may cover. */
+void direct_render_within(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t,
+                          render_stats *st, void *work, uint32_t work_bytes, const uint8_t *top, const uint8_t *bot);
+
 #endif

@@ -9,6 +9,8 @@
  * with 2.30 sine and cosine), a view coordinate below 2^30.53 raw (18.14), and a
  * height difference below 33,790 units (2^31.04 raw 16.16). */
 #include "obj_draw.h"
+
+#include "raster.h"
 #include "wide128.h"
 
 _Static_assert(!CFG_OBJECTS || CFG_FACE_VERTS + 5 <= CLIP_MAX_VERTS, "a clipped face must fit a clip_poly");
@@ -275,4 +277,36 @@ int objd_face_screen(const scene *s, const scn_model *m, uint32_t f, const view_
     if (!clip_polygon(&p, v, CLIP_ALL)) return 0;
     clip_project(v, &p, out);
     return p.n;
+}
+
+int objd_screen_box(const scene *s, const obj_state *os, const view_xform *v, int *x0, int *x1, int *y0, int *y1)
+{
+    const scn_model *m = &s->models[os->model];
+    int32_t zlo = INT32_MAX, zhi = INT32_MIN;
+    for (uint32_t i = 0; i < m->num_verts; i++) {
+        int32_t z = s->mverts[m->first_vert + i].z;
+        if (z < zlo) zlo = z;
+        if (z > zhi) zhi = z;
+    }
+    if (zlo > zhi) return -1;
+    int64_t r = m->radius, bx0 = (int64_t)os->x - r, bx1 = (int64_t)os->x + r, by0 = (int64_t)os->y - r,
+            by1 = (int64_t)os->y + r;
+    if (bx0 < INT32_MIN || bx1 > INT32_MAX || by0 < INT32_MIN || by1 > INT32_MAX) return 0; /* at the box's edge */
+    int32_t xs[2] = {(int32_t)bx0, (int32_t)bx1}, ys[2] = {(int32_t)by0, (int32_t)by1};
+    int32_t zs[2] = {os->z + zlo, os->z + zhi};
+    int32_t xmin = INT32_MAX, xmax = INT32_MIN, ymin = INT32_MAX, ymax = INT32_MIN;
+    for (int c = 0; c < 8; c++) {
+        view_pt p = view_point(v, xs[c & 1], ys[(c >> 1) & 1], zs[c >> 2]);
+        if (p.z < VIEW_ZNEAR) return 0; /* reaches past the near plane: no bound this way */
+        screen_pt q = view_project(v, p);
+        if (q.x < xmin) xmin = q.x;
+        if (q.x > xmax) xmax = q.x;
+        if (q.y < ymin) ymin = q.y;
+        if (q.y > ymax) ymax = q.y;
+    }
+    *x0 = rast_first_sample(xmin) - 1;
+    *x1 = rast_first_sample(xmax) + 1;
+    *y0 = rast_first_sample(ymin) - 1;
+    *y1 = rast_first_sample(ymax) + 1;
+    return 1;
 }

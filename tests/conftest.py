@@ -18,7 +18,7 @@ BUILD = ROOT / "build"
 SAN = Path(os.environ.get("BSPVGA_BIN", BUILD / "san"))
 WADDIR = Path(os.environ.get("DOOMWADDIR", "/usr/share/games/doom"))
 # Every render mode of build/render --mode, in one place: tests that run each mode take them from here.
-RENDER_MODES = ["direct", "spans", "painter"]
+RENDER_MODES = ["direct", "spans", "painter", "columns"]
 
 SAN_ENV = dict(os.environ, ASAN_OPTIONS="detect_leaks=1:abort_on_error=0",
                UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1")
