@@ -8,6 +8,7 @@
 #include "direct.h"
 #include "eye.h"
 #include "obj_draw.h"
+#include "obj_list.h"
 #include "surfaces.h"
 
 #define BACKGROUND_COLOUR 0
@@ -24,11 +25,22 @@ typedef struct {
 
 enum { ROW_CEIL, ROW_FLOOR, ROW_LOW, ROW_HIGH, ROW_UNUSED, ROW_LINES }; /* ROW_UNUSED: a chain not needed */
 
-/* The pixels objects may cover, which mode direct draws: rows [top[x], bot[x])
- * of each column x (empty where top >= bot). */
+/* The pixels objects may show in, which mode direct draws after the walk: the
+ * rows still open in each column of an object's screen box when the walk
+ * reaches the first leaf its box touches. The world drawn before is in front of
+ * it (the tree's order, as in mode direct); what is left open there is the
+ * objects' and direct's. */
 typedef struct {
-    uint8_t top[VIEW_W], bot[VIEW_W];
+    cov_mask mask;                    /* set: left to direct */
+    uint8_t top[VIEW_W], bot[VIEW_W]; /* the rows of each column the mask may have set in, [top, bot) */
+    uint8_t row_any[VIEW_H];          /* the rows it has set in */
+    uint8_t any;
 } cols_region;
+
+typedef struct {
+    objl_entry e;
+    uint8_t active; /* its first leaf is behind: looked at once */
+} cols_obj;
 
 typedef struct {
     const scene *sc;
@@ -40,8 +52,11 @@ typedef struct {
     occ_columns occ;                            /* columns with no row open */
     uint8_t open_top[VIEW_W], open_bot[VIEW_W]; /* rows [top, bot) of each column still open */
     int16_t rows[ROW_LINES][VIEW_W];            /* the seg in hand: where its lines cross each column */
-    const cols_region *objs;                    /* NULL: no object in view */
-    cov_mask cov; /* with objs: set where they may show, so that floors and ceilings leave it */
+    cols_region *region;                        /* what is left to the objects */
+    const world_state *w;
+    cols_obj *objs; /* the objects in view, by west edge (obj_list.h) */
+    uint32_t nobjs;
+    int32_t reach;
     uint32_t nplanes;
     cols_plane planes[CFG_COLS_PLANES];
 } cols_state;
@@ -51,12 +66,20 @@ static uint32_t align8(uint64_t n)
     return (uint32_t)((n + 7u) & ~(uint64_t)7u);
 }
 
-/* The work memory: the objects' region, then this mode's state or direct's. */
+static uint32_t object_count(const world_state *w)
+{
+    return (CFG_OBJECTS && w && w->objs) ? w->n : 0;
+}
+
+/* The work memory: the objects' region, then this mode's state and its list of
+ * objects, or direct's. */
 uint32_t cols_work_bytes(const scene *s, const world_state *w)
 {
-    uint32_t direct = direct_work_bytes(s, w), own = align8(sizeof(cols_state));
-    if (direct == 0 || direct > 0xFFFFF000u) return 0;
-    return align8(sizeof(cols_region)) + (direct > own ? direct : own);
+    uint64_t direct = direct_work_bytes(s, w), own = align8(sizeof(cols_state));
+    if (direct == 0) return 0;
+    own += align8((uint64_t)object_count(w) * sizeof(cols_obj));
+    uint64_t total = align8(sizeof(cols_region)) + (direct > own ? direct : own);
+    return total > 0xFFFFFFF0u ? 0 : (uint32_t)total;
 }
 
 /* ---- rows of a wall's lines in each column ------------------------------------------- */
@@ -164,16 +187,23 @@ static void put_column(const cols_state *S, int x, int y0, int y1, const tex_pai
         for (int y = y0; y < y1; y++) t->ids[y * VIEW_W + x] = id;
 }
 
-/* put_column, leaving out the rows objects may cover. */
+/* put_column, leaving out the pixels left to the objects. */
 static void draw_column(const cols_state *S, int x, int y0, int y1, const tex_paint *paint, uint32_t id)
 {
-    const cols_region *r = S->objs;
-    if (!r || r->top[x] >= r->bot[x] || r->top[x] >= y1 || r->bot[x] <= y0) {
+    const cols_region *r = S->region;
+    if (!r->any || r->top[x] >= y1 || r->bot[x] <= y0) {
         put_column(S, x, y0, y1, paint, id);
         return;
     }
-    put_column(S, x, y0, r->top[x], paint, id);
-    put_column(S, x, r->bot[x], y1, paint, id);
+    uint32_t bit = 1u << (x & 31);
+    int w = x >> 5;
+    for (int y = y0; y < y1;) {
+        int end = y;
+        while (end < y1 && !(r->mask.bits[end][w] & bit)) end++;
+        put_column(S, x, y, end, paint, id);
+        while (end < y1 && (r->mask.bits[end][w] & bit)) end++;
+        y = end;
+    }
 }
 
 static tex_paint plane_paint(const cols_state *S, const cols_plane *p)
@@ -194,10 +224,17 @@ static tex_paint plane_paint(const cols_state *S, const cols_plane *p)
 /* A row span of a floor or ceiling, leaving out the pixels objects may cover. */
 static inline void plane_span(cols_state *S, int y, int x0, int x1, const tex_paint *paint, uint32_t id)
 {
-    if (S->objs)
-        cov_fill(&S->cov, S->t, y, x0, x1, 0, paint, id);
-    else
+    const cols_region *r = S->region;
+    if (!r->row_any[y]) {
         rast_span(S->t, y, x0, x1, paint, id);
+        return;
+    }
+    const cov_mask *m = &r->mask;
+    for (int x = cov_next_clear(m, y, x0, x1); x < x1;) {
+        int end = cov_next_set(m, y, x, x1);
+        rast_span(S->t, y, x, end, paint, id);
+        x = cov_next_clear(m, y, end, x1);
+    }
 }
 
 /* A visplane's column runs as row spans (Doom's R_MakeSpans): a row's span
@@ -384,79 +421,101 @@ static void seg(cols_state *S, uint32_t gi, unsigned mask)
     seg_columns(S, &k, c0, c1);
 }
 
+/* An object whose box touches the leaf the walk has reached takes the rows
+ * still open in its screen box (all of them, if its box reaches past the near
+ * plane and has no screen bound). */
+static void take_object(cols_state *S, const obj_state *o)
+{
+    int x0, x1, y0, y1;
+    int got = objd_screen_box(S->sc, o, S->v, &x0, &x1, &y0, &y1);
+    if (got < 0) return;
+    if (got == 0) {
+        x0 = y0 = 0;
+        x1 = VIEW_W;
+        y1 = VIEW_H;
+    }
+    cols_region *r = S->region;
+    x0 = x0 < 0 ? 0 : x0;
+    x1 = x1 > VIEW_W ? VIEW_W : x1;
+    for (int x = x0; x < x1; x++) {
+        int a = y0 > S->open_top[x] ? y0 : S->open_top[x], b = y1 < S->open_bot[x] ? y1 : S->open_bot[x];
+        if (a >= b) continue;
+        uint32_t bit = 1u << (x & 31);
+        for (int y = a; y < b; y++) {
+            r->mask.bits[y][x >> 5] |= bit;
+            r->row_any[y] = 1;
+        }
+        if (a < r->top[x]) r->top[x] = (uint8_t)a;
+        if (b > r->bot[x]) r->bot[x] = (uint8_t)b;
+        r->any = 1;
+    }
+}
+
+static void objects_in_leaf(cols_state *S, uint32_t leaf)
+{
+    const scn_leaf *f = &S->sc->leaves[leaf];
+    int32_t box[BOX_SIDES];
+    uint32_t i;
+    objd_leaf_box(S->sc, f, box);
+    for (uint32_t end = objl_near_leaf(S->objs, S->nobjs, sizeof(cols_obj), box, S->reach, &i); i < end; i++) {
+        cols_obj *o = &S->objs[i];
+        const obj_state *os = &S->w->objs[o->e.index];
+        if (o->active || !objd_touches_leaf(S->sc, os, f, box)) continue;
+        o->active = 1;
+        take_object(S, os);
+    }
+}
+
 static int visit_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
 {
     cols_state *S = ctx;
     const scn_leaf *f = &S->sc->leaves[leaf];
     S->st->leaves++;
+    if (S->nobjs) objects_in_leaf(S, leaf);
     for (uint32_t i = 0; i < f->num_segs && !occ_full(&S->occ); i++) seg(S, f->first_seg + i, clip_mask);
     return occ_full(&S->occ);
 }
 
 /* ---- the frame ---------------------------------------------------------------------- */
 
-/* The objects in view and the pixels they may cover (cols_region): 0 if none
- * is in view, 1 if some are, -1 if one reaches past the near plane, where its
- * pixels have no bound. */
-static int objects_region(const scene *sc, const world_state *w, const view_xform *v, cols_region *r)
+static void region_clear(cols_region *r)
 {
-    int any = 0;
+    for (int y = 0; y < VIEW_H; y++) {
+        for (int i = 0; i < COV_WORDS; i++) r->mask.bits[y][i] = 0;
+        r->row_any[y] = 0;
+    }
     for (int x = 0; x < VIEW_W; x++) {
         r->top[x] = VIEW_H;
         r->bot[x] = 0;
     }
-    if (!CFG_OBJECTS || !w || !w->objs) return 0;
-    for (uint32_t i = 0; i < w->n; i++) {
-        const obj_state *o = &w->objs[i];
-        int x0, x1, y0, y1;
-        if (o->model >= sc->nmodels || !objd_in_view(sc, o, v)) continue;
-        int got = objd_screen_box(sc, o, v, &x0, &x1, &y0, &y1);
-        if (got == 0) return -1;
-        if (got < 0) continue;
-        x0 = x0 < 0 ? 0 : x0;
-        x1 = x1 > VIEW_W ? VIEW_W : x1;
-        y0 = clamp_row(y0);
-        y1 = clamp_row(y1);
-        if (x0 >= x1 || y0 >= y1) continue;
-        any = 1;
-        for (int x = x0; x < x1; x++) { /* a column keeps one run: the rows of every box over it, and between */
-            if (y0 < r->top[x]) r->top[x] = (uint8_t)y0;
-            if (y1 > r->bot[x]) r->bot[x] = (uint8_t)y1;
-        }
-    }
-    return any;
+    r->any = 0;
 }
 
 void cols_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t, render_stats *st,
                  void *work, uint32_t work_bytes)
 {
     uint32_t need = cols_work_bytes(sc, w);
-    uint8_t *mem = work;
-    cols_region *region = work;
-    int objects = 0;
-    if (!work || need == 0 || work_bytes < need || !eye_in_world(sc, w, v) ||
-        (objects = objects_region(sc, w, v, region)) < 0) {
+    if (!work || need == 0 || work_bytes < need || !eye_in_world(sc, w, v)) {
         /* an eye outside the world may see a wall from behind, and columns do not close */
         st->fallback = work && need && work_bytes >= need;
         direct_render(sc, w, v, t, st, work, work_bytes);
         return;
     }
+    uint8_t *mem = work;
+    cols_region *region = work;
     mem += align8(sizeof(cols_region));
-    uint32_t nodes = 0, culled = 0;
-    if (objects) { /* the objects and the world about them, exactly, by mode direct */
-        direct_render_within(sc, w, v, t, st, mem, work_bytes - align8(sizeof(cols_region)), region->top, region->bot);
-        nodes = st->nodes;
-        culled = st->boxes_culled;
-    }
     cols_state *S = (cols_state *)(void *)mem;
     S->sc = sc;
+    S->w = w;
     S->v = v;
     S->t = t;
     S->st = st;
     S->ceil = w ? w->ceil : 0;
     S->textured = CFG_TEXTURES && sc->look && !t->flat;
-    S->objs = objects ? region : 0;
-    if (objects) cov_columns(&S->cov, region->top, region->bot, 0);
+    S->region = region;
+    region_clear(region);
+    S->objs = (cols_obj *)(void *)(mem + align8(sizeof(cols_state)));
+    S->nobjs = objl_in_view(sc, w, v, S->objs, sizeof(cols_obj), &S->reach);
     S->nplanes = 0;
     occ_reset(&S->occ);
     for (int c = 0; c < VIEW_W; c++) {
@@ -465,10 +524,13 @@ void cols_render(const scene *sc, const world_state *w, const view_xform *v, con
     }
     walk_stats ws;
     walk_tree(sc, v, WALK_FRONT_TO_BACK, visit_leaf, S, &S->occ, &ws);
-    st->nodes = nodes + ws.nodes;
-    st->boxes_culled = culled + ws.boxes_culled + ws.boxes_hidden;
     flush_planes(S);
     tex_paint background = tex_flat(BACKGROUND_COLOUR);
     for (int c = 0; c < VIEW_W; c++) /* what no wall's column reached: the background */
         draw_column(S, c, S->open_top[c], S->open_bot[c], &background, RAST_ID(RAST_KIND_NONE, 0));
+    uint32_t nodes = ws.nodes, culled = ws.boxes_culled + ws.boxes_hidden;
+    if (region->any) /* the objects and the world about them, exactly, by mode direct */
+        direct_render_within(sc, w, v, t, st, mem, work_bytes - align8(sizeof(cols_region)), &region->mask);
+    st->nodes += nodes;
+    st->boxes_culled += culled;
 }

@@ -12,18 +12,17 @@ void cov_clear(cov_mask *m)
     m->full_rows = 0;
 }
 
-void cov_columns(cov_mask *m, const uint8_t *top, const uint8_t *bot, int inside)
+void cov_complement(cov_mask *dst, const cov_mask *src)
 {
-    for (int y = 0; y < VIEW_H; y++)
-        for (int i = 0; i < COV_WORDS; i++) m->bits[y][i] = inside ? 0xFFFFFFFFu : 0;
-    for (int x = 0; x < VIEW_W; x++)
-        for (int y = top[x]; y < bot[x]; y++) m->bits[y][x >> 5] ^= 1u << (x & 31);
-    m->full_rows = 0;
+    dst->full_rows = 0;
     for (int y = 0; y < VIEW_H; y++) {
         uint16_t open = 0;
-        for (int i = 0; i < COV_WORDS; i++) open |= (uint16_t)((m->bits[y][i] != 0xFFFFFFFFu) << i);
-        m->open[y] = open;
-        m->full_rows += open == 0;
+        for (int i = 0; i < COV_WORDS; i++) {
+            dst->bits[y][i] = ~src->bits[y][i];
+            open |= (uint16_t)((src->bits[y][i] != 0) << i);
+        }
+        dst->open[y] = open;
+        dst->full_rows += open == 0;
     }
 }
 

@@ -24,9 +24,8 @@ typedef struct {
 
 void cov_clear(cov_mask *m);
 
-/* A mask set by columns: with inside 0, set exactly in rows [top[x], bot[x]) of
- * each column x (bot[x] <= 200); with inside 1, everywhere else. */
-void cov_columns(cov_mask *m, const uint8_t *top, const uint8_t *bot, int inside);
+/* dst set exactly where src is clear. */
+void cov_complement(cov_mask *dst, const cov_mask *src);
 
 /* A run touches its two end words bit by bit; the words between are whole, so
  * they are set, and tested, through the row's word summary (open) alone. */

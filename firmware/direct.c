@@ -6,6 +6,7 @@
 #include "cover.h"
 #include "eye.h"
 #include "obj_draw.h"
+#include "obj_list.h"
 #include "surfaces.h"
 
 #define BACKGROUND_COLOUR 0
@@ -35,8 +36,7 @@ typedef struct {
 } dr_face;
 
 typedef struct {
-    int32_t left;    /* west edge of its box, whole units (the list is sorted by it) */
-    uint16_t index;  /* the object (its id; SCN_MAX_OBJECTS fits) */
+    objl_entry e;    /* the object and the west edge of its box (obj_list.h: the list is sorted by it) */
     uint16_t x0, x1; /* screen box of its faces: pixels [x0, x1) x [y0, y1) */
     uint8_t y0, y1;
     uint16_t first_face; /* stored: its faces in the pool */
@@ -44,7 +44,7 @@ typedef struct {
     uint8_t active : 1, stored : 1, drew : 1;
 } dr_obj;
 
-_Static_assert(SCN_MAX_OBJECTS <= 65536 && SCN_MAX_MODEL_FACES <= 255 && VIEW_H <= 255, "dr_obj's fields");
+_Static_assert(SCN_MAX_MODEL_FACES <= 255 && VIEW_H <= 255, "dr_obj's fields");
 
 typedef struct {
     const scene *sc;
@@ -130,7 +130,7 @@ static int face_build(const dr_state *S, const dr_obj *o, const view_pt *verts, 
                       screen_pt box[2])
 {
     const scene *sc = S->sc;
-    const scn_model *m = &sc->models[S->w->objs[o->index].model];
+    const scn_model *m = &sc->models[S->w->objs[o->e.index].model];
     screen_pt pts[CLIP_MAX_VERTS];
     if (!objd_face_plane(sc, m, fi, verts, &f->pl)) return 0;
     int n = objd_face_screen(sc, m, fi, verts, S->v, pts);
@@ -163,7 +163,7 @@ static int face_build(const dr_state *S, const dr_obj *o, const view_pt *verts, 
         if (verts[ix[k]].z > f->zmax) f->zmax = verts[ix[k]].z;
     }
     f->colour = sc->faces[fi].colour;
-    f->obj = o->index;
+    f->obj = o->e.index;
     f->model_face = fi;
     return 1;
 }
@@ -182,10 +182,10 @@ static void each_face(dr_state *S, dr_obj *o, face_visit visit, void *ctx)
         return;
     }
     const scene *sc = S->sc;
-    const scn_model *m = &sc->models[S->w->objs[o->index].model];
+    const scn_model *m = &sc->models[S->w->objs[o->e.index].model];
     view_pt verts[CFG_MODEL_VERTS];
     screen_pt box[2];
-    objd_transform(sc, &S->w->objs[o->index], S->v, verts);
+    objd_transform(sc, &S->w->objs[o->e.index], S->v, verts);
     for (uint32_t fi = m->first_face; fi < m->first_face + m->num_faces; fi++)
         if (face_build(S, o, verts, fi, &S->scratch_face, S->scratch_edges, box))
             visit(S, o, &S->scratch_face, S->scratch_edges, ctx);
@@ -226,11 +226,11 @@ static void reclaim(dr_state *S)
 static void activate(dr_state *S, dr_obj *o)
 {
     const scene *sc = S->sc;
-    const scn_model *m = &sc->models[S->w->objs[o->index].model];
+    const scn_model *m = &sc->models[S->w->objs[o->e.index].model];
     view_pt verts[CFG_MODEL_VERTS];
     screen_pt box[2] = {{INT32_MAX, INT32_MAX}, {INT32_MIN, INT32_MIN}};
     uint32_t nf = 0, ne = S->nedges, stored = 1;
-    objd_transform(sc, &S->w->objs[o->index], S->v, verts);
+    objd_transform(sc, &S->w->objs[o->e.index], S->v, verts);
     for (uint32_t fi = m->first_face; fi < m->first_face + m->num_faces; fi++) {
         dr_face *f = &S->scratch_face;
         if (!face_build(S, o, verts, fi, f, S->scratch_edges, box)) continue;
@@ -278,20 +278,6 @@ static int object_hidden(const dr_state *S, const obj_state *os)
     return r && cov_box_covered(&S->cov, y0, y1, x0, x1);
 }
 
-/* The first object in the list whose box's west edge is at or east of x. */
-static uint32_t first_at_or_east(const dr_state *S, int32_t x)
-{
-    uint32_t lo = 0, hi = S->nobjs;
-    while (lo < hi) {
-        uint32_t mid = lo + (hi - lo) / 2;
-        if (S->objs[mid].left < x)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo;
-}
-
 /* Objects whose box reaches into the leaf become active and are set up, unless
  * already hidden. Only the stretch of the list whose boxes can reach the leaf's
  * west-east extent is looked at. */
@@ -299,12 +285,11 @@ static void activate_objects_in(dr_state *S, uint32_t leaf)
 {
     const scn_leaf *f = &S->sc->leaves[leaf];
     int32_t box[BOX_SIDES];
+    uint32_t i;
     objd_leaf_box(S->sc, f, box);
-    if (box[BOX_LEFT] > box[BOX_RIGHT]) return;
-    int32_t west = (box[BOX_LEFT] >> 16) - 2 * S->reach - 1, east = box[BOX_RIGHT] >> 16;
-    for (uint32_t i = first_at_or_east(S, west); i < S->nobjs && S->objs[i].left <= east; i++) {
+    for (uint32_t end = objl_near_leaf(S->objs, S->nobjs, sizeof(dr_obj), box, S->reach, &i); i < end; i++) {
         dr_obj *o = &S->objs[i];
-        const obj_state *os = &S->w->objs[o->index];
+        const obj_state *os = &S->w->objs[o->e.index];
         if (o->active || !objd_touches_leaf(S->sc, os, f, box)) continue;
         o->active = 1; /* looked at once: hidden now stays hidden */
         if (object_hidden(S, os)) continue;
@@ -380,7 +365,7 @@ static void draw_face_row(dr_state *S, dr_obj *o, const dr_face *face, int y, in
         if (p->y0 <= y && p->y1 > y && p->x0 < b && p->x1 > a) each_face(S, p, keep_nearer_face, &k);
     }
     tex_paint paint = tex_flat(face->colour);
-    if (cov_fill(&S->cov, S->t, y, a, b, keep, &paint, RAST_ID(RAST_KIND_OBJECT, o->index)) && !o->drew) {
+    if (cov_fill(&S->cov, S->t, y, a, b, keep, &paint, RAST_ID(RAST_KIND_OBJECT, o->e.index)) && !o->drew) {
         o->drew = 1;
         S->st->objects_visible++;
     }
@@ -522,58 +507,35 @@ static int visit_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
 
 /* ---- the frame ---------------------------------------------------------------------- */
 
-/* Heap order on the west edges (in place: no memory beyond the list). */
-static void sift_down(dr_obj *a, uint32_t i, uint32_t n)
-{
-    for (;;) {
-        uint32_t c = 2 * i + 1;
-        if (c >= n) return;
-        if (c + 1 < n && a[c + 1].left > a[c].left) c++;
-        if (a[c].left <= a[i].left) return;
-        dr_obj t = a[i];
-        a[i] = a[c];
-        a[c] = t;
-        i = c;
-    }
-}
-
-static void sort_by_west_edge(dr_obj *a, uint32_t n)
-{
-    for (uint32_t i = n / 2; i-- > 0;) sift_down(a, i, n);
-    for (uint32_t end = n; end-- > 1;) {
-        dr_obj t = a[0];
-        a[0] = a[end];
-        a[end] = t;
-        sift_down(a, 0, end);
-    }
-}
-
 /* The objects in the view frustum, sorted by the west edges of their boxes. */
 static void list_objects_in_view(dr_state *S)
 {
-    const scene *sc = S->sc;
-    const world_state *w = S->w;
-    S->nobjs = S->nactive = S->nfaces = S->nedges = 0;
-    S->reach = 0;
-    if (!CFG_OBJECTS || !w || !w->objs) return;
-    for (uint32_t i = 0; i < w->n; i++) {
-        const obj_state *o = &w->objs[i];
-        if (o->model >= sc->nmodels || !objd_in_view(sc, o, S->v)) continue;
-        int32_t r = (sc->models[o->model].radius >> 16) + 1; /* whole units, rounded up */
-        if (r > S->reach) S->reach = r;
-        S->objs[S->nobjs++] = (dr_obj){.left = (int32_t)((o->x >> 16) - r), .index = (uint16_t)i};
-    }
-    sort_by_west_edge(S->objs, S->nobjs);
+    S->nactive = S->nfaces = S->nedges = 0;
+    S->nobjs = objl_in_view(S->sc, S->w, S->v, S->objs, sizeof(dr_obj), &S->reach);
 }
 
 void direct_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t, render_stats *st,
                    void *work, uint32_t work_bytes)
 {
-    direct_render_within(sc, w, v, t, st, work, work_bytes, 0, 0);
+    direct_render_within(sc, w, v, t, st, work, work_bytes, 0);
+}
+
+/* Columns where mask has no pixel set: closed. */
+static void close_empty_columns(occ_columns *occ, const cov_mask *mask)
+{
+    uint32_t any[COV_WORDS] = {0};
+    for (int y = 0; y < VIEW_H; y++)
+        for (int i = 0; i < COV_WORDS; i++) any[i] |= mask->bits[y][i];
+    for (int x = 0; x < VIEW_W;) {
+        int end = x;
+        while (end < VIEW_W && !((any[end >> 5] >> (end & 31)) & 1u)) end++;
+        if (end > x) occ_close(occ, x, end);
+        x = end + 1;
+    }
 }
 
 void direct_render_within(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t,
-                          render_stats *st, void *work, uint32_t work_bytes, const uint8_t *top, const uint8_t *bot)
+                          render_stats *st, void *work, uint32_t work_bytes, const cov_mask *only)
 {
     uint32_t need = direct_work_bytes(sc, w);
     if (!work || need == 0 || work_bytes < need) {
@@ -604,10 +566,9 @@ void direct_render_within(const scene *sc, const world_state *w, const view_xfor
     S->sink.flat = t->flat;
     walk_stats ws;
     occ_reset(&S->occ);
-    if (top) { /* only the given rows: the rest counts as drawn, columns with none as closed */
-        cov_columns(&S->cov, top, bot, 1);
-        for (int x = 0; x < VIEW_W; x++)
-            if (top[x] >= bot[x]) occ_close(&S->occ, x, x + 1);
+    if (only) { /* only these pixels: the rest counts as drawn, columns with none as closed */
+        cov_complement(&S->cov, only);
+        close_empty_columns(&S->occ, only);
     } else {
         cov_clear(&S->cov);
     }
@@ -615,7 +576,7 @@ void direct_render_within(const scene *sc, const world_state *w, const view_xfor
     st->object_pass = S->nobjs != 0;
     /* solid walls close columns only for an eye inside the world (spans.c says why) */
     S->use_occ = eye_in_world(sc, w, v);
-    walk_tree(sc, v, WALK_FRONT_TO_BACK, visit_leaf, S, (S->use_occ || top) ? &S->occ : 0, &ws);
+    walk_tree(sc, v, WALK_FRONT_TO_BACK, visit_leaf, S, (S->use_occ || only) ? &S->occ : 0, &ws);
     st->nodes = ws.nodes;
     st->boxes_culled = ws.boxes_culled + ws.boxes_hidden;
     if (CFG_OBJECTS && S->nactive) draw_objects(S);

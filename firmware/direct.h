@@ -29,6 +29,7 @@
 #define DIRECT_H
 
 #include <stdint.h>
+#include "cover.h"
 #include "objects.h"
 #include "raster.h"
 #include "render_stats.h"
@@ -41,10 +42,10 @@ uint32_t direct_work_bytes(const scene *s, const world_state *w);
 void direct_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t, render_stats *st,
                    void *work, uint32_t work_bytes);
 
-/* direct_render drawing only rows [top[x], bot[x]) of each column x (bot[x] <=
- * 200): the pixels elsewhere are left as they are, and columns with no such row
- * are not walked. Mode columns gives it the pixels objects may cover. */
+/* direct_render drawing only the pixels set in only: the others are left as
+ * they are, and columns with none are not walked. Mode columns gives it the
+ * pixels objects may cover. */
 void direct_render_within(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t,
-                          render_stats *st, void *work, uint32_t work_bytes, const uint8_t *top, const uint8_t *bot);
+                          render_stats *st, void *work, uint32_t work_bytes, const cov_mask *only);
 
 #endif

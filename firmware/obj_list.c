@@ -1,0 +1,71 @@
+/* obj_list.c - the objects in view by the west edges of their boxes (see obj_list.h). */
+#include "obj_list.h"
+
+#include "obj_draw.h"
+
+/* Swap two records, a byte at a time (they are a few words). */
+static void swap(void *list, uint32_t i, uint32_t j, uint32_t size)
+{
+    uint8_t *a = (uint8_t *)objl_at(list, i, size), *b = (uint8_t *)objl_at(list, j, size);
+    for (uint32_t k = 0; k < size; k++) {
+        uint8_t t = a[k];
+        a[k] = b[k];
+        b[k] = t;
+    }
+}
+
+/* Heap order on the west edges, in place: no memory beyond the list. */
+static void sift_down(void *list, uint32_t i, uint32_t n, uint32_t size)
+{
+    for (;;) {
+        uint32_t c = 2 * i + 1;
+        if (c >= n) return;
+        if (c + 1 < n && objl_at(list, c + 1, size)->left > objl_at(list, c, size)->left) c++;
+        if (objl_at(list, c, size)->left <= objl_at(list, i, size)->left) return;
+        swap(list, i, c, size);
+        i = c;
+    }
+}
+
+uint32_t objl_in_view(const scene *sc, const world_state *w, const view_xform *v, void *list, uint32_t size,
+                      int32_t *reach)
+{
+    uint32_t n = 0;
+    *reach = 0;
+    if (!CFG_OBJECTS || !w || !w->objs) return 0;
+    for (uint32_t i = 0; i < w->n; i++) {
+        const obj_state *o = &w->objs[i];
+        if (o->model >= sc->nmodels || !objd_in_view(sc, o, v)) continue;
+        int32_t r = (sc->models[o->model].radius >> 16) + 1; /* whole units, rounded up */
+        if (r > *reach) *reach = r;
+        uint8_t *rec = (uint8_t *)objl_at(list, n++, size);
+        for (uint32_t k = 0; k < size; k++) rec[k] = 0;
+        *(objl_entry *)(void *)rec = (objl_entry){(int32_t)((o->x >> 16) - r), (uint16_t)i};
+    }
+    for (uint32_t i = n / 2; i-- > 0;) sift_down(list, i, n, size);
+    for (uint32_t end = n; end-- > 1;) {
+        swap(list, 0, end, size);
+        sift_down(list, 0, end, size);
+    }
+    return n;
+}
+
+uint32_t objl_near_leaf(void *list, uint32_t n, uint32_t size, const int32_t box[BOX_SIDES], int32_t reach,
+                        uint32_t *first)
+{
+    *first = n;
+    if (box[BOX_LEFT] > box[BOX_RIGHT]) return n;
+    int32_t west = (box[BOX_LEFT] >> 16) - 2 * reach - 1, east = box[BOX_RIGHT] >> 16;
+    uint32_t lo = 0, hi = n; /* the first record whose west edge is at or east of west */
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (objl_at(list, mid, size)->left < west)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    uint32_t end = lo;
+    while (end < n && objl_at(list, end, size)->left <= east) end++;
+    *first = lo;
+    return end;
+}

@@ -1,0 +1,41 @@
+/* obj_list.h - the objects in view, sorted by the west edges of their boxes,
+ * and those whose boxes may reach a leaf (prefix objl_). The front-to-back
+ * modes take an object in at the first leaf of the walk its box touches
+ * (docs/objects.md); a leaf looks only at the stretch of the list whose boxes
+ * can reach its west-east extent.
+ *
+ * A mode keeps its own record per object: any struct whose first member is an
+ * objl_entry, in an array of records of `size` bytes. */
+#ifndef OBJ_LIST_H
+#define OBJ_LIST_H
+
+#include <stdint.h>
+#include "objects.h"
+#include "scene.h"
+#include "view.h"
+
+typedef struct {
+    int32_t left;   /* west edge of its box, whole units (the list is sorted by it) */
+    uint16_t index; /* the object (its id; SCN_MAX_OBJECTS fits) */
+} objl_entry;
+
+_Static_assert(SCN_MAX_OBJECTS <= 65536, "objl_entry.index");
+
+static inline objl_entry *objl_at(void *list, uint32_t i, uint32_t size)
+{
+    return (objl_entry *)(void *)((uint8_t *)list + (uint64_t)i * size);
+}
+
+/* The objects of w in the view frustum into list (records of size bytes, zero
+ * but for their objl_entry, room for w->n), sorted by west edge; returns how
+ * many. *reach: the widest box's half width in whole units (0 if none). */
+uint32_t objl_in_view(const scene *sc, const world_state *w, const view_xform *v, void *list, uint32_t size,
+                      int32_t *reach);
+
+/* The records of list[0 .. n) whose boxes may reach the leaf with box (objd_leaf_box's):
+ * [*first, n) up to the first whose west edge lies past the leaf's east edge,
+ * which is the end returned. Returns *first == end for an empty leaf box. */
+uint32_t objl_near_leaf(void *list, uint32_t n, uint32_t size, const int32_t box[BOX_SIDES], int32_t reach,
+                        uint32_t *first);
+
+#endif
