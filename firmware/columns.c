@@ -42,6 +42,8 @@ typedef struct {
     uint8_t active; /* its first leaf is behind: looked at once */
 } cols_obj;
 
+_Static_assert(sizeof(cols_obj) % 4 == 0, "obj_list.h: records of whole words");
+
 typedef struct {
     const scene *sc;
     const view_xform *v;

@@ -44,7 +44,7 @@ typedef struct {
     uint8_t active : 1, stored : 1, drew : 1;
 } dr_obj;
 
-_Static_assert(SCN_MAX_MODEL_FACES <= 255 && VIEW_H <= 255, "dr_obj's fields");
+_Static_assert(SCN_MAX_MODEL_FACES <= 255 && VIEW_H <= 255 && sizeof(dr_obj) % 4 == 0, "dr_obj's fields");
 
 typedef struct {
     const scene *sc;

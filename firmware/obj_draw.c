@@ -294,16 +294,33 @@ int objd_screen_box(const scene *s, const obj_state *os, const view_xform *v, in
     if (bx0 < INT32_MIN || bx1 > INT32_MAX || by0 < INT32_MIN || by1 > INT32_MAX) return 0; /* at the box's edge */
     int32_t xs[2] = {(int32_t)bx0, (int32_t)bx1}, ys[2] = {(int32_t)by0, (int32_t)by1};
     int32_t zs[2] = {os->z + zlo, os->z + zhi};
+    view_pt corner[8];
+    for (int c = 0; c < 8; c++) corner[c] = view_point(v, xs[c & 1], ys[(c >> 1) & 1], zs[c >> 2]);
+    /* the box's part in front of the near plane: its corners there, and where its
+     * edges cross the plane (projections are clamped to the screen) */
     int32_t xmin = INT32_MAX, xmax = INT32_MIN, ymin = INT32_MAX, ymax = INT32_MIN;
     for (int c = 0; c < 8; c++) {
-        view_pt p = view_point(v, xs[c & 1], ys[(c >> 1) & 1], zs[c >> 2]);
-        if (p.z < VIEW_ZNEAR) return 0; /* reaches past the near plane: no bound this way */
-        screen_pt q = view_project(v, p);
-        if (q.x < xmin) xmin = q.x;
-        if (q.x > xmax) xmax = q.x;
-        if (q.y < ymin) ymin = q.y;
-        if (q.y > ymax) ymax = q.y;
+        view_pt a = corner[c];
+        for (int k = -1; k < 3; k++) {
+            view_pt p = a;
+            if (k >= 0) { /* the edge to the corner across bit k, taken once, from its end in front */
+                view_pt b = corner[c ^ (1 << k)];
+                if (a.z < VIEW_ZNEAR || b.z >= VIEW_ZNEAR) continue;
+                int64_t dz = (int64_t)a.z - b.z, t = (int64_t)a.z - VIEW_ZNEAR; /* 0 <= t < dz */
+                p.x = (int32_t)(a.x + ((int64_t)b.x - a.x) * t / dz);           /* |.| < 2^32 * 2^32: fits */
+                p.y = (int32_t)(a.y + ((int64_t)b.y - a.y) * t / dz);
+                p.z = VIEW_ZNEAR;
+            } else if (a.z < VIEW_ZNEAR) {
+                continue;
+            }
+            screen_pt q = view_project(v, p);
+            if (q.x < xmin) xmin = q.x;
+            if (q.x > xmax) xmax = q.x;
+            if (q.y < ymin) ymin = q.y;
+            if (q.y > ymax) ymax = q.y;
+        }
     }
+    if (xmin > xmax) return -1; /* wholly behind the near plane */
     *x0 = rast_first_sample(xmin) - 1;
     *x1 = rast_first_sample(xmax) + 1;
     *y0 = rast_first_sample(ymin) - 1;

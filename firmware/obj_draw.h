@@ -88,10 +88,10 @@ int objd_touches_leaf(const scene *s, const obj_state *o, const scn_leaf *f, con
 int objd_in_view(const scene *s, const obj_state *o, const view_xform *v);
 
 /* The pixels the object can cover: columns [x0, x1) and rows [y0, y1), a pixel
- * wider than the projection of its box (origin +- its model's radius, its
- * model's heights), unclamped. 1 if found; 0 if the box reaches past the near
- * plane (or the coordinate box), where it has no such bound; -1 if the model
- * has no vertices (it covers nothing). */
+ * wider than the projection of the part of its box (origin +- its model's
+ * radius, its model's heights) in front of the near plane, unclamped. 1 if
+ * found; 0 if the box reaches past the coordinate box, where it has no such
+ * bound; -1 if it covers nothing (no vertices, or wholly behind the near plane). */
 int objd_screen_box(const scene *s, const obj_state *o, const view_xform *v, int *x0, int *x1, int *y0, int *y1);
 
 /* The view depth of the object's origin (view units), for painter's order. */

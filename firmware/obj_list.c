@@ -3,12 +3,12 @@
 
 #include "obj_draw.h"
 
-/* Swap two records, a byte at a time (they are a few words). */
+/* Swap two records, a word at a time (they are a few words). */
 static void swap(void *list, uint32_t i, uint32_t j, uint32_t size)
 {
-    uint8_t *a = (uint8_t *)objl_at(list, i, size), *b = (uint8_t *)objl_at(list, j, size);
-    for (uint32_t k = 0; k < size; k++) {
-        uint8_t t = a[k];
+    uint32_t *a = (uint32_t *)(void *)objl_at(list, i, size), *b = (uint32_t *)(void *)objl_at(list, j, size);
+    for (uint32_t k = 0; k < size / 4; k++) {
+        uint32_t t = a[k];
         a[k] = b[k];
         b[k] = t;
     }

@@ -5,7 +5,7 @@
  * can reach its west-east extent.
  *
  * A mode keeps its own record per object: any struct whose first member is an
- * objl_entry, in an array of records of `size` bytes. */
+ * objl_entry, in an array of records of `size` bytes (a multiple of 4). */
 #ifndef OBJ_LIST_H
 #define OBJ_LIST_H
 

@@ -35,6 +35,7 @@ int render_mode_parse(const char *name)
 
 render_mode render_mode_default(void)
 {
+    if (built(RENDER_COLUMNS)) return RENDER_COLUMNS;
     return built(RENDER_DIRECT) ? RENDER_DIRECT : (built(RENDER_SPANS) ? RENDER_SPANS : RENDER_PAINTER);
 }
 

@@ -2,7 +2,7 @@
 # instruction-counting QEMU plugin (tools/qemu_plugin), and how to run them.
 #
 #   make firmware [SCENE=...] [FULL=1] [CAMPATH=default|map01] [WORK_BYTES=N] [STREAM=framelink|raw] [ARM_OUT=DIR]
-#                 [FW_MODES=direct|LIST] [RAM_BYTES=N] [STACK_BYTES=N]
+#                 [FW_MODES=columns|LIST] [RAM_BYTES=N] [STACK_BYTES=N]
 #       -> $(ARM_OUT)/firmware.elf (default build/arm/firmware.elf): the scene
 #          (text scene, WAD map "file.wad:MAP01" or a compiled .bsc, default
 #          tests/scenes/default.scene) compiled by build/bspc and built in (in
@@ -14,8 +14,9 @@
 #          ($(ARM_OUT)/scene_config.h, written by bspc --config). FULL=1 builds
 #          every feature in, as for any scene.
 #          FW_MODES: the render modes compiled in, separated by commas (mk/modes.mk;
-#          default direct, the mode whose work area the screen bounds; FULL=1 does
-#          not change it: e.g. FW_MODES=direct,spans,painter RAM_BYTES=16777216).
+#          default columns, whose work area the screen bounds (it draws frames with
+#          objects with direct's code too); FULL=1 does not change it: e.g.
+#          FW_MODES=direct,spans,painter,columns RAM_BYTES=16777216).
 #          RAM_BYTES (default 200,000): all of the firmware's RAM - stack, both VRAM
 #          pages, palette, .data, .bss, work area (hal/mps2/mps2.ld). A build that
 #          does not fit is refused with one line giving the RAM it needs. Up to 4 MB
@@ -50,12 +51,16 @@ QEMU_ARM ?= qemu-system-arm
 UART     ?= $(ARM_OUT)/uart.bin
 RUN_ARGS ?=
 FULL     ?=
-FW_MODES ?= direct
+FW_MODES ?= columns
+# Mode columns' visplanes (firmware/build_config.h, 648 bytes each): a full pool is
+# drawn early, nothing is lost.
+COLS_PLANES ?= 16
 # Mode direct's face pools (firmware/build_config.h): small on the board; objects
 # beyond them are worked out again where needed, never dropped.
 DIRECT_FACES ?= 16
 DIRECT_EDGES ?= 96
-FW_DEFS = $(call render_modes_def,$(FW_MODES)) $(flat_def) -DCFG_DIRECT_FACES=$(DIRECT_FACES)u -DCFG_DIRECT_EDGES=$(DIRECT_EDGES)u
+FW_DEFS = $(call render_modes_def,$(FW_MODES)) $(flat_def) -DCFG_DIRECT_FACES=$(DIRECT_FACES)u -DCFG_DIRECT_EDGES=$(DIRECT_EDGES)u \
+          -DCFG_COLS_PLANES=$(COLS_PLANES)u
 RAM_BYTES ?= 200000
 # The stack: the walks keep a stack of the tree's depth (CFG_MAX_DEPTH: the scene's
 # in a build for it, 255 in a FULL=1 build); a textured frame adds a row of texels
@@ -210,7 +215,8 @@ MPS2_QEMU = $(QEMU_ARM) -M mps2-an385 -nographic -monitor none \
 # holds): a later `make run-firmware` without SCENE= must not rebuild it for the default scene.
 # Only a build setting given on the command line rebuilds first, with make's output on stderr:
 # stdout carries nothing but the UART with UART=stdio.
-FW_BUILD_VARS := SCENE FULL CAMPATH WORK_BYTES STREAM FW_MODES RAM_BYTES STACK_BYTES FLAT DIRECT_FACES DIRECT_EDGES
+FW_BUILD_VARS := SCENE FULL CAMPATH WORK_BYTES STREAM FW_MODES RAM_BYTES STACK_BYTES FLAT DIRECT_FACES DIRECT_EDGES \
+                 COLS_PLANES
 FW_BUILD_GIVEN := $(strip $(foreach v,$(FW_BUILD_VARS),$(if $(filter command line,$(origin $(v))),$(v))))
 RUN_PY := $(if $(wildcard $(PY)),$(PY),python3)
 PORT ?=

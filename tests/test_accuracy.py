@@ -1,8 +1,9 @@
 """Zero overdraw and accuracy against the reference renderer (tools/refrender.py, which ray-casts the
 source map without the BSP tree), on every view of the bench list.
 
-The world alone (--no-objects): mode spans writes each pixel once, and in both modes at least 99.9% of
-pixels carry the reference's surface id, with no pixel left empty (kind 0) inside these closed maps.
+The world alone (--no-objects): modes spans, direct and columns write each pixel once (columns by
+itself, with no frame handed to direct), and in every mode at least 99.9% of pixels carry the
+reference's surface id, with no pixel left empty (kind 0) inside these closed maps.
 
 With the maps' things drawn as objects (the default): mode spans still writes each pixel once, leaves
 none empty and agrees with the reference on at least 99.9% of pixels (all 20 views agree on 99.99% or
@@ -39,17 +40,20 @@ def test_world_against_reference(view, tmp_path):
     spans_json, spans = c_ids(view, "spans", tmp_path, "--no-objects")
     painter_json, painter = c_ids(view, "painter", tmp_path, "--no-objects")
     direct_json, direct = c_ids(view, "direct", tmp_path, "--no-objects")
+    columns_json, columns = c_ids(view, "columns", tmp_path, "--no-objects")
     z = float(spans_json["camera"]["z"])  # the same eye height as the C renderer used
     ref = refrender.render_ids(view["scene"], x, y, z, float(view["angle"]), objects=[])
-    for j in (spans_json, direct_json):
+    for j in (spans_json, direct_json, columns_json):
         assert j["overdraw"] == 1.0 and j["pixels_written"] == 64000
-    for name, ids in (("spans", spans), ("painter", painter), ("direct", direct)):
+    assert columns_json["fallback"] == 0  # drawn by columns itself: the eye stands inside these maps
+    for name, ids in (("spans", spans), ("painter", painter), ("direct", direct), ("columns", columns)):
         same = float((ids == ref).mean())
         assert same >= 0.999, f"{name}: only {same:.4%} of pixels match the reference"
         assert int(((ids >> 24) == 0).sum()) == 0, f"{name}: empty pixels inside a closed map"
     # the modes draw the same surfaces
     assert (spans == painter).mean() >= 0.999
     assert (direct == spans).mean() >= 0.999
+    assert (columns == direct).mean() >= 0.999
 
 
 @pytest.mark.parametrize("view", VIEWS, ids=IDS)
@@ -58,12 +62,14 @@ def test_world_and_things_against_reference(view, tmp_path):
     j, spans = c_ids(view, "spans", tmp_path)
     pj, painter = c_ids(view, "painter", tmp_path)
     dj, direct = c_ids(view, "direct", tmp_path)
-    assert j["objects"] == pj["objects"] == dj["objects"]
+    cj, columns = c_ids(view, "columns", tmp_path)
+    assert j["objects"] == pj["objects"] == dj["objects"] == cj["objects"]
     ref = refrender.render_ids(view["scene"], x, y, float(j["camera"]["z"]), float(view["angle"]),
                                objects=j["objects"])
-    for jj in (j, dj):
+    for jj in (j, dj, cj):
         assert jj["overdraw"] == 1.0 and jj["pixels_written"] == 64000
-    for name, ids, bound in (("spans", spans, 0.999), ("painter", painter, 0.98), ("direct", direct, 0.999)):
+    for name, ids, bound in (("spans", spans, 0.999), ("painter", painter, 0.98), ("direct", direct, 0.999),
+                             ("columns", columns, 0.999)):
         assert int(((ids >> 24) == 0).sum()) == 0, f"{name}: empty pixels inside a closed map"
         same = float((ids == ref).mean())
         assert same >= bound, f"{name}: only {same:.4%} of pixels match the reference ({j['objects_visible']} objects seen)"

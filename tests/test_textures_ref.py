@@ -5,7 +5,7 @@ of cast_view is render_ids'), its composition of a texture agrees with a patch c
 by hand from the WAD, its light follows Doom's tables on figures worked out by hand, and the
 comparison passes the reference's own frame (100%) and fails it moved by 3 pixels.
 
-Then build/render's frame of every bench view (tests/bench_views.json, the 20 player starts and
+Then build/render's frame of every bench view, in mode columns (the default) and in mode direct, (tests/bench_views.json, the 20 player starts and
 the 7 open views, all on Freedoom maps) must be acceptable on at least 99% of the compared pixels:
 within one texel and one light step of the reference (walls, floors, ceilings, sky with a texture;
 the renderer's object pixels left out). A view whose scene the renderer draws flat is skipped: the
@@ -173,11 +173,12 @@ def scene_textured(spec, j, tmp_path):
     return _needs[spec]
 
 
+@pytest.mark.parametrize("mode", ["columns", "direct"])
 @pytest.mark.parametrize("view", VIEWS, ids=IDS)
-def test_renderer_against_reference(view, tmp_path):
+def test_renderer_against_reference(view, mode, tmp_path):
     spec = scene_path(view["scene"])
     raw, ids = tmp_path / "frame.raw", tmp_path / "frame.ids"
-    j = render(spec, "--raw", raw, "--ids", ids, "--look", str(view.get("look", 0)),
+    j = render(spec, "--raw", raw, "--ids", ids, "--look", str(view.get("look", 0)), "--mode", mode,
                at=view["at"], angle=view["angle"])
     if not scene_textured(spec, j, tmp_path):
         pytest.skip(f"{view['scene']}: build/render draws this scene flat (the render JSON's "
@@ -189,9 +190,9 @@ def test_renderer_against_reference(view, tmp_path):
     ok, compared, counts = reflook.compare(e, frame, buf)
     share = counts["all"][0] / counts["all"][1]
     kinds = ", ".join(f"{k} {a}/{n}" for k, (a, n) in counts.items() if k != "all" and n)
-    print(f"{view['scene']} {view['at']} {view['angle']}: {share:.3%} of {counts['all'][1]} ({kinds})")
+    print(f"{view['scene']} {view['at']} {view['angle']} {mode}: {share:.3%} of {counts['all'][1]} ({kinds})")
     if share < GOAL:
-        diff = ROOT / "build" / "texref" / (IDS[VIEWS.index(view)].replace("/", "_").replace(":", "_") + ".png")
+        diff = ROOT / "build" / "texref" / (IDS[VIEWS.index(view)].replace("/", "_").replace(":", "_") + f"-{mode}.png")
         diff.parent.mkdir(parents=True, exist_ok=True)
         refrender.write_png_rgb(diff, reflook.diff_rgb(e, frame, ok, compared))
         pytest.fail(f"{share:.3%} acceptable, below {GOAL:.0%} ({kinds}); failures in red: {diff}")

@@ -45,7 +45,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import framelink  # noqa: E402
 
-MODES = ["spans", "painter", "direct"]  # render.h's render_mode numbers
+MODES = ["spans", "painter", "direct", "columns"]  # render.h's render_mode numbers
 PRESENTS = ["flip", "copy8", "copy16", "copy32"]
 
 

@@ -156,7 +156,7 @@ int args_parse(fw_args *a, char *line, unsigned offered, char *err, int errsize)
             if (parse_int(val, &a->look)) return fail(err, errsize, "--look '%s': expected pixels", val);
         } else if (same(o, "--mode")) {
             if ((a->mode = render_mode_parse(val)) < 0)
-                return fail(err, errsize, "--mode '%s': direct, spans or painter", val);
+                return fail(err, errsize, "--mode '%s': direct, spans, painter or columns", val);
         } else if (same(o, "--present")) {
             if ((a->present = hal_present_parse(val)) < 0)
                 return fail(err, errsize, "--present '%s': flip, copy8, copy16 or copy32", val);

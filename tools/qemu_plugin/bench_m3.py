@@ -103,7 +103,7 @@ def main():
         if name not in elves:
             out_dir = BUILD / "bench-m3" / name
             make("firmware", f"SCENE={v['scene']}", f"ARM_OUT={out_dir}", f"ARM_OBJ={obj}", "STREAM=raw", "FULL=1",
-                 "FW_MODES=direct,spans,painter", "RAM_BYTES=16777216")
+                 "FW_MODES=direct,spans,painter,columns", "RAM_BYTES=16777216")
             elves[name] = out_dir / "firmware.elf"
 
     tasks = [(i, m, w) for i in range(len(views)) for m in modes for w in ("world", "things", "flat")]
