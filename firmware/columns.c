@@ -31,18 +31,11 @@ enum { ROW_CEIL, ROW_FLOOR, ROW_LOW, ROW_HIGH, ROW_UNUSED, ROW_LINES }; /* ROW_U
  * it (the tree's order, as in mode direct); what is left open there is the
  * objects' and direct's. */
 typedef struct {
-    cov_mask mask;                    /* set: left to direct */
-    uint8_t top[VIEW_W], bot[VIEW_W]; /* the rows of each column the mask may have set in, [top, bot) */
-    uint8_t row_any[VIEW_H];          /* the rows it has set in */
+    cov_mask mask;               /* set: left to direct */
+    uint32_t col_any[COV_WORDS]; /* the columns it has set in, a bit each */
     uint8_t any;
 } cols_region;
 
-typedef struct {
-    objl_entry e;
-    uint8_t active; /* its first leaf is behind: looked at once */
-} cols_obj;
-
-_Static_assert(sizeof(cols_obj) % 4 == 0, "obj_list.h: records of whole words");
 
 typedef struct {
     const scene *sc;
@@ -56,7 +49,7 @@ typedef struct {
     int16_t rows[ROW_LINES][VIEW_W];            /* the seg in hand: where its lines cross each column */
     cols_region *region;                        /* what is left to the objects */
     const world_state *w;
-    cols_obj *objs; /* the objects in view, by west edge (obj_list.h) */
+    objl_entry *objs; /* the objects in view, by west edge (obj_list.h) */
     uint32_t nobjs;
     int32_t reach;
     uint32_t nplanes;
@@ -77,9 +70,9 @@ static uint32_t object_count(const world_state *w)
  * objects, or direct's. */
 uint32_t cols_work_bytes(const scene *s, const world_state *w)
 {
-    uint64_t direct = direct_work_bytes(s, w), own = align8(sizeof(cols_state));
-    if (direct == 0) return 0;
-    own += align8((uint64_t)object_count(w) * sizeof(cols_obj));
+    uint64_t direct = direct_work_bytes_within(s, w), own = align8(sizeof(cols_state));
+    if (direct == 0 || direct_work_bytes(s, w) == 0) return 0;
+    own += align8((uint64_t)object_count(w) * sizeof(objl_entry));
     uint64_t total = align8(sizeof(cols_region)) + (direct > own ? direct : own);
     return total > 0xFFFFFFF0u ? 0 : (uint32_t)total;
 }
@@ -110,15 +103,27 @@ static void edge_rows(screen_pt a, screen_pt b, int c0, int c1, int16_t *rows)
     if (c >= end) return;
     int64_t dx = (int64_t)b.x - a.x, dy = (int64_t)b.y - a.y;
     int64_t num = (((int64_t)c << 16) + 32768 - a.x) * dy;
-    int64_t q = floor_div(num, dx), rem = num - q * dx; /* rem in [0, dx) */
-    int64_t step = floor_div(dy * 65536, dx), srem = dy * 65536 - step * dx;
-    int64_t y = a.y + q;
+    int32_t y, step;
+    uint32_t rem, srem; /* in [0, dx) */
+#if FX_DIV32
+    if (dx > 65536) { /* wider than a column: |step| < |dy| < 2^25, and the first y lies on the edge */
+        y = a.y + fx_floordiv64_32(num, (uint32_t)dx, &rem);
+        step = fx_floordiv64_32(dy * 65536, (uint32_t)dx, &srem);
+    } else
+#endif
+    {
+        int64_t q = floor_div(num, dx), s = floor_div(dy * 65536, dx);
+        y = (int32_t)(a.y + q);
+        rem = (uint32_t)(num - q * dx);
+        step = (int32_t)s; /* over at most one column, whatever it is, it is not used again */
+        srem = (uint32_t)(dy * 65536 - s * dx);
+    }
     for (; c < end; c++) {
-        rows[c] = (int16_t)clamp_row(fx_asr64(y + 32767, 16));
-        y += step;
+        rows[c] = (int16_t)clamp_row(fx_asr64((int64_t)y + 32767, 16));
+        y = (int32_t)((uint32_t)y + (uint32_t)step);
         rem += srem;
-        if (rem >= dx) {
-            rem -= dx;
+        if (rem >= (uint32_t)dx) {
+            rem -= (uint32_t)dx;
             y++;
         }
     }
@@ -193,12 +198,12 @@ static void put_column(const cols_state *S, int x, int y0, int y1, const tex_pai
 static void draw_column(const cols_state *S, int x, int y0, int y1, const tex_paint *paint, uint32_t id)
 {
     const cols_region *r = S->region;
-    if (!r->any || r->top[x] >= y1 || r->bot[x] <= y0) {
+    uint32_t bit = 1u << (x & 31);
+    int w = x >> 5;
+    if (!(r->col_any[w] & bit)) {
         put_column(S, x, y0, y1, paint, id);
         return;
     }
-    uint32_t bit = 1u << (x & 31);
-    int w = x >> 5;
     for (int y = y0; y < y1;) {
         int end = y;
         while (end < y1 && !(r->mask.bits[end][w] & bit)) end++;
@@ -227,7 +232,10 @@ static tex_paint plane_paint(const cols_state *S, const cols_plane *p)
 static inline void plane_span(cols_state *S, int y, int x0, int x1, const tex_paint *paint, uint32_t id)
 {
     const cols_region *r = S->region;
-    if (!r->row_any[y]) {
+    uint32_t any = 0;
+    if (r->any)
+        for (int i = x0 >> 5; i <= (x1 - 1) >> 5; i++) any |= r->mask.bits[y][i];
+    if (!any) {
         rast_span(S->t, y, x0, x1, paint, id);
         return;
     }
@@ -445,10 +453,8 @@ static void take_object(cols_state *S, const obj_state *o)
         uint32_t bit = 1u << (x & 31);
         for (int y = a; y < b; y++) {
             r->mask.bits[y][x >> 5] |= bit;
-            r->row_any[y] = 1;
         }
-        if (a < r->top[x]) r->top[x] = (uint8_t)a;
-        if (b > r->bot[x]) r->bot[x] = (uint8_t)b;
+        r->col_any[x >> 5] |= bit;
         r->any = 1;
     }
 }
@@ -459,11 +465,11 @@ static void objects_in_leaf(cols_state *S, uint32_t leaf)
     int32_t box[BOX_SIDES];
     uint32_t i;
     objd_leaf_box(S->sc, f, box);
-    for (uint32_t end = objl_near_leaf(S->objs, S->nobjs, sizeof(cols_obj), box, S->reach, &i); i < end; i++) {
-        cols_obj *o = &S->objs[i];
-        const obj_state *os = &S->w->objs[o->e.index];
-        if (o->active || !objd_touches_leaf(S->sc, os, f, box)) continue;
-        o->active = 1;
+    for (uint32_t end = objl_near_leaf(S->objs, S->nobjs, sizeof(objl_entry), box, S->reach, &i); i < end; i++) {
+        objl_entry *o = &S->objs[i];
+        const obj_state *os = &S->w->objs[o->index];
+        if (o->taken || !objd_touches_leaf(S->sc, os, f, box)) continue;
+        o->taken = 1;
         take_object(S, os);
     }
 }
@@ -482,14 +488,9 @@ static int visit_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
 
 static void region_clear(cols_region *r)
 {
-    for (int y = 0; y < VIEW_H; y++) {
+    for (int y = 0; y < VIEW_H; y++)
         for (int i = 0; i < COV_WORDS; i++) r->mask.bits[y][i] = 0;
-        r->row_any[y] = 0;
-    }
-    for (int x = 0; x < VIEW_W; x++) {
-        r->top[x] = VIEW_H;
-        r->bot[x] = 0;
-    }
+    for (int i = 0; i < COV_WORDS; i++) r->col_any[i] = 0;
     r->any = 0;
 }
 
@@ -516,8 +517,8 @@ void cols_render(const scene *sc, const world_state *w, const view_xform *v, con
     S->textured = CFG_TEXTURES && sc->look && !t->flat;
     S->region = region;
     region_clear(region);
-    S->objs = (cols_obj *)(void *)(mem + align8(sizeof(cols_state)));
-    S->nobjs = objl_in_view(sc, w, v, S->objs, sizeof(cols_obj), &S->reach);
+    S->objs = (objl_entry *)(void *)(mem + align8(sizeof(cols_state)));
+    S->nobjs = objl_in_view(sc, w, v, S->objs, sizeof(objl_entry), &S->reach);
     S->nplanes = 0;
     occ_reset(&S->occ);
     for (int c = 0; c < VIEW_W; c++) {

@@ -18,8 +18,9 @@ void cov_complement(cov_mask *dst, const cov_mask *src)
     for (int y = 0; y < VIEW_H; y++) {
         uint16_t open = 0;
         for (int i = 0; i < COV_WORDS; i++) {
-            dst->bits[y][i] = ~src->bits[y][i];
-            open |= (uint16_t)((src->bits[y][i] != 0) << i);
+            uint32_t b = src->bits[y][i]; /* read first: dst may be src */
+            dst->bits[y][i] = ~b;
+            open |= (uint16_t)((b != 0) << i);
         }
         dst->open[y] = open;
         dst->full_rows += open == 0;

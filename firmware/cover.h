@@ -24,7 +24,7 @@ typedef struct {
 
 void cov_clear(cov_mask *m);
 
-/* dst set exactly where src is clear. */
+/* dst set exactly where src is clear (dst may be src). */
 void cov_complement(cov_mask *dst, const cov_mask *src);
 
 /* A run touches its two end words bit by bit; the words between are whole, so

@@ -36,15 +36,17 @@ typedef struct {
 } dr_face;
 
 typedef struct {
-    objl_entry e;    /* the object and the west edge of its box (obj_list.h: the list is sorted by it) */
-    uint16_t x0, x1; /* screen box of its faces: pixels [x0, x1) x [y0, y1) */
+    objl_entry e;                 /* the object, the west edge of its box (obj_list.h); e.nfaces: faces facing the
+                                 * eye and on screen (SCN_MAX_MODEL_FACES fits) */
+    uint16_t x0 : 15, stored : 1; /* screen box of its faces: pixels [x0, x1) x [y0, y1); stored: its faces are in
+                                   * the pools */
+    uint16_t x1 : 15, drew : 1;   /* drew: it wrote a pixel */
     uint8_t y0, y1;
     uint16_t first_face; /* stored: its faces in the pool */
-    uint8_t nfaces;      /* faces facing the eye and on screen (SCN_MAX_MODEL_FACES fits) */
-    uint8_t active : 1, stored : 1, drew : 1;
 } dr_obj;
 
-_Static_assert(SCN_MAX_MODEL_FACES <= 255 && VIEW_H <= 255 && sizeof(dr_obj) % 4 == 0, "dr_obj's fields");
+_Static_assert(SCN_MAX_MODEL_FACES <= 255 && VIEW_H <= 255 && VIEW_W < 32768 && sizeof(dr_obj) == 16,
+               "dr_obj's fields");
 
 typedef struct {
     const scene *sc;
@@ -53,7 +55,7 @@ typedef struct {
     const rast_target *t;
     render_stats *st;
     surf_sink sink;
-    cov_mask cov;
+    cov_mask *cov; /* the pixels written: after the state (direct_render) or the caller's (direct_render_within) */
     occ_columns occ;
     int use_occ;
     dr_obj *objs;     /* objects in view, by the west edge of their boxes */
@@ -76,17 +78,30 @@ static uint32_t object_count(const world_state *w)
     return (CFG_OBJECTS && w && (w->objs || w->n)) ? w->n : 0;
 }
 
-uint32_t direct_work_bytes(const scene *s, const world_state *w)
+/* The work memory: the state, the objects' records and pools, and the mask
+ * unless the caller lends one. */
+static uint32_t work_bytes(const world_state *w, int own_mask)
 {
-    (void)s;
     uint32_t n = object_count(w);
     if (n > SCN_MAX_OBJECTS) return 0; /* more than the format allows (an object record holds 16 bits): refuse */
-    uint64_t total = align8(sizeof(dr_state));
+    uint64_t total = align8(sizeof(dr_state)) + (own_mask ? align8(sizeof(cov_mask)) : 0);
     if (n)
         total += align8((uint64_t)n * sizeof(dr_obj)) + align8((uint64_t)n * sizeof(uint16_t)) +
                  align8((uint64_t)DIRECT_FACE_POOL * sizeof(dr_face)) +
                  align8((uint64_t)DIRECT_EDGE_POOL * sizeof(dr_edge));
     return total > 0xFFFFFFF0u ? 0 : (uint32_t)total;
+}
+
+uint32_t direct_work_bytes(const scene *s, const world_state *w)
+{
+    (void)s;
+    return work_bytes(w, 1);
+}
+
+uint32_t direct_work_bytes_within(const scene *s, const world_state *w)
+{
+    (void)s;
+    return work_bytes(w, 0);
 }
 
 /* ---- object faces on screen ---------------------------------------------------------- */
@@ -175,7 +190,7 @@ typedef void (*face_visit)(dr_state *S, dr_obj *o, const dr_face *f, const dr_ed
 static void each_face(dr_state *S, dr_obj *o, face_visit visit, void *ctx)
 {
     if (o->stored) {
-        for (uint32_t k = 0; k < o->nfaces; k++) {
+        for (uint32_t k = 0; k < o->e.nfaces; k++) {
             const dr_face *f = &S->faces[o->first_face + k];
             visit(S, o, f, &S->edges[f->first_edge], ctx);
         }
@@ -199,14 +214,14 @@ static void reclaim(dr_state *S)
     uint32_t na = 0, nf = 0, ne = 0;
     for (uint32_t i = 0; i < S->nactive; i++) {
         dr_obj *o = &S->objs[S->active[i]];
-        if (cov_box_covered(&S->cov, o->y0, o->y1, o->x0, o->x1)) {
-            o->nfaces = 0;
+        if (cov_box_covered(S->cov, o->y0, o->y1, o->x0, o->x1)) {
+            o->e.nfaces = 0;
             o->stored = 0;
             continue;
         }
         S->active[na++] = S->active[i];
         if (!o->stored) continue;
-        for (uint32_t k = 0; k < o->nfaces; k++) {
+        for (uint32_t k = 0; k < o->e.nfaces; k++) {
             dr_face f = S->faces[o->first_face + k];
             for (int e = 0; e < f.nedges; e++) S->edges[ne + (uint32_t)e] = S->edges[f.first_edge + (uint32_t)e];
             f.first_edge = (uint16_t)ne;
@@ -214,7 +229,7 @@ static void reclaim(dr_state *S)
             S->faces[nf + k] = f;
         }
         o->first_face = (uint16_t)nf;
-        nf += o->nfaces;
+        nf += o->e.nfaces;
     }
     S->nactive = na;
     S->nfaces = nf;
@@ -249,7 +264,7 @@ static void activate(dr_state *S, dr_obj *o)
         }
         nf++;
     }
-    o->nfaces = (uint8_t)nf;
+    o->e.nfaces = (uint8_t)nf;
     o->stored = stored != 0;
     if (nf && !stored) S->st->flushes++;
     if (stored) {
@@ -275,7 +290,7 @@ static int object_hidden(const dr_state *S, const obj_state *os)
     int x0, x1, y0, y1;
     int r = objd_screen_box(S->sc, os, S->v, &x0, &x1, &y0, &y1);
     if (r < 0) return 1;
-    return r && cov_box_covered(&S->cov, y0, y1, x0, x1);
+    return r && cov_box_covered(S->cov, y0, y1, x0, x1);
 }
 
 /* Objects whose box reaches into the leaf become active and are set up, unless
@@ -290,11 +305,11 @@ static void activate_objects_in(dr_state *S, uint32_t leaf)
     for (uint32_t end = objl_near_leaf(S->objs, S->nobjs, sizeof(dr_obj), box, S->reach, &i); i < end; i++) {
         dr_obj *o = &S->objs[i];
         const obj_state *os = &S->w->objs[o->e.index];
-        if (o->active || !objd_touches_leaf(S->sc, os, f, box)) continue;
-        o->active = 1; /* looked at once: hidden now stays hidden */
+        if (o->e.taken || !objd_touches_leaf(S->sc, os, f, box)) continue;
+        o->e.taken = 1; /* looked at once: hidden now stays hidden */
         if (object_hidden(S, os)) continue;
         activate(S, o);
-        if (o->nfaces) S->active[S->nactive++] = (uint16_t)i;
+        if (o->e.nfaces) S->active[S->nactive++] = (uint16_t)i;
     }
 }
 
@@ -365,7 +380,7 @@ static void draw_face_row(dr_state *S, dr_obj *o, const dr_face *face, int y, in
         if (p->y0 <= y && p->y1 > y && p->x0 < b && p->x1 > a) each_face(S, p, keep_nearer_face, &k);
     }
     tex_paint paint = tex_flat(face->colour);
-    if (cov_fill(&S->cov, S->t, y, a, b, keep, &paint, RAST_ID(RAST_KIND_OBJECT, o->e.index)) && !o->drew) {
+    if (cov_fill(S->cov, S->t, y, a, b, keep, &paint, RAST_ID(RAST_KIND_OBJECT, o->e.index)) && !o->drew) {
         o->drew = 1;
         S->st->objects_visible++;
     }
@@ -380,7 +395,7 @@ static void draw_face(dr_state *S, dr_obj *o, const dr_face *f, const dr_edge *e
     for (int i = 0; i < f->nedges; i++) own[i] = edges[i];
     for (int y = face.top; y < face.bottom; y++) {
         int a, b;
-        if (face_row(&face, own, y, &a, &b) && !cov_row_full(&S->cov, y)) draw_face_row(S, o, &face, y, a, b, 0);
+        if (face_row(&face, own, y, &a, &b) && !cov_row_full(S->cov, y)) draw_face_row(S, o, &face, y, a, b, 0);
     }
     S->st->object_faces++;
 }
@@ -407,8 +422,8 @@ static void draw_face_over_world(dr_state *S, dr_obj *o, const dr_face *f, const
     if (!face_row(f, edges, k->y, &a, &b)) return;
     if (a < k->x0) a = k->x0;
     if (b > k->x1) b = k->x1;
-    if (a >= b || cov_all(&S->cov, k->y, a, b)) return; /* nothing of it left to decide */
-    if (k->zmax + DEPTH_APART < f->zmin) return;        /* the world surface is nearer all over */
+    if (a >= b || cov_all(S->cov, k->y, a, b)) return; /* nothing of it left to decide */
+    if (k->zmax + DEPTH_APART < f->zmin) return;       /* the world surface is nearer all over */
     uint32_t mine[COV_WORDS] = {0};
     if (k->zmin > f->zmax + DEPTH_APART)
         cov_line_set(mine, a, b); /* the face is nearer all over */
@@ -457,7 +472,7 @@ static uint32_t fill_row_behind_objects(dr_state *S, int y, int x0, int x1, cons
         dr_obj *o = &S->objs[S->active[i]];
         if (o->y0 <= y && o->y1 > y && o->x0 < x1 && o->x1 > x0) each_face(S, o, draw_face_over_world, &k);
     }
-    return cov_fill(&S->cov, S->t, y, x0, x1, 0, paint, id);
+    return cov_fill(S->cov, S->t, y, x0, x1, 0, paint, id);
 }
 
 static void add_polygon(void *ctx, const screen_pt *pts, int n, const tex_paint *paint, uint32_t id, uint32_t seg,
@@ -468,7 +483,7 @@ static void add_polygon(void *ctx, const screen_pt *pts, int n, const tex_paint 
     int top = box.y0, bottom = box.y1, c0 = box.x0, c1 = box.x1;
     if (top < 0) top = 0;
     if (bottom > VIEW_H) bottom = VIEW_H;
-    if (top >= bottom || cov_box_covered(&S->cov, top, bottom, c0, c1)) {
+    if (top >= bottom || cov_box_covered(S->cov, top, bottom, c0, c1)) {
         S->st->occluded++;
         return;
     }
@@ -481,7 +496,7 @@ static void add_polygon(void *ctx, const screen_pt *pts, int n, const tex_paint 
         for (int y = top; y < bottom; y++)
             if (lo[y] < hi[y]) drawn += fill_row_behind_objects(S, y, lo[y], hi[y], &world, zmin, zmax, paint, id);
     } else {
-        drawn = cov_fill_rows(&S->cov, S->t, top, bottom, lo, hi, paint, id);
+        drawn = cov_fill_rows(S->cov, S->t, top, bottom, lo, hi, paint, id);
     }
     if (drawn)
         S->st->surfaces_drawn++;
@@ -494,7 +509,7 @@ static int box_hidden(void *ctx, const screen_pt *pts, int n)
 {
     const dr_state *S = ctx;
     rast_box b = rast_bounds(pts, n);
-    return cov_box_covered(&S->cov, b.y0 - 1, b.y1 + 1, b.x0 - 1, b.x1 + 1);
+    return cov_box_covered(S->cov, b.y0 - 1, b.y1 + 1, b.x0 - 1, b.x1 + 1);
 }
 
 static int visit_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
@@ -502,7 +517,7 @@ static int visit_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
     dr_state *S = ctx;
     if (CFG_OBJECTS && S->nactive < S->nobjs) activate_objects_in(S, leaf);
     surf_leaf(S->sc, S->w, S->v, leaf, clip_mask, &S->sink, S->use_occ ? &S->occ : 0, S->st);
-    return cov_full(&S->cov);
+    return cov_full(S->cov);
 }
 
 /* ---- the frame ---------------------------------------------------------------------- */
@@ -515,9 +530,9 @@ static void list_objects_in_view(dr_state *S)
 }
 
 void direct_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t, render_stats *st,
-                   void *work, uint32_t work_bytes)
+                   void *work, uint32_t bytes)
 {
-    direct_render_within(sc, w, v, t, st, work, work_bytes, 0);
+    direct_render_within(sc, w, v, t, st, work, bytes, 0);
 }
 
 /* Columns where mask has no pixel set: closed. */
@@ -535,10 +550,10 @@ static void close_empty_columns(occ_columns *occ, const cov_mask *mask)
 }
 
 void direct_render_within(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t,
-                          render_stats *st, void *work, uint32_t work_bytes, const cov_mask *only)
+                          render_stats *st, void *work, uint32_t bytes, cov_mask *only)
 {
-    uint32_t need = direct_work_bytes(sc, w);
-    if (!work || need == 0 || work_bytes < need) {
+    uint32_t need = work_bytes(w, only == 0);
+    if (!work || need == 0 || bytes < need) {
         st->refused = 1; /* the caller did not provide the memory this frame needs */
         tex_paint background = tex_flat(BACKGROUND_COLOUR);
         for (int y = 0; y < VIEW_H; y++) rast_span(t, y, 0, VIEW_W, &background, RAST_ID(RAST_KIND_NONE, 0));
@@ -555,6 +570,8 @@ void direct_render_within(const scene *sc, const world_state *w, const view_xfor
     S->faces = (dr_face *)(void *)mem;
     mem += n ? align8((uint64_t)DIRECT_FACE_POOL * sizeof(dr_face)) : 0;
     S->edges = (dr_edge *)(void *)mem;
+    mem += n ? align8((uint64_t)DIRECT_EDGE_POOL * sizeof(dr_edge)) : 0;
+    S->cov = only ? only : (cov_mask *)(void *)mem;
     S->sc = sc;
     S->w = w;
     S->v = v;
@@ -567,10 +584,10 @@ void direct_render_within(const scene *sc, const world_state *w, const view_xfor
     walk_stats ws;
     occ_reset(&S->occ);
     if (only) { /* only these pixels: the rest counts as drawn, columns with none as closed */
-        cov_complement(&S->cov, only);
         close_empty_columns(&S->occ, only);
+        cov_complement(only, only);
     } else {
-        cov_clear(&S->cov);
+        cov_clear(S->cov);
     }
     list_objects_in_view(S);
     st->object_pass = S->nobjs != 0;
@@ -582,5 +599,5 @@ void direct_render_within(const scene *sc, const world_state *w, const view_xfor
     if (CFG_OBJECTS && S->nactive) draw_objects(S);
     tex_paint background = tex_flat(BACKGROUND_COLOUR);
     for (int y = 0; y < VIEW_H; y++) /* what no surface claimed: the background */
-        cov_fill(&S->cov, t, y, 0, VIEW_W, 0, &background, RAST_ID(RAST_KIND_NONE, 0));
+        cov_fill(S->cov, t, y, 0, VIEW_W, 0, &background, RAST_ID(RAST_KIND_NONE, 0));
 }

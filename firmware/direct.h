@@ -43,9 +43,12 @@ void direct_render(const scene *sc, const world_state *w, const view_xform *v, c
                    void *work, uint32_t work_bytes);
 
 /* direct_render drawing only the pixels set in only: the others are left as
- * they are, and columns with none are not walked. Mode columns gives it the
- * pixels objects may cover. */
+ * they are, and columns with none are not walked. only becomes the mode's own
+ * mask of written pixels (complemented in place), so the work memory it needs is
+ * direct_work_bytes_within's, a mask less. Mode columns gives it the pixels
+ * objects may cover. */
 void direct_render_within(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t,
-                          render_stats *st, void *work, uint32_t work_bytes, const cov_mask *only);
+                          render_stats *st, void *work, uint32_t work_bytes, cov_mask *only);
+uint32_t direct_work_bytes_within(const scene *s, const world_state *w);
 
 #endif

@@ -17,6 +17,8 @@
 typedef struct {
     int32_t left;   /* west edge of its box, whole units (the list is sorted by it) */
     uint16_t index; /* the object (its id; SCN_MAX_OBJECTS fits) */
+    uint8_t taken;  /* the mode's: its first leaf is reached, it was looked at (0 from objl_in_view) */
+    uint8_t nfaces; /* the mode's: faces it shows, for a mode that keeps them (0 from objl_in_view) */
 } objl_entry;
 
 _Static_assert(SCN_MAX_OBJECTS <= 65536, "objl_entry.index");

@@ -211,15 +211,20 @@ static inline __attribute__((always_inline)) uint32_t wall_depth(const tex_paint
     return d14 > 0 ? depth_div((uint64_t)p->dist, (uint32_t)d14) : TEX_ZMAX;
 }
 
-static inline __attribute__((always_inline)) wall_sample wall_at(const tex_paint *p, int64_t den, int64_t slope,
-                                                                 int32_t vk)
+static inline __attribute__((always_inline)) wall_sample wall_at_depth(const tex_paint *p, uint32_t z, int64_t slope,
+                                                                       int32_t vk)
 {
-    uint32_t z = wall_depth(p, den);
     wall_sample s;
     s.u = p->u0 + (uint32_t)(((int64_t)z * (slope >> 16)) >> 14); /* < 2^47 before the shift */
     s.v = p->v0 - (uint32_t)(((int64_t)z * vk) >> 22);            /* < 2^56 */
     s.light = wall_light(p, z);
     return s;
+}
+
+static inline __attribute__((always_inline)) wall_sample wall_at(const tex_paint *p, int64_t den, int64_t slope,
+                                                                 int32_t vk)
+{
+    return wall_at_depth(p, wall_depth(p, den), slope, vk);
 }
 
 /* A row of a wall. The exact samples are taken at columns that are multiples
@@ -285,15 +290,19 @@ static inline __attribute__((always_inline)) void wall_column_as(const tex_paint
     int64_t den = (int64_t)p->a + (int64_t)sx * p->b, slope = (int64_t)p->c + (int64_t)sx * p->d;
     int32_t sy = 2 * (VIEW_CY + p->look) - 2 * y0 - 1;
     uint32_t z = wall_depth(p, den);
-    wall_sample s = wall_at(p, den, slope, sy * 13107);
+    wall_sample s = wall_at_depth(p, z, slope, sy * 13107);
     uint32_t dv = (uint32_t)(((int64_t)z * (2 * 13107)) >> 22); /* a row down: sy falls by 2 */
     const uint8_t *col = p->texels + (((s.u >> 16) & p->wmask) << p->hbits), *light = s.light;
     uint32_t v = s.v;
-    for (int n = y1 - y0; n > 0; n--) {
-        *dst = light[col[(v >> 16) & hmask]];
-        dst += pitch;
-        v += dv;
+    int n = y1 - y0;
+    for (; n >= 2; n -= 2) { /* two rows a turn: the loop's own count and branch shared */
+        uint8_t a = light[col[(v >> 16) & hmask]], b = light[col[((v + dv) >> 16) & hmask]];
+        dst[0] = a;
+        dst[pitch] = b;
+        dst += 2 * pitch;
+        v += 2 * dv;
     }
+    if (n) *dst = light[col[(v >> 16) & hmask]];
 }
 
 void tex_column(const tex_paint *p, int x, int y0, int y1, uint8_t *dst, uint32_t pitch)

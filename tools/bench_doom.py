@@ -102,6 +102,13 @@ def frame_cost(runs):
     return (drawn[l2] - drawn[l1]) / (l2 - l1)
 
 
+def default_mode():
+    """The mode build/render draws in when none is asked for (its JSON names it)."""
+    out = subprocess.run([str(bench.RENDER), "tests/scenes/default.scene"], cwd=ROOT, capture_output=True, text=True,
+                         check=True).stdout
+    return json.loads(out)["mode"]
+
+
 def ours_frame(spec, mode, frames, bench_dir, *extra):
     """build/render's instructions per frame at SPEC's player start (no camera given)."""
     scene = bench.compiled(spec, bench_dir)
@@ -162,7 +169,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(prog="bench_doom.py", description="make bench-doom: Chocolate Doom's "
                                  "instructions per frame beside build/render's at the same player starts "
                                  "(callgrind, x86-64).")
-    ap.add_argument("--mode", default="direct", help="build/render's mode (default direct, its default)")
+    ap.add_argument("--mode", help="build/render's mode (default: its own default mode)")
     ap.add_argument("--frames", type=int, default=10, metavar="N",
                     help="build/render: (run of N+1 frames - run of 1) / N (default 10)")
     ap.add_argument("-j", "--jobs", type=int, default=2, help="callgrind runs at once (default 2)")
@@ -178,6 +185,8 @@ def main(argv=None):
     bench_dir = BUILD / "bench"
     bench_dir.mkdir(parents=True, exist_ok=True)
     maps = args.map or start_maps()
+    if not args.mode:
+        args.mode = default_mode()
     res = measure(maps, args.mode, args.frames, args.jobs, bench_dir)
     s = summary(maps, res)
     tr, wr = s["things_ratio"], s["world_ratio"]
