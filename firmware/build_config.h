@@ -49,7 +49,7 @@
 #endif
 #define CFG_MODE(bit) ((CFG_RENDER_MODES & (bit)) != 0)
 
-/* Mode columns' visplanes (columns.c), 648 bytes each: any number from 2 works,
+/* Mode columns' visplanes (columns.c), 652 bytes each: any number from 4 works,
  * a full pool is drawn early. */
 #ifndef CFG_COLS_PLANES
 #define CFG_COLS_PLANES 64
@@ -92,6 +92,6 @@ _Static_assert((CFG_FEATURES & ~SCN_NEED_ALL) == 0, "CFG_FEATURES");
 _Static_assert(CFG_DIRECT_FACES >= 1 && CFG_DIRECT_FACES <= 65535 && CFG_DIRECT_EDGES >= 1 && CFG_DIRECT_EDGES <= 65535,
                "CFG_DIRECT_FACES, CFG_DIRECT_EDGES");
 _Static_assert((CFG_RENDER_MODES & 15u) != 0 && (CFG_RENDER_MODES & ~15u) == 0, "CFG_RENDER_MODES");
-_Static_assert(CFG_COLS_PLANES >= 2 && CFG_COLS_PLANES <= 4096, "CFG_COLS_PLANES");
+_Static_assert(CFG_COLS_PLANES >= 4 && CFG_COLS_PLANES <= 4096, "CFG_COLS_PLANES");
 
 #endif

@@ -14,12 +14,14 @@
 #define BACKGROUND_COLOUR 0
 #define NO_ROW 0xFFu /* a visplane column with no rows */
 
-/* A sector's floor or ceiling rows, one run per column (Doom's visplane). */
+/* A sector's floor or ceiling rows, one run per column (Doom's visplane); or
+ * a wall's rows where it is drawn in a flat colour, which row spans fill a
+ * dword at a time. */
 typedef struct {
-    uint32_t sector;
-    uint8_t ceiling;
+    uint32_t id;            /* the surface: RAST_ID of the floor, ceiling or wall side */
+    uint8_t colour;         /* a wall's flat colour */
     int16_t minx, maxx;     /* the columns used lie in [minx, maxx]; none while minx > maxx */
-    uint8_t top[VIEW_W];    /* first row of each column, NO_ROW if none */
+    uint8_t top[VIEW_W];    /* first row of each column of [minx, maxx], NO_ROW if none */
     uint8_t bottom[VIEW_W]; /* one past its last */
 } cols_plane;
 
@@ -215,14 +217,17 @@ static void draw_column(const cols_state *S, int x, int y0, int y1, const tex_pa
 
 static tex_paint plane_paint(const cols_state *S, const cols_plane *p)
 {
-    const scn_sector *sec = &S->sc->sectors[p->sector];
-    uint8_t colour = p->ceiling ? sec->ceil_color : sec->floor_color;
+    if (p->id >> 24 == RAST_KIND_WALL) return tex_flat(p->colour);
+    uint32_t sector = p->id & 0xFFFFFFu;
+    int ceiling = p->id >> 24 == RAST_KIND_CEILING;
+    const scn_sector *sec = &S->sc->sectors[sector];
+    uint8_t colour = ceiling ? sec->ceil_color : sec->floor_color;
 #if CFG_TEXTURES
     if (S->textured) {
-        if (p->ceiling && CFG_SKY && (sec->flags & SCN_SECTOR_SKY)) return tex_sky(S->sc, S->v, colour);
-        const scn_plane *pl = &S->sc->planes[p->sector];
-        int32_t h = p->ceiling ? surf_ceil_now(S->sc, S->ceil, p->sector) : sec->floor_h;
-        return tex_plane(S->sc, S->v, p->ceiling ? pl->ceil_tex : pl->floor_tex, h, sec->light, colour);
+        if (ceiling && CFG_SKY && (sec->flags & SCN_SECTOR_SKY)) return tex_sky(S->sc, S->v, colour);
+        const scn_plane *pl = &S->sc->planes[sector];
+        int32_t h = ceiling ? surf_ceil_now(S->sc, S->ceil, sector) : sec->floor_h;
+        return tex_plane(S->sc, S->v, ceiling ? pl->ceil_tex : pl->floor_tex, h, sec->light, colour);
     }
 #endif
     return tex_flat(colour);
@@ -253,7 +258,7 @@ static void draw_plane(cols_state *S, const cols_plane *p)
 {
     if (p->minx > p->maxx) return;
     tex_paint paint = plane_paint(S, p);
-    uint32_t id = RAST_ID(p->ceiling ? RAST_KIND_CEILING : RAST_KIND_FLOOR, p->sector);
+    uint32_t id = p->id;
     int16_t start[VIEW_H];
     int t1 = 0, b1 = 0; /* the previous column's rows [t1, b1) */
     for (int x = p->minx; x <= p->maxx + 1; x++) {
@@ -278,14 +283,14 @@ static void flush_planes(cols_state *S)
     S->nplanes = 0;
 }
 
-/* The newest visplane of a sector's floor or ceiling if none of columns
- * [c0, c1) is used in it yet, else a new one (Doom's R_CheckPlane). The caller
- * has made room for it. */
-static cols_plane *plane_for(cols_state *S, uint32_t sector, int ceiling, int c0, int c1)
+/* The newest visplane of a surface (and colour) if none of columns [c0, c1) is
+ * used in it yet, else a new one (Doom's R_CheckPlane). The caller has made
+ * room for it. */
+static cols_plane *plane_for(cols_state *S, uint32_t id, uint8_t colour, int c0, int c1)
 {
     for (uint32_t i = S->nplanes; i-- > 0;) {
         cols_plane *p = &S->planes[i];
-        if (p->sector != sector || p->ceiling != ceiling) continue;
+        if (p->id != id || p->colour != colour) continue;
         int lo = c0 > p->minx ? c0 : p->minx, hi = c1 - 1 < p->maxx ? c1 - 1 : p->maxx;
         int x = lo;
         while (x <= hi && p->top[x] == NO_ROW) x++;
@@ -293,33 +298,55 @@ static cols_plane *plane_for(cols_state *S, uint32_t sector, int ceiling, int c0
         break;
     }
     cols_plane *p = &S->planes[S->nplanes++];
-    p->sector = sector;
-    p->ceiling = (uint8_t)ceiling;
+    p->id = id;
+    p->colour = colour;
     p->minx = VIEW_W;
     p->maxx = -1;
-    for (int x = 0; x < VIEW_W; x++) p->top[x] = NO_ROW;
     return p;
 }
 
+/* Column x of a visplane gets rows [y0, y1). Only columns in [minx, maxx] are
+ * ever read, so those the range takes in on the way are marked empty then. */
 static inline void plane_rows(cols_plane *p, int x, int y0, int y1)
 {
+    if (p->minx > p->maxx) {
+        p->minx = p->maxx = (int16_t)x;
+    } else if (x > p->maxx) {
+        for (int i = p->maxx + 1; i < x; i++) p->top[i] = NO_ROW;
+        p->maxx = (int16_t)x;
+    } else if (x < p->minx) {
+        for (int i = x + 1; i < p->minx; i++) p->top[i] = NO_ROW;
+        p->minx = (int16_t)x;
+    }
     p->top[x] = (uint8_t)y0;
     p->bottom[x] = (uint8_t)y1;
-    if (x < p->minx) p->minx = (int16_t)x;
-    if (x > p->maxx) p->maxx = (int16_t)x;
 }
 
 /* ---- a seg ------------------------------------------------------------------------- */
 
 typedef struct {
-    uint32_t sector;    /* the front sector */
-    int two_sided;      /* 0: the wall fills the column between floor and ceiling */
-    int upper, lower;   /* two-sided: an upper wall (or sky step), a lower wall */
-    int sky_step;       /* the upper part is more sky (Doom's sky rule) */
-    tex_paint paint[3]; /* SCN_PART_* */
+    uint32_t sector;     /* the front sector */
+    int two_sided;       /* 0: the wall fills the column between floor and ceiling */
+    int upper, lower;    /* two-sided: an upper wall (or sky step), a lower wall */
+    int sky_step;        /* the upper part is more sky (Doom's sky rule) */
+    tex_paint paint[3];  /* SCN_PART_* */
+    uint8_t as_plane[3]; /* the part is a flat colour: row spans fill it (a visplane) */
+    cols_plane *wall_plane[3];
     uint32_t id;
     cols_plane *ceil_plane, *floor_plane;
 } seg_look;
+
+/* Rows [y0, y1) of column c of a wall part: down the column, or into its visplane. */
+static inline void wall_rows(cols_state *S, seg_look *k, int part, int c, int c0, int c1, int y0, int y1)
+{
+    if (y0 >= y1) return;
+    if (!k->as_plane[part]) {
+        draw_column(S, c, y0, y1, &k->paint[part], k->id);
+        return;
+    }
+    if (!k->wall_plane[part]) k->wall_plane[part] = plane_for(S, k->id, k->paint[part].colour, c0, c1);
+    plane_rows(k->wall_plane[part], c, y0, y1);
+}
 
 static inline int clamp_in(int r, int lo, int hi)
 {
@@ -342,18 +369,18 @@ static void seg_columns(cols_state *S, seg_look *k, int c0, int c1)
             if (!k->two_sided) low = high = ff;
             int ceil_end = k->sky_step ? low : fc;
             if (ceil_end > t) {
-                if (!k->ceil_plane) k->ceil_plane = plane_for(S, k->sector, 1, c0, c1);
+                if (!k->ceil_plane) k->ceil_plane = plane_for(S, RAST_ID(RAST_KIND_CEILING, k->sector), 0, c0, c1);
                 plane_rows(k->ceil_plane, c, t, ceil_end);
             }
             if (ff < b) {
-                if (!k->floor_plane) k->floor_plane = plane_for(S, k->sector, 0, c0, c1);
+                if (!k->floor_plane) k->floor_plane = plane_for(S, RAST_ID(RAST_KIND_FLOOR, k->sector), 0, c0, c1);
                 plane_rows(k->floor_plane, c, ff, b);
             }
             if (!k->two_sided) {
-                draw_column(S, c, fc, ff, &k->paint[SCN_PART_MIDDLE], k->id);
+                wall_rows(S, k, SCN_PART_MIDDLE, c, c0, c1, fc, ff);
             } else {
-                if (!k->sky_step) draw_column(S, c, fc, low, &k->paint[SCN_PART_UPPER], k->id);
-                draw_column(S, c, high, ff, &k->paint[SCN_PART_LOWER], k->id);
+                if (!k->sky_step) wall_rows(S, k, SCN_PART_UPPER, c, c0, c1, fc, low);
+                wall_rows(S, k, SCN_PART_LOWER, c, c0, c1, high, ff);
             }
             S->open_top[c] = (uint8_t)low;
             S->open_bot[c] = (uint8_t)high;
@@ -427,7 +454,11 @@ static void seg(cols_state *S, uint32_t gi, unsigned mask)
     } else {
         k.paint[SCN_PART_MIDDLE] = part(S, g, SCN_PART_MIDDLE, ff, fc, bf, bc, front->light, colour[SCN_PART_MIDDLE]);
     }
-    if (S->nplanes + 2 > CFG_COLS_PLANES) flush_planes(S); /* room for this seg's floor and ceiling */
+    for (int i = 0; i < 3; i++) k.as_plane[i] = !rast_textured_paint(S->t, &k.paint[i]);
+    if (S->nplanes + 4 > CFG_COLS_PLANES) { /* room for this seg's floor, ceiling and two flat walls */
+        flush_planes(S);
+        S->st->flushes++;
+    }
     seg_columns(S, &k, c0, c1);
 }
 

@@ -20,7 +20,7 @@
  * This is exact only for an eye inside the world (eye.h) and without objects
  * in view: other frames are drawn by mode direct, with the same work memory.
  *
- * Memory: the per-column state and CFG_COLS_PLANES visplanes of 648 bytes,
+ * Memory: the per-column state and CFG_COLS_PLANES visplanes of 652 bytes,
  * bounded by the screen; or direct's need, if larger. */
 #ifndef COLUMNS_H
 #define COLUMNS_H

@@ -25,7 +25,8 @@ typedef struct {
     uint32_t object_pass;     /* spans: 1 if the frame ran the object pass (an object was in the frustum) */
     uint32_t overflow;        /* polygons dropped for a full pool: 0 while the scene's bounds hold */
     uint32_t flushes;         /* spans: batches drawn before the last because a pool was full;
-                               * direct: objects whose faces did not fit its pools (worked out again) */
+                               * direct: objects whose faces did not fit its pools (worked out again);
+                               * columns: visplanes drawn early for a full pool, and direct's */
     uint32_t yclip_skipped;   /* polygons inside the top and bottom planes: no y-clipping done */
     uint32_t planes_skipped;  /* floors and ceilings not set up: the eye is level with or beyond them */
     uint32_t fallback;        /* columns: 1 if the frame was drawn by mode direct (objects in view, or the eye

@@ -52,7 +52,7 @@ UART     ?= $(ARM_OUT)/uart.bin
 RUN_ARGS ?=
 FULL     ?=
 FW_MODES ?= columns
-# Mode columns' visplanes (firmware/build_config.h, 648 bytes each): a full pool is
+# Mode columns' visplanes (firmware/build_config.h, 652 bytes each): a full pool is
 # drawn early, nothing is lost.
 COLS_PLANES ?= 16
 # Mode direct's face pools (firmware/build_config.h): small on the board; objects

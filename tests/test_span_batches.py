@@ -1,10 +1,12 @@
-"""Modes spans and direct with pools of a few polygons draw the same frames as with the default pools.
+"""Modes spans, direct and columns with pools of a few polygons draw the same frames as with the default
+pools.
 
 build/tinypools/render is build/render compiled with SPANS_POOL_EDGES=72 and SPANS_POOL_SURFACES=6,
-CFG_DIRECT_FACES=3 and CFG_DIRECT_EDGES=90 (the Makefile): in mode spans nearly every frame fills
-its pools many times, so it is drawn in many batches (firmware/spans.c); in mode direct the faces
-of all but an object or so do not fit, so they are worked out again wherever they are needed
-(firmware/direct.c). Both count these in `flushes`. Over many views of Freedoom maps with their things, and of the space-battle
+CFG_DIRECT_FACES=3 and CFG_DIRECT_EDGES=90, CFG_COLS_PLANES=4 (the Makefile): in mode spans nearly
+every frame fills its pools many times, so it is drawn in many batches (firmware/spans.c); in mode
+direct the faces of all but an object or so do not fit, so they are worked out again wherever they
+are needed (firmware/direct.c); in mode columns nearly every seg finds the visplanes full and draws
+them early (firmware/columns.c). All count these in `flushes`. Over many views of Freedoom maps with their things, and of the space-battle
 tests/scenes/objects.scene at several times, both builds must give the same frame CRC and the same surface-id buffer,
 with overdraw exactly 1.000 and no polygon dropped.
 """
@@ -70,7 +72,7 @@ def compare(tiny, scene, cams, tmp_path, mode):
     return flushes
 
 
-@pytest.mark.parametrize("mode", ["spans", "direct"])
+@pytest.mark.parametrize("mode", ["spans", "direct", "columns"])
 @pytest.mark.parametrize("spec", MAPS)
 def test_tiny_pools_draw_the_same_frames(spec, mode, tmp_path):
     if not (WADDIR / spec.split(":")[0]).exists():
