@@ -144,11 +144,7 @@ static void quad_rows(cols_state *S, view_pt pa, view_pt pb, int32_t hb, int32_t
     for (int c = c0; c < c1; c++) top[c] = bot[c] = miss;
     if (ht <= hb) return;
     clip_poly p;
-    p.n = 4;
-    p.v[0] = view_at_height(v, pa, ht);
-    p.v[1] = view_at_height(v, pb, ht);
-    p.v[2] = view_at_height(v, pb, hb);
-    p.v[3] = view_at_height(v, pa, hb);
+    surf_wall_quad(v, pa, pb, hb, ht, &p);
     if (!clip_polygon(&p, v, mask)) return;
     S->st->polygons++;
     screen_pt s[CLIP_MAX_VERTS];
@@ -462,13 +458,14 @@ static void seg(cols_state *S, uint32_t gi, unsigned mask)
     seg_columns(S, &k, c0, c1);
 }
 
-/* An object whose box touches the leaf the walk has reached takes the rows
- * still open in its screen box (all of them, if its box reaches past the near
- * plane and has no screen bound). */
-static void take_object(cols_state *S, const obj_state *o)
+/* An object the walk takes in (obj_list.h: at the first leaf its box touches)
+ * claims the rows still open in its screen box (all of them, if its box
+ * reaches past the coordinate box and has no screen bound). */
+static void take_object(void *ctx, uint32_t i)
 {
+    cols_state *S = ctx;
     int x0, x1, y0, y1;
-    int got = objd_screen_box(S->sc, o, S->v, &x0, &x1, &y0, &y1);
+    int got = objd_screen_box(S->sc, &S->w->objs[S->objs[i].index], S->v, &x0, &x1, &y0, &y1);
     if (got < 0) return;
     if (got == 0) {
         x0 = y0 = 0;
@@ -482,26 +479,9 @@ static void take_object(cols_state *S, const obj_state *o)
         int a = y0 > S->open_top[x] ? y0 : S->open_top[x], b = y1 < S->open_bot[x] ? y1 : S->open_bot[x];
         if (a >= b) continue;
         uint32_t bit = 1u << (x & 31);
-        for (int y = a; y < b; y++) {
-            r->mask.bits[y][x >> 5] |= bit;
-        }
+        for (int y = a; y < b; y++) r->mask.bits[y][x >> 5] |= bit;
         r->col_any[x >> 5] |= bit;
         r->any = 1;
-    }
-}
-
-static void objects_in_leaf(cols_state *S, uint32_t leaf)
-{
-    const scn_leaf *f = &S->sc->leaves[leaf];
-    int32_t box[BOX_SIDES];
-    uint32_t i;
-    objd_leaf_box(S->sc, f, box);
-    for (uint32_t end = objl_near_leaf(S->objs, S->nobjs, sizeof(objl_entry), box, S->reach, &i); i < end; i++) {
-        objl_entry *o = &S->objs[i];
-        const obj_state *os = &S->w->objs[o->index];
-        if (o->taken || !objd_touches_leaf(S->sc, os, f, box)) continue;
-        o->taken = 1;
-        take_object(S, os);
     }
 }
 
@@ -510,7 +490,7 @@ static int visit_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
     cols_state *S = ctx;
     const scn_leaf *f = &S->sc->leaves[leaf];
     S->st->leaves++;
-    if (S->nobjs) objects_in_leaf(S, leaf);
+    if (S->nobjs) objl_take_in_leaf(S->sc, S->w, leaf, S->objs, S->nobjs, sizeof(objl_entry), S->reach, take_object, S);
     for (uint32_t i = 0; i < f->num_segs && !occ_full(&S->occ); i++) seg(S, f->first_seg + i, clip_mask);
     return occ_full(&S->occ);
 }

@@ -293,24 +293,15 @@ static int object_hidden(const dr_state *S, const obj_state *os)
     return r && cov_box_covered(S->cov, y0, y1, x0, x1);
 }
 
-/* Objects whose box reaches into the leaf become active and are set up, unless
- * already hidden. Only the stretch of the list whose boxes can reach the leaf's
- * west-east extent is looked at. */
-static void activate_objects_in(dr_state *S, uint32_t leaf)
+/* An object the walk takes in (obj_list.h) becomes active and is set up, unless
+ * already hidden: looked at once, hidden now stays hidden. */
+static void take_object(void *ctx, uint32_t i)
 {
-    const scn_leaf *f = &S->sc->leaves[leaf];
-    int32_t box[BOX_SIDES];
-    uint32_t i;
-    objd_leaf_box(S->sc, f, box);
-    for (uint32_t end = objl_near_leaf(S->objs, S->nobjs, sizeof(dr_obj), box, S->reach, &i); i < end; i++) {
-        dr_obj *o = &S->objs[i];
-        const obj_state *os = &S->w->objs[o->e.index];
-        if (o->e.taken || !objd_touches_leaf(S->sc, os, f, box)) continue;
-        o->e.taken = 1; /* looked at once: hidden now stays hidden */
-        if (object_hidden(S, os)) continue;
-        activate(S, o);
-        if (o->e.nfaces) S->active[S->nactive++] = (uint16_t)i;
-    }
+    dr_state *S = ctx;
+    dr_obj *o = &S->objs[i];
+    if (object_hidden(S, &S->w->objs[o->e.index])) return;
+    activate(S, o);
+    if (o->e.nfaces) S->active[S->nactive++] = (uint16_t)i;
 }
 
 /* ---- which surface is nearer ------------------------------------------------------------ */
@@ -515,7 +506,8 @@ static int box_hidden(void *ctx, const screen_pt *pts, int n)
 static int visit_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
 {
     dr_state *S = ctx;
-    if (CFG_OBJECTS && S->nactive < S->nobjs) activate_objects_in(S, leaf);
+    if (CFG_OBJECTS && S->nactive < S->nobjs)
+        objl_take_in_leaf(S->sc, S->w, leaf, S->objs, S->nobjs, sizeof(dr_obj), S->reach, take_object, S);
     surf_leaf(S->sc, S->w, S->v, leaf, clip_mask, &S->sink, S->use_occ ? &S->occ : 0, S->st);
     return cov_full(S->cov);
 }

@@ -69,3 +69,18 @@ uint32_t objl_near_leaf(void *list, uint32_t n, uint32_t size, const int32_t box
     *first = lo;
     return end;
 }
+
+void objl_take_in_leaf(const scene *sc, const world_state *w, uint32_t leaf, void *list, uint32_t n, uint32_t size,
+                       int32_t reach, void (*take)(void *ctx, uint32_t i), void *ctx)
+{
+    const scn_leaf *f = &sc->leaves[leaf];
+    int32_t box[BOX_SIDES];
+    uint32_t i;
+    objd_leaf_box(sc, f, box);
+    for (uint32_t end = objl_near_leaf(list, n, size, box, reach, &i); i < end; i++) {
+        objl_entry *e = objl_at(list, i, size);
+        if (e->taken || !objd_touches_leaf(sc, &w->objs[e->index], f, box)) continue;
+        e->taken = 1;
+        take(ctx, i);
+    }
+}

@@ -40,4 +40,11 @@ uint32_t objl_in_view(const scene *sc, const world_state *w, const view_xform *v
 uint32_t objl_near_leaf(void *list, uint32_t n, uint32_t size, const int32_t box[BOX_SIDES], int32_t reach,
                         uint32_t *first);
 
+/* The walk has reached leaf: calls take(ctx, i) for each record i of list[0 .. n)
+ * not yet taken whose object's box touches the leaf (objd_touches_leaf), after
+ * marking it taken: an object is taken in once, at the first leaf its box
+ * touches. */
+void objl_take_in_leaf(const scene *sc, const world_state *w, uint32_t leaf, void *list, uint32_t n, uint32_t size,
+                       int32_t reach, void (*take)(void *ctx, uint32_t i), void *ctx);
+
 #endif

@@ -107,6 +107,15 @@ int surf_faces_eye(const view_xform *v, const scn_vertex *a, const scn_vertex *b
     return w128_sign_diff((int64_t)b->x - a->x, v->cy - a->y, (int64_t)b->y - a->y, v->cx - a->x) < 0;
 }
 
+void surf_wall_quad(const view_xform *v, view_pt a, view_pt b, int32_t bottom, int32_t top, clip_poly *p)
+{
+    p->n = 4;
+    p->v[0] = view_at_height(v, a, top);
+    p->v[1] = view_at_height(v, b, top);
+    p->v[2] = view_at_height(v, b, bottom);
+    p->v[3] = view_at_height(v, a, bottom);
+}
+
 /* The wall between view points a and b (rotated once per seg) from height
  * bottom to top. */
 static void wall_part(const scene *sc, const view_xform *v, view_pt a, view_pt b, int32_t bottom, int32_t top,
@@ -115,11 +124,7 @@ static void wall_part(const scene *sc, const view_xform *v, view_pt a, view_pt b
 {
     if (top <= bottom) return;
     clip_poly p;
-    p.n = 4;
-    p.v[0] = view_at_height(v, a, top);
-    p.v[1] = view_at_height(v, b, top);
-    p.v[2] = view_at_height(v, b, bottom);
-    p.v[3] = view_at_height(v, a, bottom);
+    surf_wall_quad(v, a, b, bottom, top, &p);
     emit(sc, v, &p, mask, sink, look, id, seg, st);
 }
 

@@ -10,6 +10,7 @@
 #include "objects.h"
 #include "render_stats.h"
 #include "scene.h"
+#include "clip.h"
 #include "texture.h"
 #include "occlusion.h"
 #include "view.h"
@@ -39,6 +40,11 @@ typedef struct {
  * solid walls (one-sided, or a closed door's) close the columns they cover. */
 void surf_leaf(const scene *s, const world_state *w, const view_xform *v, uint32_t leaf, unsigned clip_mask,
                const surf_sink *sink, occ_columns *occ, render_stats *st);
+
+/* The quad of a wall standing on view points a, b (a on the left seen from its
+ * front) from height bottom to top, clockwise on screen from a's top: the one
+ * every mode clips, so that their walls' edges agree. */
+void surf_wall_quad(const view_xform *v, view_pt a, view_pt b, int32_t bottom, int32_t top, clip_poly *p);
 
 /* Front-facing: the eye strictly on the right of a -> b (edge-on is culled).
  * Exact: an eye 1/65536 in front of a wall, looking along it, sees the wall in
