@@ -25,7 +25,7 @@ typedef struct {
     uint8_t bottom[VIEW_W]; /* one past its last */
 } cols_plane;
 
-enum { ROW_CEIL, ROW_FLOOR, ROW_LOW, ROW_HIGH, ROW_UNUSED, ROW_LINES }; /* ROW_UNUSED: a chain not needed */
+enum { ROW_CEIL, ROW_FLOOR, ROW_LOW, ROW_HIGH, ROW_LINES };
 
 /* The pixels objects may show in, which mode direct draws after the walk: the
  * rows still open in each column of an object's screen box when the walk
@@ -48,7 +48,7 @@ typedef struct {
     int textured;
     occ_columns occ;                            /* columns with no row open */
     uint8_t open_top[VIEW_W], open_bot[VIEW_W]; /* rows [top, bot) of each column still open */
-    int16_t rows[ROW_LINES][VIEW_W];            /* the seg in hand: where its lines cross each column */
+    uint8_t rows[ROW_LINES][VIEW_W];            /* the seg in hand: where its lines cross each column */
     cols_region *region;                        /* what is left to the objects */
     const world_state *w;
     objl_entry *objs; /* the objects in view, by west edge (obj_list.h) */
@@ -63,18 +63,13 @@ static uint32_t align8(uint64_t n)
     return (uint32_t)((n + 7u) & ~(uint64_t)7u);
 }
 
-static uint32_t object_count(const world_state *w)
-{
-    return (CFG_OBJECTS && w && w->objs) ? w->n : 0;
-}
-
 /* The work memory: the objects' region, then this mode's state and its list of
  * objects, or direct's. */
 uint32_t cols_work_bytes(const scene *s, const world_state *w)
 {
     uint64_t direct = direct_work_bytes_within(s, w), own = align8(sizeof(cols_state));
     if (direct == 0 || direct_work_bytes(s, w) == 0) return 0;
-    own += align8((uint64_t)object_count(w) * sizeof(objl_entry));
+    own += align8((uint64_t)objl_capacity(w) * sizeof(objl_entry));
     uint64_t total = align8(sizeof(cols_region)) + (direct > own ? direct : own);
     return total > 0xFFFFFFF0u ? 0 : (uint32_t)total;
 }
@@ -97,7 +92,7 @@ static inline int clamp_row(int64_t r)
  * the edge's y there by an exact DDA (floor, 16.16), sampled as the fill rule
  * samples rows. Screen points are inside [0, 320] x [0, 200] (clip.h), so the
  * products stay below 2^50. */
-static void edge_rows(screen_pt a, screen_pt b, int c0, int c1, int16_t *rows)
+static void edge_rows(screen_pt a, screen_pt b, int c0, int c1, uint8_t *rows)
 {
     int c = rast_first_sample(a.x), end = rast_first_sample(b.x);
     if (c < c0) c = c0;
@@ -121,7 +116,7 @@ static void edge_rows(screen_pt a, screen_pt b, int c0, int c1, int16_t *rows)
         srem = (uint32_t)(dy * 65536 - s * dx);
     }
     for (; c < end; c++) {
-        rows[c] = (int16_t)clamp_row(fx_asr64((int64_t)y + 32767, 16));
+        rows[c] = (uint8_t)clamp_row(fx_asr64((int64_t)y + 32767, 16));
         y = (int32_t)((uint32_t)y + (uint32_t)step);
         rem += srem;
         if (rem >= (uint32_t)dx) {
@@ -134,14 +129,17 @@ static void edge_rows(screen_pt a, screen_pt b, int c0, int c1, int16_t *rows)
 /* Where the wall quad from height hb to ht over view points pa, pb meets each
  * column of [c0, c1): top[c] its first row, bot[c] one past its last (clipped
  * and projected as every mode clips it, its upper chain walked into top and its
- * lower chain into bot). A column the clipped quad misses lies wholly above the
- * screen (a quad above the eye) or below it. */
+ * lower chain into bot; either may be NULL: not needed). A column the clipped
+ * quad misses lies wholly above the screen (a quad above the eye) or below it. */
 static void quad_rows(cols_state *S, view_pt pa, view_pt pb, int32_t hb, int32_t ht, unsigned mask, int c0, int c1,
-                      int16_t *top, int16_t *bot)
+                      uint8_t *top, uint8_t *bot)
 {
     const view_xform *v = S->v;
-    int16_t miss = (int16_t)(hb >= v->cz ? 0 : (ht <= v->cz ? VIEW_H : clamp_row(VIEW_CY + VIEW_LOOK(v))));
-    for (int c = c0; c < c1; c++) top[c] = bot[c] = miss;
+    uint8_t miss = (uint8_t)(hb >= v->cz ? 0 : (ht <= v->cz ? VIEW_H : clamp_row(VIEW_CY + VIEW_LOOK(v))));
+    for (int c = c0; c < c1; c++) {
+        if (top) top[c] = miss;
+        if (bot) bot[c] = miss;
+    }
     if (ht <= hb) return;
     clip_poly p;
     surf_wall_quad(v, pa, pb, hb, ht, &p);
@@ -151,9 +149,9 @@ static void quad_rows(cols_state *S, view_pt pa, view_pt pb, int32_t hb, int32_t
     clip_project(v, &p, s);
     for (int i = 0; i < p.n; i++) { /* clockwise on screen: rightwards along the top, leftwards along the bottom */
         screen_pt a = s[i], b = s[i + 1 == p.n ? 0 : i + 1];
-        if (a.x < b.x)
+        if (a.x < b.x && top)
             edge_rows(a, b, c0, c1, top);
-        else if (a.x > b.x)
+        else if (a.x > b.x && bot)
             edge_rows(b, a, c0, c1, bot);
     }
 }
@@ -438,13 +436,13 @@ static void seg(cols_state *S, uint32_t gi, unsigned mask)
             k.upper = 1;
             k.sky_step = CFG_SKY && (front->flags & back->flags & SCN_SECTOR_SKY);
             int32_t low = bc > ff ? bc : ff;
-            quad_rows(S, pa, pb, low, fc, mask, c0, c1, S->rows[ROW_UNUSED], S->rows[ROW_LOW]);
+            quad_rows(S, pa, pb, low, fc, mask, c0, c1, 0, S->rows[ROW_LOW]);
             k.paint[SCN_PART_UPPER] = part(S, g, SCN_PART_UPPER, ff, fc, bf, bc, front->light, colour[SCN_PART_UPPER]);
         }
         if (CFG_HEIGHTS && bf > ff) {
             k.lower = 1;
             int32_t high = bf < fc ? bf : fc;
-            quad_rows(S, pa, pb, ff, high, mask, c0, c1, S->rows[ROW_HIGH], S->rows[ROW_UNUSED]);
+            quad_rows(S, pa, pb, ff, high, mask, c0, c1, S->rows[ROW_HIGH], 0);
             k.paint[SCN_PART_LOWER] = part(S, g, SCN_PART_LOWER, ff, fc, bf, bc, front->light, colour[SCN_PART_LOWER]);
         }
     } else {

@@ -73,16 +73,11 @@ static uint32_t align8(uint64_t n)
     return (uint32_t)((n + 7u) & ~(uint64_t)7u);
 }
 
-static uint32_t object_count(const world_state *w)
-{
-    return (CFG_OBJECTS && w && (w->objs || w->n)) ? w->n : 0;
-}
-
 /* The work memory: the state, the objects' records and pools, and the mask
  * unless the caller lends one. */
 static uint32_t work_bytes(const world_state *w, int own_mask)
 {
-    uint32_t n = object_count(w);
+    uint32_t n = objl_capacity(w);
     if (n > SCN_MAX_OBJECTS) return 0; /* more than the format allows (an object record holds 16 bits): refuse */
     uint64_t total = align8(sizeof(dr_state)) + (own_mask ? align8(sizeof(cov_mask)) : 0);
     if (n)
@@ -554,7 +549,7 @@ void direct_render_within(const scene *sc, const world_state *w, const view_xfor
     uint8_t *mem = work;
     dr_state *S = (dr_state *)(void *)mem;
     mem += align8(sizeof(dr_state));
-    uint32_t n = object_count(w);
+    uint32_t n = objl_capacity(w);
     S->objs = (dr_obj *)(void *)mem;
     mem += n ? align8((uint64_t)n * sizeof(dr_obj)) : 0;
     S->active = (uint16_t *)(void *)mem;

@@ -28,6 +28,13 @@ static inline objl_entry *objl_at(void *list, uint32_t i, uint32_t size)
     return (objl_entry *)(void *)((uint8_t *)list + (uint64_t)i * size);
 }
 
+/* The most objects a frame may list: all of w's. A world state of n objects
+ * with no states yet (objs NULL: a build sizing its work memory) counts as n. */
+static inline uint32_t objl_capacity(const world_state *w)
+{
+    return (CFG_OBJECTS && w && (w->objs || w->n)) ? w->n : 0;
+}
+
 /* The objects of w in the view frustum into list (records of size bytes, zero
  * but for their objl_entry, room for w->n), sorted by west edge; returns how
  * many. *reach: the widest box's half width in whole units (0 if none). */

@@ -173,7 +173,7 @@ def test_render_link_sends_one_keyframe_that_decodes_to_its_frame(tmp_path, flat
     assert link["bytes"] == decoder.counters["bytes"]
     assert link["acks"] == 1
     info = frame["info"]
-    assert info["crc32"] == j["crc32"] and info["mode"] == ["spans", "painter", "direct"].index(j["mode"])  # render.h
+    assert info["crc32"] == j["crc32"] and info["mode"] == ["spans", "painter", "direct", "columns"].index(j["mode"])  # render.h
     assert j["textured"] == (0 if flat else 1)
     # the hello names the scene as given and the CRC-32 of the blob it compiles to
     blob = tmp_path / "scene.bsc"

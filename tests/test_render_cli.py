@@ -31,7 +31,7 @@ def test_json_counters_and_camera_echo(compiled):
     assert j["camera"]["x"] == round(100.3 * 65536) / 65536
     assert j["camera"]["y"] == -20.5
     assert j["camera"]["angle"] == 33.25
-    assert j["mode"] == "direct" and j["present"] == "flip"
+    assert j["mode"] == "columns" and j["present"] == "flip"  # the defaults
     assert len(j["crc32"]) == 8
 
 
