@@ -128,7 +128,7 @@ def test_frames_stream_and_match_the_host_renderer(raw_firmware, tmp_path):
     assert len(set(palette)) > 16
     for info, pixels in frames:
         assert zlib.crc32(pixels) == info["crc32"]
-        assert (info["mode"], info["present"]) == (2, 0)  # direct (render.h: RENDER_DIRECT), flip
+        assert (info["mode"], info["present"]) == (3, 0)  # columns (render.h: RENDER_COLUMNS), flip
     assert frames[0][0]["crc32"] == frames[1][0]["crc32"]  # the path starts standing still
     assert len({info["crc32"] for info, _ in frames}) > 90  # then moves
     # the messages also go to the UART, as text outside the frames
