@@ -17,11 +17,20 @@
  * row), or earlier when the pool of planes is full: every pixel is still
  * written exactly once.
  *
- * This is exact only for an eye inside the world (eye.h) and without objects
- * in view: other frames are drawn by mode direct, with the same work memory.
+ * Walls in a flat colour go to visplanes too, so that row spans fill them a
+ * dword at a time.
  *
- * Memory: the per-column state and CFG_COLS_PLANES visplanes of 652 bytes,
- * bounded by the screen; or direct's need, if larger. */
+ * Objects: an object is taken in at the first leaf of the walk its box touches
+ * (obj_list.h, as mode direct does) and claims the rows still open in its screen
+ * box; the world drawn before is in front of it by the tree's order. The
+ * claimed pixels are drawn after the walk by mode direct alone
+ * (direct_render_within), which sorts objects and world there exactly. The
+ * gap rule needs an eye inside the world (eye.h): other frames are drawn by
+ * mode direct whole, with the same work memory (render_stats.fallback).
+ *
+ * Memory: the objects' pixel mask, then the per-column state, CFG_COLS_PLANES
+ * visplanes of 652 bytes and the objects in view, or direct's need if larger
+ * (docs/needs.md); bounded by the screen and the objects, never by the map. */
 #ifndef COLUMNS_H
 #define COLUMNS_H
 
