@@ -38,9 +38,9 @@ uint32_t objl_in_view(const scene *sc, const world_state *w, const view_xform *v
         if (o->model >= sc->nmodels || !objd_in_view(sc, o, v)) continue;
         int32_t r = (sc->models[o->model].radius >> 16) + 1; /* whole units, rounded up */
         if (r > *reach) *reach = r;
-        uint8_t *rec = (uint8_t *)objl_at(list, n++, size);
-        for (uint32_t k = 0; k < size; k++) rec[k] = 0;
-        *(objl_entry *)(void *)rec = (objl_entry){(int32_t)((o->x >> 16) - r), (uint16_t)i};
+        uint32_t *rec = (uint32_t *)(void *)objl_at(list, n++, size);
+        for (uint32_t k = 0; k < size / 4; k++) rec[k] = 0;
+        *(objl_entry *)(void *)rec = (objl_entry){(int32_t)((o->x >> 16) - r), (uint16_t)i, 0, 0};
     }
     for (uint32_t i = n / 2; i-- > 0;) sift_down(list, i, n, size);
     for (uint32_t end = n; end-- > 1;) {
@@ -50,24 +50,18 @@ uint32_t objl_in_view(const scene *sc, const world_state *w, const view_xform *v
     return n;
 }
 
-uint32_t objl_near_leaf(void *list, uint32_t n, uint32_t size, const int32_t box[BOX_SIDES], int32_t reach,
-                        uint32_t *first)
+/* The first record whose west edge is at or east of x (the list is sorted by it). */
+static uint32_t first_at_or_east(void *list, uint32_t n, uint32_t size, int32_t x)
 {
-    *first = n;
-    if (box[BOX_LEFT] > box[BOX_RIGHT]) return n;
-    int32_t west = (box[BOX_LEFT] >> 16) - 2 * reach - 1, east = box[BOX_RIGHT] >> 16;
-    uint32_t lo = 0, hi = n; /* the first record whose west edge is at or east of west */
+    uint32_t lo = 0, hi = n;
     while (lo < hi) {
         uint32_t mid = lo + (hi - lo) / 2;
-        if (objl_at(list, mid, size)->left < west)
+        if (objl_at(list, mid, size)->left < x)
             lo = mid + 1;
         else
             hi = mid;
     }
-    uint32_t end = lo;
-    while (end < n && objl_at(list, end, size)->left <= east) end++;
-    *first = lo;
-    return end;
+    return lo;
 }
 
 void objl_take_in_leaf(const scene *sc, const world_state *w, uint32_t leaf, void *list, uint32_t n, uint32_t size,
@@ -75,9 +69,11 @@ void objl_take_in_leaf(const scene *sc, const world_state *w, uint32_t leaf, voi
 {
     const scn_leaf *f = &sc->leaves[leaf];
     int32_t box[BOX_SIDES];
-    uint32_t i;
     objd_leaf_box(sc, f, box);
-    for (uint32_t end = objl_near_leaf(list, n, size, box, reach, &i); i < end; i++) {
+    if (box[BOX_LEFT] > box[BOX_RIGHT]) return;
+    /* only the stretch of the list whose boxes can reach the leaf's west-east extent */
+    int32_t west = (box[BOX_LEFT] >> 16) - 2 * reach - 1, east = box[BOX_RIGHT] >> 16;
+    for (uint32_t i = first_at_or_east(list, n, size, west); i < n && objl_at(list, i, size)->left <= east; i++) {
         objl_entry *e = objl_at(list, i, size);
         if (e->taken || !objd_touches_leaf(sc, &w->objs[e->index], f, box)) continue;
         e->taken = 1;

@@ -41,12 +41,6 @@ static inline uint32_t objl_capacity(const world_state *w)
 uint32_t objl_in_view(const scene *sc, const world_state *w, const view_xform *v, void *list, uint32_t size,
                       int32_t *reach);
 
-/* The records of list[0 .. n) whose boxes may reach the leaf with box (objd_leaf_box's):
- * [*first, n) up to the first whose west edge lies past the leaf's east edge,
- * which is the end returned. Returns *first == end for an empty leaf box. */
-uint32_t objl_near_leaf(void *list, uint32_t n, uint32_t size, const int32_t box[BOX_SIDES], int32_t reach,
-                        uint32_t *first);
-
 /* The walk has reached leaf: calls take(ctx, i) for each record i of list[0 .. n)
  * not yet taken whose object's box touches the leaf (objd_touches_leaf), after
  * marking it taken: an object is taken in once, at the first leaf its box
