@@ -51,19 +51,25 @@ static inline __attribute__((always_inline)) int walk(const scene *s, const walk
 {
     uint32_t stack[WALK_STACK_MAX];
     uint8_t states[WALK_STACK_MAX];
+    uint16_t depths[WALK_STACK_MAX]; /* each entry's depth in the tree */
     int sp = 0;
     walk_stats local;
     if (!st) st = &local;
     st->nodes = st->boxes_culled = st->boxes_hidden = 0;
     if (s->nleaves == 0) return 0;
     stack[sp] = s->root;
+    depths[sp] = 0;
     states[sp++] = (uint8_t)state;
+    uint32_t back_to = 0;
     while (sp > 0) {
         sp--;
         uint32_t n = stack[sp];
-        unsigned in = states[sp];
+        unsigned in = states[sp], depth = depths[sp];
+        if (depth < back_to) back_to = depth;
         if (rules->stop && sp > 0 && rules->stop(ctx)) return 1;
         if (n & SCN_LEAF_BIT) {
+            st->back_to = back_to;
+            back_to = UINT32_MAX;
             if (rules->leaf(rules->leaf_ctx, n & ~SCN_LEAF_BIT, in)) return 1;
             continue;
         }
@@ -77,12 +83,14 @@ static inline __attribute__((always_inline)) int walk(const scene *s, const walk
         if (sp + 2 > WALK_STACK_MAX) return 0; /* unreachable for a validated scene */
         if (m2 >= 0) {
             stack[sp] = node->child[second];
+            depths[sp] = (uint16_t)(depth + 1);
             states[sp++] = (uint8_t)m2;
         } else {
             st->boxes_culled++;
         }
         if (m1 >= 0) {
             stack[sp] = node->child[first];
+            depths[sp] = (uint16_t)(depth + 1);
             states[sp++] = (uint8_t)m1;
         } else {
             st->boxes_culled++;
@@ -104,6 +112,8 @@ typedef struct {
     walk_order order;
     const occ_columns *occ; /* may be NULL */
     walk_stats *st;
+    void (*hidden)(void *ctx, const int32_t box[BOX_SIDES]); /* may be NULL */
+    void *ctx;
 } frustum_walk;
 
 static int frustum_first(void *ctx, const scn_node *node)
@@ -122,6 +132,7 @@ static int frustum_box(void *ctx, const int32_t box[BOX_SIDES], unsigned mask)
         occ_box_columns(f->v, box, &x0, &x1);
         if (occ_hidden(f->occ, x0, x1)) {
             f->st->boxes_hidden++;
+            if (f->hidden) f->hidden(f->ctx, box);
             return -1;
         }
     }
@@ -137,8 +148,14 @@ static int frustum_full(void *ctx)
 void walk_tree(const scene *s, const view_xform *v, walk_order order, walk_visit visit, void *ctx,
                const occ_columns *occ, walk_stats *st)
 {
+    walk_tree_hidden(s, v, order, visit, ctx, occ, st, 0);
+}
+
+void walk_tree_hidden(const scene *s, const view_xform *v, walk_order order, walk_visit visit, void *ctx,
+                      const occ_columns *occ, walk_stats *st, void (*hidden)(void *ctx, const int32_t box[BOX_SIDES]))
+{
     walk_stats local;
-    frustum_walk f = {v, {{0}}, order, occ, st ? st : &local};
+    frustum_walk f = {v, {{0}}, order, occ, st ? st : &local, hidden, ctx};
     const walk_rules rules = {frustum_first, frustum_box, visit, ctx, occ ? frustum_full : 0};
     frustum_planes(v, f.planes);
     walk(s, &rules, &f, CLIP_ALL, f.st);

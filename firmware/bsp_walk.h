@@ -29,6 +29,11 @@ typedef struct {
     uint32_t nodes;        /* nodes visited */
     uint32_t boxes_culled; /* subtrees rejected by their bounding box */
     uint32_t boxes_hidden; /* subtrees behind closed columns (walk_tree) */
+    /* Set before each leaf is handed to the visitor: the shallowest tree depth
+     * (the root's children: 1) of the subtrees the walk entered since the leaf
+     * before. A walk visits a subtree's leaves one after another, so a subtree
+     * whose root is at depth d is done once a leaf comes with back_to <= d. */
+    uint32_t back_to;
 } walk_stats;
 
 /* What a walk_boxes walk asks its caller: first, box and stop get the ctx
@@ -56,5 +61,11 @@ int walk_boxes(const scene *s, const walk_rules *rules, void *ctx, unsigned stat
  * front to back only): subtrees whose boxes fall in closed columns are skipped. */
 void walk_tree(const scene *s, const view_xform *v, walk_order order, walk_visit visit, void *ctx,
                const occ_columns *occ, walk_stats *st);
+
+/* walk_tree, also telling hidden(ctx, box) of each subtree skipped behind closed
+ * columns, no later than its leaves would have come (the sibling walked second
+ * is told of before the first is walked). */
+void walk_tree_hidden(const scene *s, const view_xform *v, walk_order order, walk_visit visit, void *ctx,
+                      const occ_columns *occ, walk_stats *st, void (*hidden)(void *ctx, const int32_t box[BOX_SIDES]));
 
 #endif

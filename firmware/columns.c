@@ -28,10 +28,10 @@ typedef struct {
 enum { ROW_CEIL, ROW_FLOOR, ROW_LOW, ROW_HIGH, ROW_LINES };
 
 /* The pixels objects may show in, which mode direct draws after the walk: the
- * rows still open in each column of an object's screen box when the walk
- * reaches the first leaf its box touches. The world drawn before is in front of
- * it (the tree's order, as in mode direct); what is left open there is the
- * objects' and direct's. */
+ * pixels of an object's faces still open when the walk reaches the first leaf
+ * its box touches. The walls drawn before are in front of it (the tree's order,
+ * as in mode direct); what is left open there is the objects' and direct's, with
+ * whatever of the world comes in front of them. */
 typedef struct {
     cov_mask mask;               /* set: left to direct */
     uint32_t col_any[COV_WORDS]; /* the columns it has set in, a bit each */
@@ -54,6 +54,9 @@ typedef struct {
     objl_entry *objs; /* the objects in view, by west edge (obj_list.h) */
     uint32_t nobjs;
     int32_t reach;
+    uint32_t *claimed; /* a bit per object of w: it claimed a pixel (the rest are hidden) */
+    int claimed_any;   /* the object in hand claimed a pixel */
+    int whole_rows;    /* an object claimed whole rows, not its faces */
     uint32_t nplanes;
     cols_plane planes[CFG_COLS_PLANES];
 } cols_state;
@@ -63,14 +66,20 @@ static uint32_t align8(uint64_t n)
     return (uint32_t)((n + 7u) & ~(uint64_t)7u);
 }
 
-/* The work memory: the objects' region, then this mode's state and its list of
- * objects, or direct's. */
+/* The objects that claimed pixels: a bit per object of w. */
+static uint32_t claimed_bytes(const world_state *w)
+{
+    return align8(((uint64_t)objl_capacity(w) + 31u) / 32u * 4u);
+}
+
+/* The work memory: the objects' region and which objects claimed pixels, then
+ * this mode's state and its list of objects, or direct's. */
 uint32_t cols_work_bytes(const scene *s, const world_state *w)
 {
     uint64_t direct = direct_work_bytes_within(s, w), own = align8(sizeof(cols_state));
     if (direct == 0 || direct_work_bytes(s, w) == 0) return 0;
     own += align8((uint64_t)objl_capacity(w) * sizeof(objl_entry));
-    uint64_t total = align8(sizeof(cols_region)) + (direct > own ? direct : own);
+    uint64_t total = align8(sizeof(cols_region)) + claimed_bytes(w) + (direct > own ? direct : own);
     return total > 0xFFFFFFF0u ? 0 : (uint32_t)total;
 }
 
@@ -456,31 +465,41 @@ static void seg(cols_state *S, uint32_t gi, unsigned mask)
     seg_columns(S, &k, c0, c1);
 }
 
+/* One row of an object's face: the pixels of it still open are left to the objects. */
+static void claim_row(void *ctx, int y, int x0, int x1)
+{
+    cols_state *S = ctx;
+    cols_region *r = S->region;
+    for (int x = x0; x < x1; x++) {
+        if (y < S->open_top[x] || y >= S->open_bot[x]) continue;
+        uint32_t bit = 1u << (x & 31);
+        r->mask.bits[y][x >> 5] |= bit;
+        r->col_any[x >> 5] |= bit;
+        r->any = 1;
+        S->claimed_any = 1;
+    }
+}
+
 /* An object the walk takes in (obj_list.h: at the first leaf its box touches)
- * claims the rows still open in its screen box (all of them, if its box
- * reaches past the coordinate box and has no screen bound). */
+ * claims the pixels of its faces whose rows are still open: mode direct draws
+ * them after the walk, the object or whatever of the world is in front of it.
+ * Nothing behind it shows there, so direct's walk ends at the object. An object
+ * whose box reaches past the coordinate box claims every open row instead. */
 static void take_object(void *ctx, uint32_t i)
 {
     cols_state *S = ctx;
     int x0, x1, y0, y1;
-    int got = objd_screen_box(S->sc, &S->w->objs[S->objs[i].index], S->v, &x0, &x1, &y0, &y1);
+    uint32_t obj = S->objs[i].index;
+    int got = objd_screen_box(S->sc, &S->w->objs[obj], S->v, &x0, &x1, &y0, &y1);
     if (got < 0) return;
-    if (got == 0) {
-        x0 = y0 = 0;
-        x1 = VIEW_W;
-        y1 = VIEW_H;
+    S->claimed_any = 0;
+    if (got > 0) {
+        direct_object_rows(S->sc, S->w, S->v, obj, claim_row, S);
+    } else {
+        for (int y = 0; y < VIEW_H; y++) claim_row(S, y, 0, VIEW_W);
+        S->whole_rows = 1;
     }
-    cols_region *r = S->region;
-    x0 = x0 < 0 ? 0 : x0;
-    x1 = x1 > VIEW_W ? VIEW_W : x1;
-    for (int x = x0; x < x1; x++) {
-        int a = y0 > S->open_top[x] ? y0 : S->open_top[x], b = y1 < S->open_bot[x] ? y1 : S->open_bot[x];
-        if (a >= b) continue;
-        uint32_t bit = 1u << (x & 31);
-        for (int y = a; y < b; y++) r->mask.bits[y][x >> 5] |= bit;
-        r->col_any[x >> 5] |= bit;
-        r->any = 1;
-    }
+    if (S->claimed_any) S->claimed[obj >> 5] |= 1u << (obj & 31);
 }
 
 static int visit_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
@@ -516,6 +535,9 @@ void cols_render(const scene *sc, const world_state *w, const view_xform *v, con
     uint8_t *mem = work;
     cols_region *region = work;
     mem += align8(sizeof(cols_region));
+    uint32_t *claimed = (uint32_t *)(void *)mem, nclaimed = claimed_bytes(w);
+    for (uint32_t i = 0; i < nclaimed / 4u; i++) claimed[i] = 0;
+    mem += nclaimed;
     cols_state *S = (cols_state *)(void *)mem;
     S->sc = sc;
     S->w = w;
@@ -525,6 +547,8 @@ void cols_render(const scene *sc, const world_state *w, const view_xform *v, con
     S->ceil = w ? w->ceil : 0;
     S->textured = CFG_TEXTURES && sc->look && !t->flat;
     S->region = region;
+    S->claimed = claimed;
+    S->whole_rows = 0;
     region_clear(region);
     S->objs = (objl_entry *)(void *)(mem + align8(sizeof(cols_state)));
     S->nobjs = objl_in_view(sc, w, v, S->objs, sizeof(objl_entry), &S->reach);
@@ -541,8 +565,9 @@ void cols_render(const scene *sc, const world_state *w, const view_xform *v, con
     for (int c = 0; c < VIEW_W; c++) /* what no wall's column reached: the background */
         draw_column(S, c, S->open_top[c], S->open_bot[c], &background, RAST_ID(RAST_KIND_NONE, 0));
     uint32_t nodes = ws.nodes, culled = ws.boxes_culled + ws.boxes_hidden;
-    if (region->any) /* the objects and the world about them, exactly, by mode direct */
-        direct_render_within(sc, w, v, t, st, mem, work_bytes - align8(sizeof(cols_region)), &region->mask);
+    if (region->any) /* the objects, and the world in front of them, exactly, by mode direct */
+        direct_render_within(sc, w, v, t, st, mem, work_bytes - (uint32_t)(mem - (uint8_t *)work), &region->mask,
+                             S->whole_rows ? 0 : claimed);
     st->nodes += nodes;
     st->boxes_culled += culled;
 }

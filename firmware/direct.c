@@ -36,17 +36,17 @@ typedef struct {
 } dr_face;
 
 typedef struct {
-    objl_entry e;                 /* the object, the west edge of its box (obj_list.h); e.nfaces: faces facing the
-                                 * eye and on screen (SCN_MAX_MODEL_FACES fits) */
-    uint16_t x0 : 15, stored : 1; /* screen box of its faces: pixels [x0, x1) x [y0, y1); stored: its faces are in
-                                   * the pools */
-    uint16_t x1 : 15, drew : 1;   /* drew: it wrote a pixel */
-    uint8_t y0, y1;
+    objl_entry e; /* the object, the west edge of its box (obj_list.h); e.nfaces: faces facing the eye and on
+                   * screen (SCN_MAX_MODEL_FACES fits) */
+    /* screen box of its faces: pixels [x0, x1) x [y0, y1); stored: its faces are in the pools; drew: it wrote a
+     * pixel */
+    uint32_t x0 : 9, x1 : 9, y0 : 8, stored : 1, drew : 1;
+    uint8_t y1;
+    uint8_t subtree;     /* objd_subtree_depth, at most 255: the walk is done with it once back_to is no deeper */
     uint16_t first_face; /* stored: its faces in the pool */
 } dr_obj;
 
-_Static_assert(SCN_MAX_MODEL_FACES <= 255 && VIEW_H <= 255 && VIEW_W < 32768 && sizeof(dr_obj) == 16,
-               "dr_obj's fields");
+_Static_assert(SCN_MAX_MODEL_FACES <= 255 && VIEW_H <= 255 && VIEW_W < 512 && sizeof(dr_obj) == 16, "dr_obj's fields");
 
 typedef struct {
     const scene *sc;
@@ -66,6 +66,9 @@ typedef struct {
     dr_edge *edges;
     dr_face scratch_face; /* a face of an object the pools could not hold */
     dr_edge scratch_edges[FACE_EDGES];
+    const walk_stats *walk; /* the walk's, for back_to */
+    int faces_only;         /* direct_render_within's objects given: the world matters only in front of them */
+    int32_t low, high;      /* faces_only: the lowest and highest point of the objects listed */
 } dr_state;
 
 static uint32_t align8(uint64_t n)
@@ -136,14 +139,12 @@ static int face_row(const dr_face *f, const dr_edge *edges, int y, int *a, int *
 
 /* Face fi of the object's model, if it faces the eye and shows: its plane, rows
  * and edges (into edges[], at most FACE_EDGES). */
-static int face_build(const dr_state *S, const dr_obj *o, const view_pt *verts, uint32_t fi, dr_face *f, dr_edge *edges,
-                      screen_pt box[2])
+static int face_build(const scene *sc, const view_xform *v, const scn_model *m, uint32_t obj, const view_pt *verts,
+                      uint32_t fi, dr_face *f, dr_edge *edges, screen_pt box[2])
 {
-    const scene *sc = S->sc;
-    const scn_model *m = &sc->models[S->w->objs[o->e.index].model];
     screen_pt pts[CLIP_MAX_VERTS];
     if (!objd_face_plane(sc, m, fi, verts, &f->pl)) return 0;
-    int n = objd_face_screen(sc, m, fi, verts, S->v, pts);
+    int n = objd_face_screen(sc, m, fi, verts, v, pts);
     if (!n) return 0;
     int ne = 0, top = VIEW_H, bottom = 0;
     for (int i = 0; i < n; i++) {
@@ -173,7 +174,7 @@ static int face_build(const dr_state *S, const dr_obj *o, const view_pt *verts, 
         if (verts[ix[k]].z > f->zmax) f->zmax = verts[ix[k]].z;
     }
     f->colour = sc->faces[fi].colour;
-    f->obj = o->e.index;
+    f->obj = obj;
     f->model_face = fi;
     return 1;
 }
@@ -197,8 +198,26 @@ static void each_face(dr_state *S, dr_obj *o, face_visit visit, void *ctx)
     screen_pt box[2];
     objd_transform(sc, &S->w->objs[o->e.index], S->v, verts);
     for (uint32_t fi = m->first_face; fi < m->first_face + m->num_faces; fi++)
-        if (face_build(S, o, verts, fi, &S->scratch_face, S->scratch_edges, box))
+        if (face_build(sc, S->v, m, o->e.index, verts, fi, &S->scratch_face, S->scratch_edges, box))
             visit(S, o, &S->scratch_face, S->scratch_edges, ctx);
+}
+
+void direct_object_rows(const scene *sc, const world_state *w, const view_xform *v, uint32_t obj,
+                        void (*row)(void *ctx, int y, int x0, int x1), void *ctx)
+{
+    const scn_model *m = &sc->models[w->objs[obj].model];
+    view_pt verts[CFG_MODEL_VERTS];
+    screen_pt box[2] = {{0, 0}, {0, 0}};
+    dr_face f;
+    dr_edge edges[FACE_EDGES];
+    objd_transform(sc, &w->objs[obj], v, verts);
+    for (uint32_t fi = m->first_face; fi < m->first_face + m->num_faces; fi++) {
+        if (!face_build(sc, v, m, obj, verts, fi, &f, edges, box)) continue;
+        for (int y = f.top; y < f.bottom; y++) {
+            int a, b;
+            if (face_row(&f, edges, y, &a, &b)) row(ctx, y, a, b);
+        }
+    }
 }
 
 /* Room in the pools: an active object whose screen box is wholly drawn can show
@@ -243,7 +262,7 @@ static void activate(dr_state *S, dr_obj *o)
     objd_transform(sc, &S->w->objs[o->e.index], S->v, verts);
     for (uint32_t fi = m->first_face; fi < m->first_face + m->num_faces; fi++) {
         dr_face *f = &S->scratch_face;
-        if (!face_build(S, o, verts, fi, f, S->scratch_edges, box)) continue;
+        if (!face_build(sc, S->v, m, o->e.index, verts, fi, f, S->scratch_edges, box)) continue;
         /* into the pools if the face and its own edges fit, after making room if
          * the first face does not */
         if (nf == 0 && !(S->nfaces < DIRECT_FACE_POOL && ne + f->nedges <= DIRECT_EDGE_POOL)) {
@@ -270,9 +289,9 @@ static void activate(dr_state *S, dr_obj *o)
     if (!nf) return;
     int x0 = rast_first_sample(box[0].x) - 1, x1 = rast_first_sample(box[1].x) + 1;
     int y0 = rast_first_sample(box[0].y) - 1, y1 = rast_first_sample(box[1].y) + 1;
-    o->x0 = (uint16_t)(x0 < 0 ? 0 : x0);
-    o->x1 = (uint16_t)(x1 > VIEW_W ? VIEW_W : x1);
-    o->y0 = (uint8_t)(y0 < 0 ? 0 : y0);
+    o->x0 = (uint32_t)(x0 < 0 ? 0 : (x0 > VIEW_W ? VIEW_W : x0));
+    o->x1 = (uint32_t)(x1 > VIEW_W ? VIEW_W : x1);
+    o->y0 = (uint32_t)(y0 < 0 ? 0 : (y0 > VIEW_H ? VIEW_H : y0));
     o->y1 = (uint8_t)(y1 > VIEW_H ? VIEW_H : y1);
 }
 
@@ -294,9 +313,22 @@ static void take_object(void *ctx, uint32_t i)
 {
     dr_state *S = ctx;
     dr_obj *o = &S->objs[i];
-    if (object_hidden(S, &S->w->objs[o->e.index])) return;
+    const obj_state *os = &S->w->objs[o->e.index];
+    if (object_hidden(S, os)) return;
+    uint32_t depth = objd_subtree_depth(S->sc, os);
+    o->subtree = (uint8_t)(depth > 255 ? 255 : depth); /* shallower: done later, never early */
     activate(S, o);
     if (o->e.nfaces) S->active[S->nactive++] = (uint16_t)i;
+}
+
+/* With the objects' faces only, a subtree the walk skips (its columns hold no
+ * pixel to draw) may hold the leaf where an object would have been met: the
+ * objects its box meets are taken in now, so that the walls met before the
+ * object's next leaf are still weighed against it. Early is exact, only slower. */
+static void take_in_hidden(void *ctx, const int32_t box[BOX_SIDES])
+{
+    dr_state *S = ctx;
+    if (S->nactive < S->nobjs) objl_take_in_box(S->w, box, S->objs, S->nobjs, sizeof(dr_obj), S->reach, take_object, S);
 }
 
 /* ---- which surface is nearer ------------------------------------------------------------ */
@@ -498,28 +530,91 @@ static int box_hidden(void *ctx, const screen_pt *pts, int n)
     return cov_box_covered(S->cov, b.y0 - 1, b.y1 + 1, b.x0 - 1, b.x1 + 1);
 }
 
+/* A leaf, with the objects' faces only to draw. Its floor may be in front of
+ * an object met later, if the object reaches below it (mode columns closes a
+ * floor's rows only at the seg beyond it), and so may its ceiling, if an object
+ * reaches above it; its walls cannot be (columns drew them in the tree's order),
+ * so they matter only near the objects met and not yet done. */
+static void faces_only_leaf(dr_state *S, uint32_t leaf, unsigned clip_mask)
+{
+    const scn_leaf *f = &S->sc->leaves[leaf];
+    S->st->leaves++;
+    unsigned which = 0;
+    if (f->sector != SCN_NONE) {
+        which |= S->sc->sectors[f->sector].floor_h > S->low ? SURF_FLOOR : 0u;
+        which |= surf_ceil_now(S->sc, S->w ? S->w->ceil : 0, f->sector) < S->high ? SURF_CEILING : 0u;
+    }
+    if (which) surf_leaf_planes(S->sc, S->w, S->v, leaf, clip_mask, &S->sink, S->st, which);
+    if (S->nactive) surf_leaf_walls(S->sc, S->w, S->v, leaf, clip_mask, &S->sink, S->use_occ ? &S->occ : 0, S->st);
+}
+
+/* Objects whose subtree the walk has left (obj_draw.h: objd_subtree_depth): no
+ * leaf to come holds anything in front of them, so their faces fill what is
+ * still free of them now, and they leave the active list (the pools drop their
+ * faces at the next reclaim). What they leave free another active object's face
+ * is nearer at: that one fills it when its turn comes. */
+static void retire_objects(dr_state *S, uint32_t back_to)
+{
+    for (uint32_t i = 0; i < S->nactive;) {
+        dr_obj *o = &S->objs[S->active[i]];
+        /* only once its subtree is known to be the walk's (a box may take it in early, from outside) */
+        if (back_to > o->subtree || !(o->e.taken & OBJL_AT_LEAF)) {
+            i++;
+            continue;
+        }
+        each_face(S, o, draw_face, 0);
+        /* out of the list, the others kept in order (the pools' order, for reclaim) */
+        S->nactive--;
+        for (uint32_t k = i; k < S->nactive; k++) S->active[k] = S->active[k + 1];
+    }
+}
+
 static int visit_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
 {
     dr_state *S = ctx;
+    if (CFG_OBJECTS && S->nactive) {
+        retire_objects(S, S->walk->back_to);
+        if (cov_full(S->cov)) return 1;
+    }
     if (CFG_OBJECTS && S->nactive < S->nobjs)
         objl_take_in_leaf(S->sc, S->w, leaf, S->objs, S->nobjs, sizeof(dr_obj), S->reach, take_object, S);
+    if (S->faces_only) {
+        faces_only_leaf(S, leaf, clip_mask);
+        return cov_full(S->cov);
+    }
     surf_leaf(S->sc, S->w, S->v, leaf, clip_mask, &S->sink, S->use_occ ? &S->occ : 0, S->st);
     return cov_full(S->cov);
 }
 
 /* ---- the frame ---------------------------------------------------------------------- */
 
-/* The objects in the view frustum, sorted by the west edges of their boxes. */
-static void list_objects_in_view(dr_state *S)
+/* The objects in the view frustum, sorted by the west edges of their boxes;
+ * only those set in `only` if given. */
+static void list_objects_in_view(dr_state *S, const uint32_t *only)
 {
     S->nactive = S->nfaces = S->nedges = 0;
     S->nobjs = objl_in_view(S->sc, S->w, S->v, S->objs, sizeof(dr_obj), &S->reach);
+    S->low = INT32_MAX;
+    S->high = INT32_MIN;
+    if (!only) return;
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < S->nobjs; i++) {
+        uint32_t k = S->objs[i].e.index;
+        if (!((only[k >> 5] >> (k & 31)) & 1u)) continue;
+        S->objs[n++] = S->objs[i];
+        const obj_state *o = &S->w->objs[k];
+        const scn_model *m = &S->sc->models[o->model];
+        int64_t lo = (int64_t)o->z + m->zmin, hi = (int64_t)o->z + m->zmax;
+        if (lo < S->low) S->low = lo < INT32_MIN ? INT32_MIN : (int32_t)lo;
+        if (hi > S->high) S->high = hi > INT32_MAX ? INT32_MAX : (int32_t)hi;
+    }
+    S->nobjs = n;
 }
 
 void direct_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t, render_stats *st,
                    void *work, uint32_t bytes)
 {
-    direct_render_within(sc, w, v, t, st, work, bytes, 0);
+    direct_render_within(sc, w, v, t, st, work, bytes, 0, 0);
 }
 
 /* Columns where mask has no pixel set: closed. */
@@ -537,7 +632,7 @@ static void close_empty_columns(occ_columns *occ, const cov_mask *mask)
 }
 
 void direct_render_within(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t,
-                          render_stats *st, void *work, uint32_t bytes, cov_mask *only)
+                          render_stats *st, void *work, uint32_t bytes, cov_mask *only, const uint32_t *objects)
 {
     uint32_t need = work_bytes(w, only == 0);
     if (!work || need == 0 || bytes < need) {
@@ -569,18 +664,21 @@ void direct_render_within(const scene *sc, const world_state *w, const view_xfor
     S->sink.ctx = S;
     S->sink.flat = t->flat;
     walk_stats ws;
+    S->walk = &ws;
     occ_reset(&S->occ);
-    if (only) { /* only these pixels: the rest counts as drawn, columns with none as closed */
+    if (only) { /* only these pixels: the rest counts as drawn */
         close_empty_columns(&S->occ, only);
         cov_complement(only, only);
     } else {
         cov_clear(S->cov);
     }
-    list_objects_in_view(S);
+    S->faces_only = only && objects;
+    list_objects_in_view(S, only ? objects : 0);
     st->object_pass = S->nobjs != 0;
     /* solid walls close columns only for an eye inside the world (spans.c says why) */
     S->use_occ = eye_in_world(sc, w, v);
-    walk_tree(sc, v, WALK_FRONT_TO_BACK, visit_leaf, S, (S->use_occ || only) ? &S->occ : 0, &ws);
+    walk_tree_hidden(sc, v, WALK_FRONT_TO_BACK, visit_leaf, S, (S->use_occ || only) ? &S->occ : 0, &ws,
+                     S->faces_only ? take_in_hidden : 0);
     st->nodes = ws.nodes;
     st->boxes_culled = ws.boxes_culled + ws.boxes_hidden;
     if (CFG_OBJECTS && S->nactive) draw_objects(S);

@@ -42,13 +42,26 @@ uint32_t direct_work_bytes(const scene *s, const world_state *w);
 void direct_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t, render_stats *st,
                    void *work, uint32_t work_bytes);
 
+/* The pixels object obj (an index into w's objects) covers when this mode draws
+ * it, each face's rows as row(ctx, y, x0, x1) with pixels [x0, x1): the faces
+ * that face the eye, clipped to the near plane, stepped as drawn. Mode columns
+ * leaves exactly these to direct_render_within. */
+void direct_object_rows(const scene *sc, const world_state *w, const view_xform *v, uint32_t obj,
+                        void (*row)(void *ctx, int y, int x0, int x1), void *ctx);
+
 /* direct_render drawing only the pixels set in only: the others are left as
- * they are, and columns with none are not walked. only becomes the mode's own
- * mask of written pixels (complemented in place), so the work memory it needs is
- * direct_work_bytes_within's, a mask less. Mode columns gives it the pixels
- * objects may cover. */
+ * they are. only becomes the mode's own mask of written pixels (complemented in
+ * place), so the work memory it needs is direct_work_bytes_within's, a mask
+ * less.
+ *
+ * objects NULL: only may hold any pixels; columns with none are not walked.
+ * Else a bit per object of w (bit k of word k / 32): the pixels of only are the
+ * faces (direct_object_rows) of the objects set, all others are hidden. Then
+ * the walk draws the world only while an object it has met is not yet done
+ * (obj_draw.h: objd_subtree_depth), and ends when only is drawn: about the cost
+ * of the objects, not of the screen. Mode columns hands over its objects so. */
 void direct_render_within(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t,
-                          render_stats *st, void *work, uint32_t work_bytes, cov_mask *only);
+                          render_stats *st, void *work, uint32_t work_bytes, cov_mask *only, const uint32_t *objects);
 uint32_t direct_work_bytes_within(const scene *s, const world_state *w);
 
 #endif

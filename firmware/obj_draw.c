@@ -175,6 +175,35 @@ int objd_touches_leaf(const scene *sc, const obj_state *o, const scn_leaf *f, co
     return 1;
 }
 
+/* Which side of the node's partition the box [x0, x1] x [y0, y1] lies on: 0
+ * front, 1 back, -1 both (or on the line). As scene_node_side, to 1/8192 unit. */
+static int box_side(const scn_node *n, int64_t x0, int64_t y0, int64_t x1, int64_t y1)
+{
+    int front = 0, back = 0;
+    for (int c = 0; c < 4; c++) {
+        int64_t ex = fx_asr64(((c & 1) ? x1 : x0) - n->x, 3), ey = fx_asr64(((c & 2) ? y1 : y0) - n->y, 3);
+        int64_t cross = (int64_t)n->dx * ey - (int64_t)n->dy * ex;
+        front |= cross < 0;
+        back |= cross > 0;
+        if (cross == 0) return -1;
+    }
+    return front == back ? -1 : back;
+}
+
+uint32_t objd_subtree_depth(const scene *s, const obj_state *o)
+{
+    int64_t r = (int64_t)s->models[o->model].radius + FX_ONE;
+    int64_t x0 = (int64_t)o->x - r, y0 = (int64_t)o->y - r, x1 = (int64_t)o->x + r, y1 = (int64_t)o->y + r;
+    uint32_t n = s->root, depth = 0;
+    while (!(n & SCN_LEAF_BIT) && depth < SCN_MAX_DEPTH + 1u) {
+        int side = box_side(&s->nodes[n], x0, y0, x1, y1);
+        if (side < 0) break;
+        n = s->nodes[n].child[side];
+        depth++;
+    }
+    return depth;
+}
+
 /* The horizontal offset of the origin from the eye, rotated into view axes (16.16,
  * int64): z forward, x right. */
 static void origin_view(const obj_state *o, const view_xform *v, int64_t *vx, int64_t *vz)

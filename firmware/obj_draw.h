@@ -84,6 +84,13 @@ void objd_leaf_box(const scene *s, const scn_leaf *f, int32_t box[BOX_SIDES]);
  * an object in a leaf early by it. */
 int objd_touches_leaf(const scene *s, const obj_state *o, const scn_leaf *f, const int32_t box[BOX_SIDES]);
 
+/* The depth in the tree (the root: 0) of the deepest subtree whose region holds
+ * the object's box with a unit to spare on every side: every leaf the box
+ * touches, and every point of the object, lies in that subtree. A front-to-back
+ * walk that has left the subtree (bsp_walk.h's back_to) reaches nothing more
+ * that can be in front of the object. */
+uint32_t objd_subtree_depth(const scene *s, const obj_state *o);
+
 /* 0 if the object's bounding cylinder is wholly outside the near, left or right plane. */
 int objd_in_view(const scene *s, const obj_state *o, const view_xform *v);
 

@@ -75,8 +75,29 @@ void objl_take_in_leaf(const scene *sc, const world_state *w, uint32_t leaf, voi
     int32_t west = (box[BOX_LEFT] >> 16) - 2 * reach - 1, east = box[BOX_RIGHT] >> 16;
     for (uint32_t i = first_at_or_east(list, n, size, west); i < n && objl_at(list, i, size)->left <= east; i++) {
         objl_entry *e = objl_at(list, i, size);
-        if (e->taken || !objd_touches_leaf(sc, &w->objs[e->index], f, box)) continue;
-        e->taken = 1;
+        if ((e->taken & OBJL_AT_LEAF) || !objd_touches_leaf(sc, &w->objs[e->index], f, box)) continue;
+        int seen = e->taken & OBJL_SEEN;
+        e->taken = OBJL_SEEN | OBJL_AT_LEAF;
+        if (!seen) take(ctx, i);
+    }
+}
+
+void objl_take_in_box(const world_state *w, const int32_t box[BOX_SIDES], void *list, uint32_t n, uint32_t size,
+                      int32_t reach, void (*take)(void *ctx, uint32_t i), void *ctx)
+{
+    int64_t west = ((int64_t)box[BOX_LEFT] >> 16) - 2 * (int64_t)reach - 1, east = (int64_t)box[BOX_RIGHT] >> 16;
+    if (west < INT32_MIN) west = INT32_MIN;
+    for (uint32_t i = first_at_or_east(list, n, size, (int32_t)west); i < n && objl_at(list, i, size)->left <= east;
+         i++) {
+        objl_entry *e = objl_at(list, i, size);
+        if (e->taken) continue;
+        /* the object's box: its origin +- the widest half width, in whole units rounded out */
+        const obj_state *o = &w->objs[e->index];
+        int64_t x = (int64_t)o->x >> 16, y = (int64_t)o->y >> 16, r = reach + 1;
+        if (x + r < ((int64_t)box[BOX_LEFT] >> 16) || y + r < ((int64_t)box[BOX_BOTTOM] >> 16) ||
+            y - r > ((int64_t)box[BOX_TOP] >> 16) + 1)
+            continue;
+        e->taken = OBJL_SEEN;
         take(ctx, i);
     }
 }

@@ -17,11 +17,15 @@
 typedef struct {
     int32_t left;   /* west edge of its box, whole units (the list is sorted by it) */
     uint16_t index; /* the object (its id; SCN_MAX_OBJECTS fits) */
-    uint8_t taken;  /* the mode's: its first leaf is reached, it was looked at (0 from objl_in_view) */
+    uint8_t taken;  /* OBJL_* bits (0 from objl_in_view) */
     uint8_t nfaces; /* the mode's: faces it shows, for a mode that keeps them (0 from objl_in_view) */
 } objl_entry;
 
 _Static_assert(SCN_MAX_OBJECTS <= 65536, "objl_entry.index");
+
+/* objl_entry.taken: OBJL_SEEN once handed to the mode's take (by a leaf or a
+ * box), OBJL_AT_LEAF once the walk has reached a leaf its box touches. */
+enum { OBJL_SEEN = 1, OBJL_AT_LEAF = 2 };
 
 static inline objl_entry *objl_at(void *list, uint32_t i, uint32_t size)
 {
@@ -41,11 +45,17 @@ static inline uint32_t objl_capacity(const world_state *w)
 uint32_t objl_in_view(const scene *sc, const world_state *w, const view_xform *v, void *list, uint32_t size,
                       int32_t *reach);
 
-/* The walk has reached leaf: calls take(ctx, i) for each record i of list[0 .. n)
- * not yet taken whose object's box touches the leaf (objd_touches_leaf), after
- * marking it taken: an object is taken in once, at the first leaf its box
- * touches. */
+/* The walk has reached leaf: marks OBJL_AT_LEAF in each record i of list[0 ..
+ * n) whose object's box touches the leaf (objd_touches_leaf), and calls take(ctx,
+ * i) for those not yet seen, after marking them seen: an object is taken in once,
+ * at the first leaf its box touches (or earlier, by objl_take_in_box). */
 void objl_take_in_leaf(const scene *sc, const world_state *w, uint32_t leaf, void *list, uint32_t n, uint32_t size,
                        int32_t reach, void (*take)(void *ctx, uint32_t i), void *ctx);
+
+/* The walk skips a subtree whose box (BOX_* sides) holds leaves an object's box
+ * may touch: calls take(ctx, i) for each record not yet seen whose object's box
+ * meets it, after marking it seen (not OBJL_AT_LEAF). */
+void objl_take_in_box(const world_state *w, const int32_t box[BOX_SIDES], void *list, uint32_t n, uint32_t size,
+                      int32_t reach, void (*take)(void *ctx, uint32_t i), void *ctx);
 
 #endif

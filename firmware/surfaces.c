@@ -238,34 +238,45 @@ static void plane(const scene *sc, const view_xform *v, const view_pt *pts, uint
     emit(sc, v, &p, mask, sink, look, id, SCN_NONE, st);
 }
 
+void surf_leaf_planes(const scene *sc, const world_state *w, const view_xform *v, uint32_t leaf, unsigned mask,
+                      const surf_sink *sink, render_stats *st, unsigned which)
+{
+    const scn_leaf *f = &sc->leaves[leaf];
+    if (f->sector == SCN_NONE) return;
+    const scn_sector *sec = &sc->sectors[f->sector];
+    int32_t top = surf_ceil_now(sc, w ? w->ceil : 0, f->sector);
+    /* edge-on or from behind: no plane work */
+    int floor = (which & SURF_FLOOR) && v->cz > sec->floor_h, ceiling = (which & SURF_CEILING) && v->cz < top;
+    st->planes_skipped += (uint32_t)!floor + (uint32_t)!ceiling;
+    uint32_t n = f->num_pverts;
+    if (n < 3 || n > CLIP_MAX_VERTS - 5) return; /* degenerate; the loader refuses more than the build's */
+    view_pt pts[CLIP_MAX_VERTS];
+    if (floor || ceiling) /* the leaf polygon rotated once for both */
+        for (uint32_t i = 0; i < n; i++) {
+            const scn_vertex *q = &sc->pverts[f->first_pvert + i];
+            pts[i] = view_point(v, q->x, q->y, 0);
+        }
+    if (floor) {
+        surf_look k = plane_look(sc, f->sector, 0, sec->floor_h);
+        plane(sc, v, pts, n, sec->floor_h, 1, mask, sink, &k, RAST_ID(RAST_KIND_FLOOR, f->sector), st);
+    }
+    if (ceiling) {
+        surf_look k = plane_look(sc, f->sector, 1, top);
+        plane(sc, v, pts, n, top, 0, mask, sink, &k, RAST_ID(RAST_KIND_CEILING, f->sector), st);
+    }
+}
+
+void surf_leaf_walls(const scene *sc, const world_state *w, const view_xform *v, uint32_t leaf, unsigned mask,
+                     const surf_sink *sink, occ_columns *occ, render_stats *st)
+{
+    const scn_leaf *f = &sc->leaves[leaf];
+    for (uint32_t i = 0; i < f->num_segs; i++) seg_parts(sc, w ? w->ceil : 0, v, f->first_seg + i, mask, sink, occ, st);
+}
+
 void surf_leaf(const scene *sc, const world_state *w, const view_xform *v, uint32_t leaf, unsigned mask,
                const surf_sink *sink, occ_columns *occ, render_stats *st)
 {
-    const scn_leaf *f = &sc->leaves[leaf];
-    const fx_t *ceil = w ? w->ceil : 0;
     st->leaves++;
-    if (f->sector != SCN_NONE) {
-        const scn_sector *sec = &sc->sectors[f->sector];
-        int32_t top = surf_ceil_now(sc, ceil, f->sector);
-        int floor = v->cz > sec->floor_h, ceiling = v->cz < top; /* edge-on or from behind: no plane work */
-        st->planes_skipped += (uint32_t)!floor + (uint32_t)!ceiling;
-        uint32_t n = f->num_pverts;
-        if (n < 3 || n > CLIP_MAX_VERTS - 5)
-            floor = ceiling = 0; /* degenerate; the loader refuses more than the build's */
-        view_pt pts[CLIP_MAX_VERTS];
-        if (floor || ceiling) /* the leaf polygon rotated once for both */
-            for (uint32_t i = 0; i < n; i++) {
-                const scn_vertex *q = &sc->pverts[f->first_pvert + i];
-                pts[i] = view_point(v, q->x, q->y, 0);
-            }
-        if (floor) {
-            surf_look k = plane_look(sc, f->sector, 0, sec->floor_h);
-            plane(sc, v, pts, n, sec->floor_h, 1, mask, sink, &k, RAST_ID(RAST_KIND_FLOOR, f->sector), st);
-        }
-        if (ceiling) {
-            surf_look k = plane_look(sc, f->sector, 1, top);
-            plane(sc, v, pts, n, top, 0, mask, sink, &k, RAST_ID(RAST_KIND_CEILING, f->sector), st);
-        }
-    }
-    for (uint32_t i = 0; i < f->num_segs; i++) seg_parts(sc, ceil, v, f->first_seg + i, mask, sink, occ, st);
+    surf_leaf_planes(sc, w, v, leaf, mask, sink, st, SURF_FLOOR | SURF_CEILING);
+    surf_leaf_walls(sc, w, v, leaf, mask, sink, occ, st);
 }

@@ -41,6 +41,14 @@ typedef struct {
 void surf_leaf(const scene *s, const world_state *w, const view_xform *v, uint32_t leaf, unsigned clip_mask,
                const surf_sink *sink, occ_columns *occ, render_stats *st);
 
+/* surf_leaf's two halves: the floor and ceiling (those asked for: SURF_FLOOR,
+ * SURF_CEILING), and the walls. */
+enum { SURF_FLOOR = 1, SURF_CEILING = 2 };
+void surf_leaf_planes(const scene *s, const world_state *w, const view_xform *v, uint32_t leaf, unsigned clip_mask,
+                      const surf_sink *sink, render_stats *st, unsigned which);
+void surf_leaf_walls(const scene *s, const world_state *w, const view_xform *v, uint32_t leaf, unsigned clip_mask,
+                     const surf_sink *sink, occ_columns *occ, render_stats *st);
+
 /* The quad of a wall standing on view points a, b (a on the left seen from its
  * front) from height bottom to top, clockwise on screen from a's top: the one
  * every mode clips, so that their walls' edges agree. */
