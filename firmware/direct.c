@@ -66,9 +66,10 @@ typedef struct {
     dr_edge *edges;
     dr_face scratch_face; /* a face of an object the pools could not hold */
     dr_edge scratch_edges[FACE_EDGES];
-    const walk_stats *walk; /* the walk's, for back_to */
-    int faces_only;         /* direct_render_within's objects given: the world matters only in front of them */
-    int32_t low, high;      /* faces_only: the lowest and highest point of the objects listed */
+    const walk_stats *walk;      /* the walk's, for back_to */
+    int faces_only;              /* direct_render_within's objects given: the world matters only in front of them */
+    int32_t low, high;           /* faces_only: the lowest and highest point of the objects listed */
+    uint32_t face_cap, edge_cap; /* the pools' sizes */
 } dr_state;
 
 static uint32_t align8(uint64_t n)
@@ -265,11 +266,11 @@ static void activate(dr_state *S, dr_obj *o)
         if (!face_build(sc, S->v, m, o->e.index, verts, fi, f, S->scratch_edges, box)) continue;
         /* into the pools if the face and its own edges fit, after making room if
          * the first face does not */
-        if (nf == 0 && !(S->nfaces < DIRECT_FACE_POOL && ne + f->nedges <= DIRECT_EDGE_POOL)) {
+        if (nf == 0 && !(S->nfaces < S->face_cap && ne + f->nedges <= S->edge_cap)) {
             reclaim(S);
             ne = S->nedges;
         }
-        stored &= (uint32_t)(S->nfaces + nf < DIRECT_FACE_POOL && ne + f->nedges <= DIRECT_EDGE_POOL);
+        stored &= (uint32_t)(S->nfaces + nf < S->face_cap && ne + f->nedges <= S->edge_cap);
         if (stored) {
             f->first_edge = (uint16_t)ne;
             for (int i = 0; i < f->nedges; i++) S->edges[ne + (uint32_t)i] = S->scratch_edges[i];
@@ -611,6 +612,25 @@ static void list_objects_in_view(dr_state *S, const uint32_t *only)
     S->nobjs = n;
 }
 
+/* With the objects' faces only, the list holds just the objects that claimed
+ * pixels, often few of the n it has room for: the pools take the rest of that
+ * room (end: where the pools end), a face to every four edges. */
+static void widen_pools(dr_state *S, uint32_t n, uint8_t *end)
+{
+    uint8_t *p = (uint8_t *)S->objs + align8((uint64_t)S->nobjs * sizeof(dr_obj));
+    uint16_t *active = (uint16_t *)(void *)p;
+    p += align8((uint64_t)S->nobjs * sizeof(uint16_t));
+    uint64_t room = (uint64_t)(end - p), faces = room / (sizeof(dr_face) + 4u * sizeof(dr_edge));
+    if (S->nobjs >= n || faces <= DIRECT_FACE_POOL) return; /* no more than the fixed pools */
+    if (faces > 65535u) faces = 65535u;                     /* their indices are 16 bits */
+    uint64_t edges = (room - align8(faces * sizeof(dr_face))) / sizeof(dr_edge);
+    S->active = active;
+    S->faces = (dr_face *)(void *)p;
+    S->edges = (dr_edge *)(void *)(p + align8(faces * sizeof(dr_face)));
+    S->face_cap = (uint32_t)faces;
+    S->edge_cap = (uint32_t)(edges > 65535u ? 65535u : edges);
+}
+
 void direct_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t, render_stats *st,
                    void *work, uint32_t bytes)
 {
@@ -653,6 +673,8 @@ void direct_render_within(const scene *sc, const world_state *w, const view_xfor
     mem += n ? align8((uint64_t)DIRECT_FACE_POOL * sizeof(dr_face)) : 0;
     S->edges = (dr_edge *)(void *)mem;
     mem += n ? align8((uint64_t)DIRECT_EDGE_POOL * sizeof(dr_edge)) : 0;
+    S->face_cap = DIRECT_FACE_POOL;
+    S->edge_cap = DIRECT_EDGE_POOL;
     S->cov = only ? only : (cov_mask *)(void *)mem;
     S->sc = sc;
     S->w = w;
@@ -674,6 +696,7 @@ void direct_render_within(const scene *sc, const world_state *w, const view_xfor
     }
     S->faces_only = only && objects;
     list_objects_in_view(S, only ? objects : 0);
+    if (S->faces_only) widen_pools(S, n, mem);
     st->object_pass = S->nobjs != 0;
     /* solid walls close columns only for an eye inside the world (spans.c says why) */
     S->use_occ = eye_in_world(sc, w, v);
