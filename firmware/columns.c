@@ -480,6 +480,16 @@ static void claim_row(void *ctx, int y, int x0, int x1)
     }
 }
 
+/* Is a pixel of [x0, x1) x [y0, y1) still open? */
+static int box_open(const cols_state *S, int x0, int x1, int y0, int y1)
+{
+    x0 = x0 < 0 ? 0 : x0;
+    x1 = x1 > VIEW_W ? VIEW_W : x1;
+    for (int x = x0; x < x1; x++)
+        if ((y0 > S->open_top[x] ? y0 : S->open_top[x]) < (y1 < S->open_bot[x] ? y1 : S->open_bot[x])) return 1;
+    return 0;
+}
+
 /* An object the walk takes in (obj_list.h: at the first leaf its box touches)
  * claims the pixels of its faces whose rows are still open: mode direct draws
  * them after the walk, the object or whatever of the world is in front of it.
@@ -491,7 +501,7 @@ static void take_object(void *ctx, uint32_t i)
     int x0, x1, y0, y1;
     uint32_t obj = S->objs[i].index;
     int got = objd_screen_box(S->sc, &S->w->objs[obj], S->v, &x0, &x1, &y0, &y1);
-    if (got < 0) return;
+    if (got < 0 || (got > 0 && !box_open(S, x0, x1, y0, y1))) return;
     S->claimed_any = 0;
     if (got > 0) {
         direct_object_rows(S->sc, S->w, S->v, obj, claim_row, S);
