@@ -59,8 +59,10 @@ COLS_PLANES ?= 12
 # beyond them are worked out again where needed, never dropped.
 DIRECT_FACES ?= 16
 DIRECT_EDGES ?= 96
+# KNOB_DEFS: a precision knob configuration's flags (mk/report.mk), for make report's Cortex-M3 runs.
+KNOB_DEFS ?=
 FW_DEFS = $(call render_modes_def,$(FW_MODES)) $(flat_def) -DCFG_DIRECT_FACES=$(DIRECT_FACES)u -DCFG_DIRECT_EDGES=$(DIRECT_EDGES)u \
-          -DCFG_COLS_PLANES=$(COLS_PLANES)u
+          -DCFG_COLS_PLANES=$(COLS_PLANES)u $(KNOB_DEFS)
 RAM_BYTES ?= 200000
 # The stack: the walks keep a stack of the tree's depth (CFG_MAX_DEPTH: the scene's
 # in a build for it, 255 in a FULL=1 build); a textured frame adds a row of texels
@@ -170,8 +172,10 @@ $(ARM_OUT)/fw_sizer.o: $(ARM_OUT)/gen/fw_sizer.c
 	$(ARMCC) $(ARM_CFLAGS) -c $< -o $@
 $(ARM_OUT)/sizer.elf: $(filter-out $(ARM_OUT)/fw_scene.o,$(ARM_OBJS)) $(ARM_OUT)/fw_sizer.o hal/mps2/mps2.ld
 	$(ARMCC) $(ARM_CFLAGS) $(call mps2_ld,0x20000000,$(MPS2_SSRAM_BYTES)) $(filter %.o,$^) -lgcc -o $@
-$(ARM_OUT)/work_bytes: $(ARM_OUT)/sizer.elf $(ARM_OUT)/config
-	@if [ -n '$(WORK_BYTES)' ]; then echo '$(WORK_BYTES)' > $@; \
+# With WORK_BYTES given the sizer is not run, and the file changes only with it: a
+# scene built in for several builds of the objects (ARM_OBJ) is compiled once.
+$(ARM_OUT)/work_bytes: $(if $(WORK_BYTES),,$(ARM_OUT)/sizer.elf) $(ARM_OUT)/config
+	@if [ -n '$(WORK_BYTES)' ]; then echo '$(WORK_BYTES)' | cmp -s - $@ || echo '$(WORK_BYTES)' > $@; \
 	elif n=$$(timeout 60 $(QEMU_ARM) -M mps2-an385 -nographic -monitor none -semihosting-config enable=on,target=native \
 	          -kernel $< -serial null 2>&1 | sed -n 's/.* needs \([0-9]*\) bytes of work memory.*/\1/p') && [ -n "$$n" ]; then \
 	  echo "$$n" > $@; \

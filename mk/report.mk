@@ -105,8 +105,8 @@ report-configs:
 	@$(foreach c,$(REPORT_CONFIGS),echo '$(c): $(strip $(KNOB_FLAGS_$(c)))';)
 
 # make report REPORT_CONFIGS="default subpix0": a few configurations only;
-# REPORT_ARGS: more options of tools/report.py (--views N, --tex-views N, --no-ir, --jobs N).
-report: deps $(BUILD)/bspc $(BUILD)/render $(KNOB_RENDERS)
+# REPORT_ARGS: more options of tools/report.py (--views N, --tex-views N, --m3-views N, --no-ir, --jobs N).
+report: deps $(BUILD)/bspc $(BUILD)/render $(BUILD)/bin2c $(BUILD)/insn_count.so $(KNOB_RENDERS)
 	$(PY) tools/report.py --configs $(REPORT_CONFIGS) $(REPORT_ARGS)
 
 # tests/test_report.py renders with two knob configurations beside the default.

@@ -16,6 +16,7 @@ sys.path.insert(0, str(ROOT / "tools"))
 import accuracy  # noqa: E402
 import refrender  # noqa: E402
 import report  # noqa: E402
+import report_m3  # noqa: E402
 
 KNOB = BUILD / "knob"
 VIEW = {"scene": "freedoom1.wad:E1M4", "at": "896,-1760", "angle": "135"}
@@ -126,11 +127,16 @@ def test_report_writes_tables_and_figure_from_fake_points(tmp_path):
     assert points[0]["ir"] == 2000 and points[0]["worst_differ"] == 0.03 and points[0]["worst_view"] == "s1/v"
     assert points[0]["mean_differ_bench"] == 0.01 and points[0]["p99_edge"] == 2 and points[0]["failed"] == ["s1/v"]
     per_scene = {"s1": {"views": 1, "spans": {"differ": 0.03, "edge": 320}, "painter": {"differ": 0.0, "edge": 0}}}
-    report.plot(tmp_path / "p.png", points, no_ir=False)
+    points[0]["m3_ir"], points[1]["m3_ir"] = 9000, None
+    drawn = report.plot(tmp_path / "p.png", points, no_ir=False)
+    assert any("lower left is better" in t for t in drawn["texts"])
+    assert "mode columns, Cortex-M3" in drawn["texts"]
     report.write_markdown(tmp_path / "r.md", points, per_scene, views,
-                          {"default": "", "cheap": points[1]["flags"]}, "p.png", no_ir=False, tex_names=["a", "b"])
+                          {"default": "", "cheap": points[1]["flags"]}, "p.png", no_ir=False, tex_names=["a", "b"],
+                          m3_names=["a"])
     md = (tmp_path / "r.md").read_text()
-    assert "| **default** | — | spans | 2,000 | +0.0% | 2.000% |" in md, md
+    assert "| **default** | — | spans | 2,000 | +0.0% | 9,000 | +0.0% | 2.000% |" in md, md
+    assert "On the Cortex-M3 (mode columns" in md
     assert "| s1 | 1 | 3.00% | 320 | 0.00% | 0 |" in md, md
     assert "| 1 | 0.300% | 0.50% | b |" in md, md            # texels off: mean, worst, its view
     assert "| 0 | — | — | — |" in md, md                      # not measured for the second point
@@ -140,6 +146,49 @@ def test_report_writes_tables_and_figure_from_fake_points(tmp_path):
     assert report.hist_percentile([0, 0, 5], 99) == 2 and report.hist_percentile([0] * 4, 99) == 0
     assert points[0]["worst_moved_edge"] == 2 and points[0]["worst_edge"] == report.CAP
     assert report.sparse_hist(np.array([3, 3, 400])) == [[3, 2], [report.CAP, 1]]
+
+
+def test_pareto_front_is_the_lower_left_edge():
+    xy = [(3, 0.1), (1, 0.5), (2, 0.5), (2, 0.2), (4, 0.0), (5, 0.0)]
+    assert report.front(xy) == [1, 3, 0, 4]  # by instructions; (2, 0.5) and (5, 0) are beaten
+    assert report.front([]) == [] and report.front([(1, 1)]) == [0]
+
+
+def test_plot_names_the_front_without_overlapping_labels(tmp_path):
+    # 34 configurations crowded as the knobs crowd them: many nearly equal, a few far apart
+    rng = np.random.default_rng(7)
+    points = []
+    for i in range(34):
+        ir = int(2_000_000 * (1 + 0.002 * rng.standard_normal())) if i % 5 else int(2_000_000 * (0.7 + 0.1 * i / 5))
+        differ = 0.0 if i % 7 == 0 else float(10 ** rng.uniform(-5, -2))
+        p = fake_point("default" if i == 0 else f"k{i}", "spans", ir, differ,
+                       "" if i == 0 else f"-DRAST_STEP_BITS={4 + i % 12}", tex=float(10 ** rng.uniform(-4, -1)),
+                       edge=int(rng.integers(0, 30)))
+        p["m3_ir"] = ir * 3
+        points.append(dict(p, mode="columns"))
+    drawn = report.plot(tmp_path / "p.png", points, no_ir=False)
+    named = [b for boxes in drawn["labels"] for b in boxes]
+    assert len(named) >= 6  # the default and the front of each plot are named
+    for boxes in drawn["labels"]:
+        for i, a in enumerate(boxes):
+            for b in boxes[i + 1:]:
+                assert not report._overlaps(a, b), (a, b)
+    assert any("lower left is better" in t for t in drawn["texts"])
+
+
+def test_report_counts_a_configuration_on_the_cortex_m3_and_caches_it(tmp_path, monkeypatch):
+    cache, logs = report.Cache(tmp_path / "cache.json"), []
+    got = report_m3.measure({"recip8": "-DVIEW_RECIP_BITS=8"}, [VIEW], tmp_path / "m3", cache, logs.append)
+    assert 100_000 < got["recip8"][0] < 20_000_000, got
+    assert "-DVIEW_RECIP_BITS=8" in (tmp_path / "m3" / "recip8" / "obj" / "modes").read_text()  # the knob
+    assert any("1/1 configurations" in line for line in logs), logs
+
+    def no_build(*args):
+        raise AssertionError("built again")
+
+    monkeypatch.setattr(report_m3, "build", no_build)
+    again = report_m3.measure({"recip8": "-DVIEW_RECIP_BITS=8"}, [VIEW], tmp_path / "m3", cache, logs.append)
+    assert again == got
 
 
 def test_progress_gives_configurations_done_and_time_left():

@@ -2,8 +2,8 @@
 """make report: error against run time, per render mode and precision-knob configuration.
 
 Each configuration is a build/knob/NAME/render built by mk/report.mk with the knob flags in
-build/knob/NAME/flags ("default" has none). For each configuration and render mode (spans,
-painter):
+build/knob/NAME/flags ("default" has none). For each configuration and render mode (every mode
+build/render takes):
 
 - error, over the views of tests/bench_views.json and every view of the extreme scenes'
   manifests (tests/scenes/extreme/*.json): the surface-id buffer against the reference renderer's
@@ -17,20 +17,26 @@ painter):
   firmware/texture.h are about this error; the surface-id error above does not see them;
 - run time, over the bench views only: instructions per frame with callgrind, as tools/bench.py
   counts them ((Ir of --repeat 3 - Ir of --repeat 1) / 2); the bench views are WAD maps, so these
-  are textured frames.
+  are textured frames;
+- run time on the Cortex-M3, over the first bench views (--m3-views N, default 8): each
+  configuration's firmware under QEMU with the instruction-counting plugin, mode columns
+  (tools/report_m3.py). There a divide is costly, which the reciprocal knobs are for.
 
 Writes OUT/report.md (default build/report/): a summary per render mode (the best configurations
-by error, by texel-and-light error and by instructions, the default's place in each, and those no
-other beats on both error and instructions), a table of every point, OUT/error_vs_ir.png
-(mean differing share, worst edge displacement and mean texel-and-light error against median
-instructions per frame, on log axes with a band for exact zeros, points numbered with a key, the
-default configuration marked), and a per-scene table of the extreme scenes for the default
-configuration. Reference id buffers are kept in OUT/ref/, and every measured figure in
-OUT/cache.json keyed by the binary's and the scene's contents, so a re-run only measures what
-changed. Progress goes to stderr: tasks and configurations done, and the time left at the mean
-so far. A report, not a test: it asserts nothing about the figures.
+by error, by texel-and-light error and by instructions, on x86-64 and the Cortex-M3, the default's
+place in each, and those no other beats on both error and instructions), a table of every point,
+OUT/error_vs_ir.png (mean differing share, worst edge displacement and mean texel-and-light error
+against median instructions per frame, a column per mode and one for the Cortex-M3, on log axes with
+a band for exact zeros; the Pareto front joined and ringed, it and the default named where a name
+fits without covering another label or a point, "lower left is better" on every plot), and a
+per-scene table of the extreme scenes for the default configuration. Reference id buffers are kept
+in OUT/ref/, and every measured figure in OUT/cache.json keyed by the binary's and the scene's
+contents (the firmware's: its sources and flags), so a re-run only measures what changed. Progress
+goes to stderr: tasks and configurations done, and the time left at the mean so far. A report, not
+a test: it asserts nothing about the figures.
 
-usage: tools/report.py [--configs NAME ...] [--views N] [--tex-views N] [--no-ir] [--jobs N] [--out DIR]
+usage: tools/report.py [--configs NAME ...] [--views N] [--tex-views N] [--m3-views N] [--no-ir] [--jobs N]
+                       [--out DIR]
 """
 import argparse
 import concurrent.futures as cf
@@ -51,6 +57,7 @@ import accuracy  # noqa: E402
 import bench  # noqa: E402
 import reflook  # noqa: E402
 import refrender  # noqa: E402
+import report_m3  # noqa: E402
 import texcompare  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -367,18 +374,29 @@ def summary_lines(points):
                 where.append(f"instructions {rank(timed, d, 'ir')} of {len(timed)} ({d['ir']:,})")
             lines.append(f"  The default's place (1 = lowest): " + ", ".join(where) + ".")
         if len(timed) > 1:
-            front = sorted(pareto(timed), key=lambda p: p["ir"])
+            edge = sorted(pareto(timed), key=lambda p: p["ir"])
             lines.append("  Not beaten on both error and instructions by any other (the lower-left edge of the "
-                         "plot): " + ", ".join(p["config"] for p in front) + ".")
+                         "plot): " + ", ".join(p["config"] for p in edge) + ".")
+        on_m3 = [dict(p, ir=p["m3_ir"]) for p in pts if p.get("m3_ir") is not None]
+        if on_m3:
+            low = min(p["ir"] for p in on_m3)
+            line = f"  On the Cortex-M3: fewest instructions: {best(on_m3, 'ir')} ({low:,} per frame)"
+            if d is not None and d.get("m3_ir") is not None:
+                line += f"; the default {rank(on_m3, dict(d, ir=d['m3_ir']), 'ir')} of {len(on_m3)} ({d['m3_ir']:,})"
+            if len(on_m3) > 1:
+                line += "; not beaten on both: " + ", ".join(
+                    p["config"] for p in sorted(pareto(on_m3), key=lambda p: p["ir"]))
+            lines.append(line + ".")
     return lines + [""]
 
 
-def write_markdown(path, points, per_scene, views, configs, png_name, no_ir, tex_names=()):
+def write_markdown(path, points, per_scene, views, configs, png_name, no_ir, tex_names=(), m3_names=()):
     """The report: how it was measured, every point, the default's extreme scenes."""
     n_bench = sum(1 for v in views if v["set"] == "bench")
     groups = sorted({v["group"] for v in views if v["set"] == "extreme"})
     n_ext = len(views) - n_bench
     default_ir = {p["mode"]: p["ir"] for p in points if p["config"] == DEFAULT}
+    default_m3 = next((p.get("m3_ir") for p in points if p["config"] == DEFAULT and p.get("m3_ir")), None)
     lines = [
         "# Error against run time",
         "",
@@ -390,7 +408,10 @@ def write_markdown(path, points, per_scene, views, configs, png_name, no_ir, tex
         f"when that is not within {accuracy.SEARCH} pixels. Run time: "
         + ("not measured (--no-ir)." if no_ir else
            "instructions per frame on x86-64 (callgrind, (Ir of --repeat 3 - Ir of --repeat 1) / 2), "
-           "the median over the bench views."),
+           "the median over the bench views.")
+        + (f" On the Cortex-M3 (mode {report_m3.MODE}, the board's): the firmware built with each configuration's "
+           f"flags, under QEMU (mps2-an385) with the instruction-counting plugin, the world alone, the median over "
+           f"{len(m3_names)} bench views: " + ", ".join(m3_names) + " (tools/report_m3.py)." if m3_names else ""),
         "",
         "Columns: *mean differ* over all views (and over the bench and extreme views apart), *worst differ* "
         "and the view it is on, *worst edge* the largest displacement on any view (320: a surface one "
@@ -408,18 +429,20 @@ def write_markdown(path, points, per_scene, views, configs, png_name, no_ir, tex
         "",
         f"![error against instructions per frame]({png_name})",
         "",
-        "| config | flags | mode | median Ir/frame | vs default | mean differ | bench | extreme | worst differ "
-        "| worst view | worst edge px | worst moved edge px | p99 edge px | views at 320 | texels off: mean "
-        "| worst | worst texel view |",
-        "|---|---|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---|",
+        "| config | flags | mode | median Ir/frame | vs default | Cortex-M3 | vs default | mean differ | bench "
+        "| extreme | worst differ | worst view | worst edge px | worst moved edge px | p99 edge px | views at 320 "
+        "| texels off: mean | worst | worst texel view |",
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---|",
     ]
     for p in points:
         base = default_ir.get(p["mode"])
         rel = "—" if p["ir"] is None or not base else f"{100.0 * (p['ir'] - base) / base:+.1f}%"
         name = f"**{p['config']}**" if p["config"] == DEFAULT else p["config"]
+        m3 = p.get("m3_ir")
+        m3_rel = "—" if m3 is None or not default_m3 else f"{100.0 * (m3 - default_m3) / default_m3:+.1f}%"
         lines.append(
             f"| {name} | {p['flags'] or '—'} | {p['mode']} | {'—' if p['ir'] is None else format(p['ir'], ',')} "
-            f"| {rel} | {pct(p['mean_differ'])} | {pct(p['mean_differ_bench'])} | {pct(p['mean_differ_extreme'])} "
+            f"| {rel} | {'—' if m3 is None else format(m3, ',')} | {m3_rel} | {pct(p['mean_differ'])} | {pct(p['mean_differ_bench'])} | {pct(p['mean_differ_extreme'])} "
             f"| {pct(p['worst_differ'], 2)} | {p['worst_view']} | {p['worst_edge']} | {p['worst_moved_edge']} "
             f"| {p['p99_edge']} "
             f"| {p['views_at_cap']} | {pct(p['tex_bad_mean'])} | {pct(p['tex_bad_worst'], 2)} "
@@ -462,32 +485,64 @@ def family(config, flags):
             "TEX_LIGHT_BITS": "light steps", "CFG_FLAT": "flat (no textures)"}.get(sorted(knobs)[0], "other")
 
 
-def _place_labels(ax, items, fontsize=7):
-    """Write each point's label beside it, moved up or down in steps of a line until it no longer
-    overlaps a label already written (the points of nearly equal configurations coincide)."""
-    fig = ax.figure
-    fig.canvas.draw()
-    px_per_pt = fig.dpi / 72.0
-    line = fontsize * 1.3  # points
-    placed = []
-    for x, y, text, colour in sorted(items, key=lambda t: (t[0], t[1])):
-        px, py = ax.transData.transform((x, y)) / px_per_pt  # in points
-        w = len(text) * fontsize * 0.6
-        for k in [0, 1, -1, 2, -2, 3, -3, 4, -4, 5, -5, 6, -6, 7, -7, 8, -8, 9, -9, 10, -10]:
-            box = (px + 5, py - 3 + k * line, px + 5 + w, py - 3 + (k + 1) * line)
-            if not any(box[0] < b[2] and b[0] < box[2] and box[1] < b[3] and b[1] < box[3] for b in placed):
+def front(xy):
+    """Indices of the points (x, y) that no other point beats on both (lower left): the Pareto front,
+    in order of x."""
+    order = sorted(range(len(xy)), key=lambda i: (xy[i][0], xy[i][1]))
+    out, low = [], None
+    for i in order:
+        if low is None or xy[i][1] < low:
+            out.append(i)
+            low = xy[i][1]
+    return out
+
+
+def _overlaps(a, b):
+    return a.x0 < b.x1 and b.x0 < a.x1 and a.y0 < b.y1 and b.y0 < a.y1
+
+
+def _place_labels(fig, ax, items, taken, fontsize=8):
+    """Write each label (x, y, text, colour) beside its point, at the first of a ring of offsets,
+    growing outwards, where its box (measured by the renderer) meets no box already taken (other
+    labels, and the markers) and stays inside the axes; a label with no such place within reach is
+    left out. Returns the boxes written (display pixels), which are added to taken."""
+    from matplotlib.text import Text
+    renderer = fig.canvas.get_renderer()
+    frame = ax.get_window_extent(renderer)
+    written = []
+    for x, y, text, colour in items:
+        for r in (6, 14, 24, 36, 50, 66):
+            placed = None
+            for dx, dy, ha, va in ((r, 0, "left", "center"), (0, r, "center", "bottom"), (-r, 0, "right", "center"),
+                                   (0, -r, "center", "top"), (r, r, "left", "bottom"), (-r, r, "right", "bottom"),
+                                   (-r, -r, "right", "top"), (r, -r, "left", "top")):
+                t = ax.annotate(text, (x, y), xytext=(dx, dy), textcoords="offset pixels", ha=ha, va=va,
+                                fontsize=fontsize, color=colour, annotation_clip=False,
+                                arrowprops=dict(arrowstyle="-", color=colour, lw=0.5, alpha=0.7) if r > 6 else None)
+                t.update_positions(renderer)
+                box = Text.get_window_extent(t, renderer).padded(1)  # the text alone, not its leader line
+                inside = frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1
+                if inside and not any(_overlaps(box, b) for b in taken):
+                    placed = box
+                    break
+                t.remove()
+            if placed is not None:
+                taken.append(placed)
+                written.append(placed)
                 break
-        placed.append(box)
-        ax.annotate(text, (x, y), xytext=(5, -3 + k * line), textcoords="offset points", fontsize=fontsize,
-                    color=colour, arrowprops=dict(arrowstyle="-", color=colour, lw=0.4, alpha=0.6) if k else None)
+    return written
 
 
 def plot(path, points, no_ir):
-    """Per render mode (a column each), against median instructions per frame: the mean share of
-    differing pixels, the largest displacement of an edge both buffers have, and the texel-and-light
-    error. Each figure is on a log axis, with a band below it for the points at exactly 0 (a log axis
-    has no 0, and a symlog one puts a jump there); the points are numbered, and the key beside the
-    plots names each number's configuration and flags."""
+    """Error against run time, per render mode (a column each, x86-64 instructions) and for mode
+    columns on the Cortex-M3 (a column more, when measured), for each error figure (a row each): the
+    mean share of differing pixels, the largest displacement of an edge both buffers have, and the
+    texel-and-light error. Each figure is on a log axis, with a band below it for the points at
+    exactly 0 (a log axis has no 0). In each plot the Pareto front (no other configuration has both
+    fewer instructions and less error) is joined by a line and its points ringed; the default is a
+    star. Only the front and the default are named beside their points, where a name fits without
+    covering another or a point; every point's figures are in report.md. Returns the label boxes
+    written, per plot (display pixels), and the figure's texts."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -496,47 +551,62 @@ def plot(path, points, no_ir):
     fams = sorted({family(p["config"], p["flags"]) for p in points} - {"default"})
     colours = {f: plt.get_cmap("tab10")(i % 10) for i, f in enumerate(fams)}
     colours["default"] = "black"
-    modes = [m for m in MODES if any(p["mode"] == m for p in points)]
+    panels = [(m, "ir", f"mode {m}, x86-64") for m in MODES if any(p["mode"] == m for p in points)]
+    if not no_ir and any(p.get("m3_ir") is not None for p in points):
+        panels.append((next(p["mode"] for p in points if p.get("m3_ir") is not None), "m3_ir",
+                       f"mode {report_m3.MODE}, Cortex-M3"))
     order = {c: i for i, c in enumerate(dict.fromkeys(p["config"] for p in points))}
-    flags = {p["config"]: p["flags"] for p in points}
     rows = [("mean_differ", "mean share of pixels differing\nfrom the reference (%)", 100.0),
             ("worst_moved_edge", f"worst edge displacement (px),\nbelow 320 (found within {accuracy.SEARCH} px)", 1.0)]
     if any(p.get("tex_bad_mean") is not None for p in points):
         rows.append(("tex_bad_mean", "mean share of pixels not within one\ntexel and one light step (%)", 100.0))
-    fig = plt.figure(figsize=(7.5 * len(modes) + 4.5, 5.6 * len(rows)))
-    grid = fig.add_gridspec(2 * len(rows), len(modes) + 1, height_ratios=[5, 0.6] * len(rows),
-                            width_ratios=[7.5] * len(modes) + [4.5], hspace=0.08, wspace=0.12)
+    fig = plt.figure(figsize=(6.5 * len(panels) + 1.5, 5.2 * len(rows)), dpi=100)
+    grid = fig.add_gridspec(2 * len(rows), len(panels), height_ratios=[5, 0.6] * len(rows), hspace=0.1, wspace=0.14)
     better = "lower is better \u2193" if no_ir else "lower left is better \u2199"
-    labels = []
+    fig.suptitle(f"Precision knobs: error against the reference renderer vs. instructions per frame ({better})",
+                 fontsize=13)
+    handles = [plt.Line2D([], [], marker="*", color="gold", markeredgecolor="black", markersize=15, linestyle="",
+                          label="default")]
+    handles += [plt.Line2D([], [], marker="o", color=colours[f], linestyle="", label=f) for f in fams]
+    handles.append(plt.Line2D([], [], marker="o", markerfacecolor="none", markeredgecolor="crimson", markersize=11,
+                              color="crimson", linestyle="--", label="Pareto front (named)"))
+    fig.legend(handles=handles, loc="lower center", ncol=min(len(handles), 7), fontsize=9, title="knob",
+               title_fontsize=9, frameon=False)
+    fig.subplots_adjust(left=0.07, right=0.99, top=0.94, bottom=0.1)
+    placements = []
     for row, (key, ylabel, scale) in enumerate(rows):
         values = [p[key] * scale for p in points if p.get(key) is not None]
         positive = [v for v in values if v > 0]
         # whole decades, at least one, so that the log axis has labelled ticks
-        lo = 10.0 ** np.floor(np.log10(min(positive))) if positive else 0.1
+        lo = 10.0 ** np.floor(np.log10(min(positive) / 1.5)) if positive else 0.1
         hi = 10.0 ** np.ceil(np.log10(max(positive) * 1.5)) if positive else 10.0
-        for col, mode in enumerate(modes):
+        for col, (mode, xkey, title) in enumerate(panels):
             ax = fig.add_subplot(grid[2 * row, col])
             zero = fig.add_subplot(grid[2 * row + 1, col], sharex=ax)
-            items = {ax: [], zero: []}
-            for p in points:
-                if p["mode"] != mode or p.get(key) is None:
-                    continue
-                x = order[p["config"]] if no_ir or p["ir"] is None else p["ir"]
-                y = p[key] * scale
+            pts = [p for p in points if p["mode"] == mode and p.get(key) is not None and
+                   (no_ir or p.get(xkey) is not None)]
+            xy = [(order[p["config"]] if no_ir else p[xkey], p[key] * scale) for p in pts]
+            on_front = set(front(xy)) if not no_ir else set()
+            for p, (x, y) in zip(pts, xy):
                 target = ax if y > 0 else zero
-                fam = family(p["config"], p["flags"])
                 if p["config"] == DEFAULT:
-                    target.scatter([x], [y], marker="*", s=420, c="gold", edgecolors="black", linewidths=1.5,
-                                   zorder=5)
+                    target.scatter([x], [y], marker="*", s=380, c="gold", edgecolors="black", linewidths=1.3, zorder=5)
                 else:
-                    target.scatter([x], [y], marker="o", s=46, color=colours[fam], edgecolors="black",
-                                   linewidths=0.4, zorder=3)
-                items[target].append((x, y, str(order[p["config"]] + 1), colours[fam]))
+                    target.scatter([x], [y], marker="o", s=40, color=colours[family(p["config"], p["flags"])],
+                                   edgecolors="black", linewidths=0.4, zorder=3)
+            fx = sorted((xy[i] for i in on_front), key=lambda t: t[0])
+            for target, part in ((ax, [t for t in fx if t[1] > 0]), (zero, [t for t in fx if t[1] <= 0])):
+                if part:
+                    target.scatter([t[0] for t in part], [t[1] for t in part], s=520, facecolors="none",
+                                   edgecolors="crimson", linewidths=1.4, zorder=6)
+                if len(part) > 1:
+                    target.step([t[0] for t in part], [t[1] for t in part], where="post", color="crimson",
+                                linestyle="--", linewidth=1.0, zorder=2)
             ax.set_yscale("log")
             ax.set_ylim(lo, hi)
             ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
             ax.yaxis.set_minor_formatter(ticker.NullFormatter())
-            ax.margins(x=0.12)
+            ax.margins(x=0.15)
             ax.grid(True, which="both", alpha=0.3)
             ax.tick_params(labelbottom=False)
             ax.text(0.98, 0.97, better, transform=ax.transAxes, ha="right", va="top", fontsize=10,
@@ -547,36 +617,37 @@ def plot(path, points, no_ir):
             zero.grid(True, axis="x", alpha=0.3)
             if col == 0:
                 ax.set_ylabel(ylabel)
-            else:
-                ax.tick_params(labelleft=False)
-                zero.tick_params(labelleft=False)
             if row == 0:
-                ax.set_title(f"mode {mode}")
+                ax.set_title(title)
             if row == len(rows) - 1:
                 zero.set_xlabel("configuration (instructions not measured: --no-ir)" if no_ir else
-                                "median instructions per frame, bench views (x86-64, callgrind)")
+                                "median instructions per frame" +
+                                (" (QEMU plugin)" if xkey == "m3_ir" else " (callgrind)"))
             else:
                 zero.tick_params(labelbottom=False)
-            labels += list(items.items())
-    key_ax = fig.add_subplot(grid[:, len(modes)])
-    key_ax.axis("off")
-    handles = [plt.Line2D([], [], marker="*", color="gold", markeredgecolor="black", markersize=15, linestyle="",
-                          label="default")]
-    handles += [plt.Line2D([], [], marker="o", color=colours[f], linestyle="", label=f) for f in fams]
-    key_ax.legend(handles=handles, fontsize=8, loc="upper left", title="knob", title_fontsize=9)
-    key = [(f"{i + 1:>2}  {c}  " + " ".join(f.replace("-D", "", 1) for f in flags[c].split()),
-            colours[family(c, flags[c])]) for c, i in order.items()]
-    top = 0.97 - 0.03 * (len(handles) + 2)
-    step = min(0.025, top / max(len(key), 1))
-    for k, (text, colour) in enumerate(key):
-        key_ax.text(0.0, top - k * step, text, transform=key_ax.transAxes, fontsize=7, family="monospace",
-                    color=colour, va="top")
-    fig.suptitle(f"Precision knobs: error against the reference renderer vs. instructions per frame ({better})")
-    fig.subplots_adjust(left=0.07, right=0.99, top=0.95, bottom=0.06)
-    for ax, items in labels:  # placed in figure pixels, so after the layout is final
-        _place_labels(ax, items)
+            named = [(i, p) for i, p in enumerate(pts) if i in on_front or p["config"] == DEFAULT]
+            placements.append((ax, zero, [(xy[i], p) for i, p in named], [xy[i] for i in range(len(pts))]))
+    fig.canvas.draw()  # the layout is final: labels are measured and placed in display pixels
+    boxes = []
+    for ax, zero, named, allxy in placements:
+        taken = []
+        for target in (ax, zero):
+            for x, y in allxy:  # the markers, as boxes of their size
+                if (y > 0) == (target is ax):
+                    px, py = target.transData.transform((x, y))
+                    taken.append(matplotlib.transforms.Bbox([[px - 12, py - 12], [px + 12, py + 12]]))
+        written = []
+        for target in (ax, zero):
+            items = [(x, y, p["config"], colours[family(p["config"], p["flags"])]) for (x, y), p in named
+                     if (y > 0) == (target is ax)]
+            own = [b for b in taken]
+            written += _place_labels(fig, target, items, own)
+            taken = own
+        boxes.append(written)
     fig.savefig(path, dpi=fig.dpi)
+    texts = [t.get_text() for t in fig.findobj(matplotlib.text.Text)]
     plt.close(fig)
+    return {"labels": boxes, "texts": texts}
 
 
 # ---- main ------------------------------------------------------------------------------------
@@ -588,7 +659,10 @@ def main(argv=None):
     ap.add_argument("--views", type=int, default=0, help="only the first N views (bench views first)")
     ap.add_argument("--tex-views", type=int, default=None, metavar="N",
                     help="texel-and-light error over the first N bench views (default: all; 0: none)")
-    ap.add_argument("--no-ir", action="store_true", help="no instruction counts (no callgrind)")
+    ap.add_argument("--no-ir", action="store_true", help="no instruction counts (no callgrind, no Cortex-M3)")
+    ap.add_argument("--m3-views", type=int, default=8, metavar="N",
+                    help="instructions per frame on the Cortex-M3 (QEMU) over the first N bench views, mode "
+                         f"{report_m3.MODE} (default 8; 0: none)")
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="parallel workers")
     ap.add_argument("--knob-dir", type=Path, default=KNOB, help="where the configurations' binaries are")
     ap.add_argument("--out", type=Path, default=BUILD / "report", help="output folder")
@@ -700,6 +774,13 @@ def main(argv=None):
                 cache.put(key, r)
         cache.save()
 
+    # run time on the Cortex-M3: every configuration's firmware, mode columns, the first bench views
+    m3, m3_views = {}, []
+    if not args.no_ir and args.m3_views > 0:
+        m3_views = [v for v in views if v["set"] == "bench"][:args.m3_views]
+        log(f"Cortex-M3: {len(configs)} configurations x {len(m3_views)} views, mode {report_m3.MODE}")
+        m3 = report_m3.measure(configs, m3_views, out / "m3", cache, log, jobs=args.jobs)
+
     points = []
     for c in configs:
         for m in MODES:
@@ -707,6 +788,7 @@ def main(argv=None):
             ir = [irs[(c, m, i)] for i, v in enumerate(views) if (c, m, i) in irs]
             tex = [(texerr[(c, m, i)], views[i]["name"]) for i in tex_views]
             points.append(summarise(c, configs[c], m, views, errs, ir, tex))
+            points[-1]["m3_ir"] = int(statistics.median(m3[c])) if c in m3 and m == report_m3.MODE else None
     per_scene = {}
     if DEFAULT in configs:
         for i, v in enumerate(views):
@@ -722,7 +804,7 @@ def main(argv=None):
     png = out / "error_vs_ir.png"
     plot(png, points, args.no_ir)
     write_markdown(out / "report.md", points, per_scene, views, configs, png.name, args.no_ir,
-                   [views[i]["name"] for i in tex_views])
+                   [views[i]["name"] for i in tex_views], [v["name"] for v in m3_views])
     (out / "points.json").write_text(json.dumps({"points": points, "per_scene": per_scene}, indent=1))
     log(f"wrote {out / 'report.md'} and {png} in {time.time() - t_start:.0f} s")
     print((out / "report.md").read_text())
