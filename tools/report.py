@@ -635,7 +635,7 @@ def plot(path, points, no_ir):
             for x, y in allxy:  # the markers, as boxes of their size
                 if (y > 0) == (target is ax):
                     px, py = target.transData.transform((x, y))
-                    taken.append(matplotlib.transforms.Bbox([[px - 12, py - 12], [px + 12, py + 12]]))
+                    taken.append(matplotlib.transforms.Bbox([[px - 14, py - 14], [px + 14, py + 14]]))  # a ring's size
         written = []
         for target in (ax, zero):
             items = [(x, y, p["config"], colours[family(p["config"], p["flags"])]) for (x, y), p in named
