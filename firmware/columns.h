@@ -21,16 +21,18 @@
  * dword at a time.
  *
  * Objects: an object is taken in at the first leaf of the walk its box touches
- * (obj_list.h, as mode direct does) and claims the rows still open in its screen
- * box; the world drawn before is in front of it by the tree's order. The
+ * (obj_list.h, as mode direct does) and claims the pixels of its faces still
+ * open; the walls drawn before are in front of it by the tree's order. The
  * claimed pixels are drawn after the walk by mode direct alone
- * (direct_render_within), which sorts objects and world there exactly. The
+ * (direct_render_within, told which objects claimed them), which sorts objects
+ * and the world in front of them there exactly. The
  * gap rule needs an eye inside the world (eye.h): other frames are drawn by
  * mode direct whole, with the same work memory (render_stats.fallback).
  *
- * Memory: the objects' pixel mask, then the per-column state, CFG_COLS_PLANES
- * visplanes of 652 bytes and the objects in view, or direct's need if larger
- * (docs/needs.md); bounded by the screen and the objects, never by the map. */
+ * Memory: the objects' pixel mask and a bit per object, then the per-column
+ * state, CFG_COLS_PLANES visplanes of 652 bytes and the objects in view, or
+ * direct's need if larger (docs/needs.md); bounded by the screen and the
+ * objects, never by the map. */
 #ifndef COLUMNS_H
 #define COLUMNS_H
 

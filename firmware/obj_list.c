@@ -64,6 +64,16 @@ static uint32_t first_at_or_east(void *list, uint32_t n, uint32_t size, int32_t 
     return lo;
 }
 
+/* The first record whose box can reach a map box's west-east extent; *east: past
+ * which west edge no later record can. */
+static uint32_t stretch_start(void *list, uint32_t n, uint32_t size, const int32_t box[BOX_SIDES], int32_t reach,
+                              int32_t *east)
+{
+    int64_t west = ((int64_t)box[BOX_LEFT] >> 16) - 2 * (int64_t)reach - 1;
+    *east = box[BOX_RIGHT] >> 16;
+    return first_at_or_east(list, n, size, west < INT32_MIN ? INT32_MIN : (int32_t)west);
+}
+
 void objl_take_in_leaf(const scene *sc, const world_state *w, uint32_t leaf, void *list, uint32_t n, uint32_t size,
                        int32_t reach, void (*take)(void *ctx, uint32_t i), void *ctx)
 {
@@ -71,9 +81,9 @@ void objl_take_in_leaf(const scene *sc, const world_state *w, uint32_t leaf, voi
     int32_t box[BOX_SIDES];
     objd_leaf_box(sc, f, box);
     if (box[BOX_LEFT] > box[BOX_RIGHT]) return;
-    /* only the stretch of the list whose boxes can reach the leaf's west-east extent */
-    int32_t west = (box[BOX_LEFT] >> 16) - 2 * reach - 1, east = box[BOX_RIGHT] >> 16;
-    for (uint32_t i = first_at_or_east(list, n, size, west); i < n && objl_at(list, i, size)->left <= east; i++) {
+    int32_t east; /* only the stretch of the list whose boxes can reach the leaf's west-east extent */
+    for (uint32_t i = stretch_start(list, n, size, box, reach, &east); i < n && objl_at(list, i, size)->left <= east;
+         i++) {
         objl_entry *e = objl_at(list, i, size);
         if ((e->taken & OBJL_AT_LEAF) || !objd_touches_leaf(sc, &w->objs[e->index], f, box)) continue;
         int seen = e->taken & OBJL_SEEN;
@@ -85,9 +95,8 @@ void objl_take_in_leaf(const scene *sc, const world_state *w, uint32_t leaf, voi
 void objl_take_in_box(const world_state *w, const int32_t box[BOX_SIDES], void *list, uint32_t n, uint32_t size,
                       int32_t reach, void (*take)(void *ctx, uint32_t i), void *ctx)
 {
-    int64_t west = ((int64_t)box[BOX_LEFT] >> 16) - 2 * (int64_t)reach - 1, east = (int64_t)box[BOX_RIGHT] >> 16;
-    if (west < INT32_MIN) west = INT32_MIN;
-    for (uint32_t i = first_at_or_east(list, n, size, (int32_t)west); i < n && objl_at(list, i, size)->left <= east;
+    int32_t east;
+    for (uint32_t i = stretch_start(list, n, size, box, reach, &east); i < n && objl_at(list, i, size)->left <= east;
          i++) {
         objl_entry *e = objl_at(list, i, size);
         if (e->taken) continue;
