@@ -17,6 +17,8 @@ static const uint32_t record_bytes[SCN_SEC_COUNT] = {
     sizeof(scn_look),    256,
     sizeof(scn_texture), 1,
     sizeof(scn_side),    sizeof(scn_plane),
+    sizeof(scn_sprite),  sizeof(uint32_t),
+    sizeof(scn_sprset),
 };
 
 const char *scene_status_text(scene_status st)
@@ -42,9 +44,10 @@ const char *scene_status_text(scene_status st)
 const char *scene_section_name(int section)
 {
     static const char *const names[SCN_SEC_COUNT] = {
-        "vertices", "sectors",      "lines",          "segs",   "nodes",        "leaves",  "leaf polygon vertices",
-        "palette",  "models",       "model vertices", "faces",  "face indices", "objects", "needs",
-        "look",     "light tables", "textures",       "texels", "sides",        "planes",
+        "vertices",     "sectors",      "lines",          "segs",   "nodes",        "leaves",  "leaf polygon vertices",
+        "palette",      "models",       "model vertices", "faces",  "face indices", "objects", "needs",
+        "look",         "light tables", "textures",       "texels", "sides",        "planes",  "sprites",
+        "sprite masks", "sprite sets",
     };
     return (section >= 0 && section < SCN_SEC_COUNT) ? names[section] : "header";
 }
@@ -96,7 +99,7 @@ static scene_status check_look_sections(scene *s, const uint8_t *base, const scn
     uint32_t look = sec[SCN_SEC_LOOK].count;
     if (look > 1) return fail(err, SCENE_ERR_SECTION, SCN_SEC_LOOK, 0);
     if (look == 0) {
-        for (int i = SCN_SEC_LIGHTS; i <= SCN_SEC_PLANES; i++)
+        for (int i = SCN_SEC_LIGHTS; i <= SCN_SEC_SPRSETS; i++)
             if (sec[i].count != 0) return fail(err, SCENE_ERR_SECTION, i, 0);
         s->look = 0;
     } else {
@@ -112,6 +115,12 @@ static scene_status check_look_sections(scene *s, const uint8_t *base, const scn
     s->texels = base + sec[SCN_SEC_TEXELS].offset;
     s->sides = (const scn_side *)(base + sec[SCN_SEC_SIDES].offset);
     s->planes = (const scn_plane *)(base + sec[SCN_SEC_PLANES].offset);
+    s->sprites = (const scn_sprite *)(base + sec[SCN_SEC_SPRITES].offset);
+    s->sprmask = (const uint32_t *)(base + sec[SCN_SEC_SPRMASK].offset);
+    s->sprsets = (const scn_sprset *)(base + sec[SCN_SEC_SPRSETS].offset);
+    s->nsprites = sec[SCN_SEC_SPRITES].count;
+    s->nsprmask = sec[SCN_SEC_SPRMASK].count;
+    s->nsprsets = sec[SCN_SEC_SPRSETS].count;
     s->nlights = sec[SCN_SEC_LIGHTS].count;
     s->ntextures = sec[SCN_SEC_TEXTURES].count;
     s->ntexels = sec[SCN_SEC_TEXELS].count;
@@ -331,6 +340,42 @@ static scene_status check_look(const scene *s, scene_error *err)
     return SCENE_OK;
 }
 
+/* Every sprite image inside the texels and masks and within its size limits,
+ * every sprite set's images in range, and every sprite object's model holding
+ * its images in every rotation (docs/objects.md, "Sprites"). */
+static scene_status check_sprites(const scene *s, scene_error *err)
+{
+    const int32_t off_max = SCN_MODEL_MAX;
+    for (uint32_t i = 0; i < s->nsprites; i++) {
+        const scn_sprite *p = &s->sprites[i];
+        if (p->width < 1 || p->width > SCN_SPRITE_MAX || p->height < 1 || p->height > SCN_SPRITE_MAX ||
+            p->left < -off_max || p->left > off_max || p->top < -off_max || p->top > off_max)
+            return fail(err, SCENE_ERR_RANGE, SCN_SEC_SPRITES, i);
+        uint64_t words = (uint64_t)p->width * (((uint32_t)p->height + 31u) >> 5);
+        if ((uint64_t)p->first + (uint64_t)p->width * p->height > s->ntexels || (uint64_t)p->mask + words > s->nsprmask)
+            return fail(err, SCENE_ERR_INDEX, SCN_SEC_SPRITES, i);
+    }
+    for (uint32_t i = 0; i < s->nsprsets; i++) {
+        const scn_sprset *q = &s->sprsets[i];
+        for (int r = 0; r < SCN_SPRITE_ROTS; r++)
+            if (q->image[r] >= s->nsprites) return fail(err, SCENE_ERR_INDEX, SCN_SEC_SPRSETS, i);
+        if ((q->flags & ~SCN_SPRSET_BRIGHT) || q->reserved != 0) return fail(err, SCENE_ERR_RANGE, SCN_SEC_SPRSETS, i);
+    }
+    for (uint32_t i = 0; i < s->nobjects; i++) {
+        const scn_object *o = &s->objects[i];
+        if (o->sprset == SCN_NONE) continue;
+        if (o->sprset >= s->nsprsets) return fail(err, SCENE_ERR_INDEX, SCN_SEC_OBJECTS, i);
+        const scn_model *m = &s->models[o->model];
+        for (int r = 0; r < SCN_SPRITE_ROTS; r++) {
+            const scn_sprite *p = &s->sprites[s->sprsets[o->sprset].image[r]];
+            int32_t reach = p->left > p->width - p->left ? p->left : p->width - p->left;
+            if ((int64_t)reach << 16 > m->radius || (int64_t)p->top << 16 > m->zmax || m->zmin > 0)
+                return fail(err, SCENE_ERR_RANGE, SCN_SEC_OBJECTS, i);
+        }
+    }
+    return SCENE_OK;
+}
+
 /* Walk the whole graph from the root with a stack of SCN_MAX_DEPTH + 1 entries,
  * counting visits: a tree visits each node at most once, so more visits than
  * nodes means a shared child or a cycle. Bounded by nnodes + 1 pops. */
@@ -396,6 +441,7 @@ scene_status scene_parse(scene *s, const void *blob, uint32_t len, scene_error *
     if (st == SCENE_OK) st = check_geometry(s, err);
     if (st == SCENE_OK) st = check_objects(s, err);
     if (st == SCENE_OK) st = check_look(s, err);
+    if (st == SCENE_OK) st = check_sprites(s, err);
     if (st == SCENE_OK) st = check_tree(s, err);
     return st;
 }

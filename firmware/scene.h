@@ -34,6 +34,13 @@ typedef struct {
     const uint8_t *texels;
     const scn_side *sides;
     const scn_plane *planes;
+    /* WAD things' sprites (docs/objects.md, "Sprites"): none without a look.
+     * The loader guarantees every image lies inside texels[] and sprmask[],
+     * every set's images exist, and each sprite object's model holds them. */
+    const scn_sprite *sprites;
+    const uint32_t *sprmask;
+    const scn_sprset *sprsets;
+    uint32_t nsprites, nsprmask, nsprsets;
     uint32_t nlights, ntextures, ntexels;
     uint32_t nverts, nsectors, nlines, nsegs, nnodes, nleaves, npverts;
     uint32_t nmodels, nmverts, nfaces, nfindex, nobjects;

@@ -26,7 +26,7 @@
 #include <stdint.h>
 
 #define SCN_MAGIC 0x4E435342u /* bytes "BSCN" */
-#define SCN_VERSION 4u
+#define SCN_VERSION 5u
 #define SCN_NONE 0xFFFFFFFFu     /* "no sector" / "no index" */
 #define SCN_LEAF_BIT 0x80000000u /* child index refers to a leaf */
 
@@ -64,6 +64,10 @@ enum scn_section_id {
     SCN_SEC_TEXELS,   /* uint8_t[]: the textures' texels (count = bytes; the section is padded to 4) */
     SCN_SEC_SIDES,    /* scn_side[]: per line side, index line * 2 + side */
     SCN_SEC_PLANES,   /* scn_plane[]: per sector, its floor and ceiling textures */
+    /* Sprites of WAD things (docs/objects.md, "Sprites"); counts 0 in a flat-shaded scene. */
+    SCN_SEC_SPRITES, /* scn_sprite[]: sprite images (their texels are in SCN_SEC_TEXELS) */
+    SCN_SEC_SPRMASK, /* uint32_t[]: the images' opacity bits */
+    SCN_SEC_SPRSETS, /* scn_sprset[]: a thing's image for each of the 8 rotations */
     SCN_SEC_COUNT
 };
 
@@ -162,6 +166,7 @@ typedef struct {
     int32_t pa, pb;     /* 16.16: circle radius, 0; line DX, DY */
     uint32_t period_ms; /* one turn or one round trip; > 0 when path != SCN_PATH_NONE */
     int32_t spin;       /* degrees per second, 16.16 */
+    uint32_t sprset;    /* drawn as this sprite set, or SCN_NONE: as its model [index: SPRSETS or SCN_NONE] */
 } scn_object;
 
 /* ---- Textures and light (docs/textures.md) ---- */
@@ -211,6 +216,31 @@ typedef struct {
     uint16_t floor_tex; /* scn_texture index, or SCN_TEX_NONE [index: TEXTURES or SCN_TEX_NONE] */
     uint16_t ceil_tex;  /* the same; SCN_TEX_NONE is a sky ceiling [index: TEXTURES or SCN_TEX_NONE] */
 } scn_plane;
+
+/* ---- Sprites (docs/objects.md, "Sprites") ---- */
+
+#define SCN_SPRITE_MAX 512   /* width and height of a sprite image, texels */
+#define SCN_SPRITE_ROTS 8    /* Doom's rotations: 0 seen from the front, then every 45 degrees */
+#define SCN_SPRSET_BRIGHT 1u /* full-bright: drawn with light table 0 */
+
+/* An image of a sprite: Doom's patch, decoded. Column u (0 left) row v (0 top)
+ * is texels[first + u * height + v]; it is opaque where bit (v & 31) of
+ * mask words[mask + u * ((height + 31) >> 5) + (v >> 5)] is set. */
+typedef struct {
+    uint32_t first;         /* [range: TEXELS, width * height] */
+    uint32_t mask;          /* [range: SPRMASK, width * ((height + 31) >> 5)] */
+    uint16_t width, height; /* 1 .. SCN_SPRITE_MAX */
+    int16_t left, top;      /* Doom's offsets: the origin is left texels right of column 0, row 0 top above it */
+} scn_sprite;
+
+/* The images of one thing, by rotation (the angle from the eye to the thing,
+ * less the thing's yaw: docs/objects.md). */
+typedef struct {
+    uint16_t image[SCN_SPRITE_ROTS]; /* [index: SPRITES] */
+    uint8_t mirror;                  /* bit r: rotation r's image is drawn mirrored left to right */
+    uint8_t flags;                   /* SCN_SPRSET_* */
+    uint16_t reserved;               /* 0 */
+} scn_sprset;
 
 /* What a scene needs of a renderer, written by the compiler's analysis
  * (tools/bspc/needs.c, docs/needs.md). A build compiled for one scene

@@ -78,7 +78,7 @@ def flat_names(lumps):
 
 
 def sections(blob):
-    return [struct.unpack_from("<II", blob, 44 + 8 * i) for i in range(20)]
+    return [struct.unpack_from("<II", blob, 44 + 8 * i) for i in range(23)]
 
 
 def measure(bspc, wad, mapname, tmp):

@@ -14,7 +14,9 @@ _Static_assert(sizeof(scn_sector) == 16, "scn_sector layout");
 _Static_assert(sizeof(scn_model) == 28, "scn_model layout");
 _Static_assert(sizeof(scn_mvert) == 12, "scn_mvert layout");
 _Static_assert(sizeof(scn_face) == 8, "scn_face layout");
-_Static_assert(sizeof(scn_object) == 40, "scn_object layout");
+_Static_assert(sizeof(scn_object) == 44, "scn_object layout");
+_Static_assert(sizeof(scn_sprite) == 16, "scn_sprite layout");
+_Static_assert(sizeof(scn_sprset) == 20, "scn_sprset layout");
 _Static_assert(sizeof(scn_line) == 24, "scn_line layout");
 _Static_assert(sizeof(scn_seg) == 16, "scn_seg layout");
 _Static_assert(sizeof(scn_node) == 56, "scn_node layout");
@@ -135,9 +137,12 @@ static uint64_t blob_layout(const bs_scene *s, const bs_tree *t, uint32_t counts
                                        look ? lk->ntex : 0u,
                                        look ? lk->ntexels : 0u,
                                        look ? 2u * s->nlines : 0u,
-                                       look ? s->nsectors : 0u};
-    static const uint32_t recsz[SCN_SEC_COUNT] = {8, 12 + 4, 24, 16, 56, 20, 8, 3, 28, 12, 8, 4, 40, sizeof(scn_needs),
-                                                  8, 256,    12, 1,  24, 4};
+                                       look ? s->nsectors : 0u,
+                                       look ? lk->nsprites : 0u,
+                                       look ? lk->nsprmask : 0u,
+                                       look ? lk->nsprsets : 0u};
+    static const uint32_t recsz[SCN_SEC_COUNT] = {8, 12 + 4, 24, 16, 56, 20, 8,  3, 28, 12, 8, 4, 44, sizeof(scn_needs),
+                                                  8, 256,    12, 1,  24, 4,  16, 4, 20};
     uint64_t at = sizeof(scn_header);
     for (int k = 0; k < SCN_SEC_COUNT; k++) {
         at = (at + 3) & ~(uint64_t)3;
@@ -334,6 +339,7 @@ static void put_objects(wr *w, const blob_src *b)
         wi32(w, o->pb);
         w32(w, o->period_ms);
         wi32(w, o->spin);
+        w32(w, o->sprset1 ? o->sprset1 - 1 : SCN_NONE);
     }
 }
 
@@ -389,6 +395,35 @@ static void put_planes(wr *w, const blob_src *b)
     }
 }
 
+static void put_sprites(wr *w, const blob_src *b)
+{
+    for (uint32_t i = 0; i < b->s->look.nsprites; i++) {
+        const scn_sprite *p = &b->s->look.sprites[i];
+        w32(w, p->first);
+        w32(w, p->mask);
+        w16(w, p->width);
+        w16(w, p->height);
+        w16(w, (uint16_t)p->left);
+        w16(w, (uint16_t)p->top);
+    }
+}
+
+static void put_sprmask(wr *w, const blob_src *b)
+{
+    for (uint32_t i = 0; i < b->s->look.nsprmask; i++) w32(w, b->s->look.sprmask[i]);
+}
+
+static void put_sprsets(wr *w, const blob_src *b)
+{
+    for (uint32_t i = 0; i < b->s->look.nsprsets; i++) {
+        const scn_sprset *p = &b->s->look.sprsets[i];
+        for (int r = 0; r < SCN_SPRITE_ROTS; r++) w16(w, p->image[r]);
+        w8(w, p->mirror);
+        w8(w, p->flags);
+        w16(w, 0);
+    }
+}
+
 /* One writer per section, in enum order. The needs record (SCN_SEC_NEEDS) has
  * none: it stays zero here, and bspc.c fills it in from the analysis of this
  * very blob and recomputes the CRC. */
@@ -399,7 +434,8 @@ static void (*const put_section[SCN_SEC_COUNT])(wr *, const blob_src *) = {
     [SCN_SEC_MVERTS] = put_mverts,     [SCN_SEC_FACES] = put_faces,     [SCN_SEC_FINDEX] = put_findex,
     [SCN_SEC_OBJECTS] = put_objects,   [SCN_SEC_LOOK] = put_look,       [SCN_SEC_LIGHTS] = put_lights,
     [SCN_SEC_TEXTURES] = put_textures, [SCN_SEC_TEXELS] = put_texels,   [SCN_SEC_SIDES] = put_sides,
-    [SCN_SEC_PLANES] = put_planes,
+    [SCN_SEC_PLANES] = put_planes,     [SCN_SEC_SPRITES] = put_sprites, [SCN_SEC_SPRMASK] = put_sprmask,
+    [SCN_SEC_SPRSETS] = put_sprsets,
 };
 
 int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *len, char *err, size_t errlen)

@@ -104,8 +104,9 @@ typedef struct {
     uint32_t path;        /* SCN_PATH_* */
     int32_t pa, pb;       /* 16.16 */
     uint32_t period_ms;
-    int32_t spin; /* degrees per second, 16.16 */
-    int src_line; /* text: line; WAD: thing index in the lump */
+    int32_t spin;     /* degrees per second, 16.16 */
+    int src_line;     /* text: line; WAD: thing index in the lump */
+    uint32_t sprset1; /* 1 + its bs_look sprite set; 0: drawn as its model */
 } bs_object;
 
 /* Limits beyond scene_format.h that keep the path arithmetic of docs/objects.md
@@ -128,6 +129,13 @@ typedef struct {
     scn_side *sides;       /* 2 per scene line, index line * 2 + side */
     scn_plane *planes;     /* one per sector */
     uint8_t shade[3][256]; /* model faces' fake contrast under PLAYPAL: [contrast + 1][colour] */
+    /* the things' sprites (docs/objects.md, "Sprites"); their texels are in texels[] */
+    scn_sprite *sprites;
+    uint32_t nsprites, spcap;
+    uint32_t *sprmask;
+    uint32_t nsprmask, smcap;
+    scn_sprset *sprsets;
+    uint32_t nsprsets, sscap;
 } bs_look;
 
 typedef struct {
