@@ -7,6 +7,7 @@
 #include "eye.h"
 #include "obj_draw.h"
 #include "obj_list.h"
+#include "sprite.h"
 #include "surfaces.h"
 
 #define BACKGROUND_COLOUR 0
@@ -31,8 +32,12 @@ typedef struct {
     int16_t top, bottom; /* rows [top, bottom) */
     uint16_t first_edge; /* into the edge pool (or the scratch face's own) */
     uint8_t nedges, colour;
-    uint32_t obj, model_face; /* whose face it is: the object, and the face in the scene's faces */
-    int32_t zmin, zmax;       /* the view depths of its vertices */
+    uint32_t obj,
+        model_face;     /* whose face it is: the object, and the face in the scene's faces (SCN_NONE: its sprite) */
+    int32_t zmin, zmax; /* the view depths of its vertices */
+#if CFG_TEXTURES
+    spr_view spr; /* a sprite: its image, placement and light */
+#endif
 } dr_face;
 
 typedef struct {
@@ -138,15 +143,10 @@ static int face_row(const dr_face *f, const dr_edge *edges, int y, int *a, int *
     return lo < hi;
 }
 
-/* Face fi of the object's model, if it faces the eye and shows: its plane, rows
- * and edges (into edges[], at most FACE_EDGES). */
-static int face_build(const scene *sc, const view_xform *v, const scn_model *m, uint32_t obj, const view_pt *verts,
-                      uint32_t fi, dr_face *f, dr_edge *edges, screen_pt box[2])
+/* A face's rows and edges (into edges[], at most FACE_EDGES) from its n screen
+ * points; its box grows box. 0 if it covers no row. */
+static int face_edges(const screen_pt *pts, int n, dr_face *f, dr_edge *edges, screen_pt box[2])
 {
-    screen_pt pts[CLIP_MAX_VERTS];
-    if (!objd_face_plane(sc, m, fi, verts, &f->pl)) return 0;
-    int n = objd_face_screen(sc, m, fi, verts, v, pts);
-    if (!n) return 0;
     int ne = 0, top = VIEW_H, bottom = 0;
     for (int i = 0; i < n; i++) {
         screen_pt a = pts[i], b = pts[(i + 1 == n) ? 0 : i + 1];
@@ -167,6 +167,18 @@ static int face_build(const scene *sc, const view_xform *v, const scn_model *m, 
     f->top = (int16_t)top;
     f->bottom = (int16_t)bottom;
     f->nedges = (uint8_t)ne;
+    return 1;
+}
+
+/* Face fi of the object's model, if it faces the eye and shows: its plane, rows
+ * and edges (into edges[], at most FACE_EDGES). */
+static int face_build(const scene *sc, const view_xform *v, const scn_model *m, uint32_t obj, const view_pt *verts,
+                      uint32_t fi, dr_face *f, dr_edge *edges, screen_pt box[2])
+{
+    screen_pt pts[CLIP_MAX_VERTS];
+    if (!objd_face_plane(sc, m, fi, verts, &f->pl)) return 0;
+    int n = objd_face_screen(sc, m, fi, verts, v, pts);
+    if (!n || !face_edges(pts, n, f, edges, box)) return 0;
     const uint32_t *ix = &sc->findex[sc->faces[fi].first_index];
     f->zmin = INT32_MAX;
     f->zmax = INT32_MIN;
@@ -178,6 +190,85 @@ static int face_build(const scene *sc, const view_xform *v, const scn_model *m, 
     f->obj = obj;
     f->model_face = fi;
     return 1;
+}
+
+#if CFG_TEXTURES
+/* Object obj's sprite (set sprset) as one face, if it shows (sprite.h). */
+static int sprite_face_build(const scene *sc, const world_state *w, const view_xform *v, uint32_t obj, uint32_t sprset,
+                             dr_face *f, dr_edge *edges, screen_pt box[2])
+{
+    view_pt quad[4];
+    screen_pt pts[CLIP_MAX_VERTS];
+    if (!spr_view_of(sc, &w->objs[obj], sprset, v, &f->spr, quad)) return 0;
+    view_pt front[4] = {quad[3], quad[2], quad[1], quad[0]}; /* counter-clockwise seen from the eye */
+    if (!objd_points_plane(front, 4, &f->pl)) return 0;
+    int n = objd_points_screen(quad, 4, v, pts);
+    if (!n || !face_edges(pts, n, f, edges, box)) return 0;
+    const scn_model *m = &sc->models[w->objs[obj].model];
+    f->zmin = f->zmax = f->spr.zc;
+    f->colour = sc->faces[m->first_face].colour; /* a flat-shaded target's colour */
+    f->obj = obj;
+    f->model_face = SCN_NONE;
+    return 1;
+}
+#endif
+
+/* The faces of one object that face the eye and show, one at a time: its
+ * sprite's, or its model's. */
+typedef struct {
+    const scene *sc;
+    const world_state *w;
+    const view_xform *v;
+    const scn_model *m;
+    uint32_t obj, sprset, fi, end;
+    view_pt verts[CFG_MODEL_VERTS];
+} face_iter;
+
+static void faces_begin(face_iter *it, const scene *sc, const world_state *w, const view_xform *v, uint32_t obj)
+{
+    it->sc = sc;
+    it->w = w;
+    it->v = v;
+    it->obj = obj;
+    it->m = &sc->models[w->objs[obj].model];
+    it->sprset = obj_sprset(w, obj);
+    if (it->sprset != SCN_NONE) {
+        it->fi = 0;
+        it->end = 1;
+        return;
+    }
+    it->fi = it->m->first_face;
+    it->end = it->m->first_face + it->m->num_faces;
+    objd_transform(sc, &w->objs[obj], v, it->verts);
+}
+
+static int faces_next(face_iter *it, dr_face *f, dr_edge *edges, screen_pt box[2])
+{
+    while (it->fi < it->end) {
+        uint32_t fi = it->fi++;
+#if CFG_TEXTURES
+        if (it->sprset != SCN_NONE) {
+            if (sprite_face_build(it->sc, it->w, it->v, it->obj, it->sprset, f, edges, box)) return 1;
+            continue;
+        }
+#endif
+        if (face_build(it->sc, it->v, it->m, it->obj, it->verts, fi, f, edges, box)) return 1;
+    }
+    return 0;
+}
+
+/* A sprite face's opaque pixels of [a, b) on row y into op (cleared by the
+ * caller); 0 for a model's face, opaque all over. */
+static int face_opaque(const scene *sc, int look, const dr_face *f, int y, int a, int b, uint32_t *op)
+{
+#if CFG_TEXTURES
+    if (f->model_face != SCN_NONE) return 0;
+    spr_opaque(sc, &f->spr, look, y, a, b, op);
+    return 1;
+#else
+    (void)sc, (void)look, (void)f, (void)y, (void)a, (void)b, (void)op;
+    return 0;
+#endif
 }
 
 /* Calls visit(S, o, face, its edges, ctx) for each face of the active object o
@@ -193,30 +284,31 @@ static void each_face(dr_state *S, dr_obj *o, face_visit visit, void *ctx)
         }
         return;
     }
-    const scene *sc = S->sc;
-    const scn_model *m = &sc->models[S->w->objs[o->e.index].model];
-    view_pt verts[CFG_MODEL_VERTS];
+    face_iter it;
     screen_pt box[2];
-    objd_transform(sc, &S->w->objs[o->e.index], S->v, verts);
-    for (uint32_t fi = m->first_face; fi < m->first_face + m->num_faces; fi++)
-        if (face_build(sc, S->v, m, o->e.index, verts, fi, &S->scratch_face, S->scratch_edges, box))
-            visit(S, o, &S->scratch_face, S->scratch_edges, ctx);
+    faces_begin(&it, S->sc, S->w, S->v, o->e.index);
+    while (faces_next(&it, &S->scratch_face, S->scratch_edges, box))
+        visit(S, o, &S->scratch_face, S->scratch_edges, ctx);
 }
 
 void direct_object_rows(const scene *sc, const world_state *w, const view_xform *v, uint32_t obj,
                         void (*row)(void *ctx, int y, int x0, int x1), void *ctx)
 {
-    const scn_model *m = &sc->models[w->objs[obj].model];
-    view_pt verts[CFG_MODEL_VERTS];
+    face_iter it;
     screen_pt box[2] = {{0, 0}, {0, 0}};
     dr_face f;
     dr_edge edges[FACE_EDGES];
-    objd_transform(sc, &w->objs[obj], v, verts);
-    for (uint32_t fi = m->first_face; fi < m->first_face + m->num_faces; fi++) {
-        if (!face_build(sc, v, m, obj, verts, fi, &f, edges, box)) continue;
+    faces_begin(&it, sc, w, v, obj);
+    while (faces_next(&it, &f, edges, box)) {
         for (int y = f.top; y < f.bottom; y++) {
             int a, b;
-            if (face_row(&f, edges, y, &a, &b)) row(ctx, y, a, b);
+            uint32_t op[COV_WORDS] = {0};
+            if (!face_row(&f, edges, y, &a, &b)) continue;
+            if (!face_opaque(sc, VIEW_LOOK(v), &f, y, a, b, op)) {
+                row(ctx, y, a, b);
+                continue;
+            }
+            for (int x = a, x0; spr_next_run(op, &x, b, &x0);) row(ctx, y, x0, x); /* the opaque runs */
         }
     }
 }
@@ -255,15 +347,12 @@ static void reclaim(dr_state *S)
  * where needed), and its screen box. */
 static void activate(dr_state *S, dr_obj *o)
 {
-    const scene *sc = S->sc;
-    const scn_model *m = &sc->models[S->w->objs[o->e.index].model];
-    view_pt verts[CFG_MODEL_VERTS];
+    face_iter it;
     screen_pt box[2] = {{INT32_MAX, INT32_MAX}, {INT32_MIN, INT32_MIN}};
     uint32_t nf = 0, ne = S->nedges, stored = 1;
-    objd_transform(sc, &S->w->objs[o->e.index], S->v, verts);
-    for (uint32_t fi = m->first_face; fi < m->first_face + m->num_faces; fi++) {
-        dr_face *f = &S->scratch_face;
-        if (!face_build(sc, S->v, m, o->e.index, verts, fi, f, S->scratch_edges, box)) continue;
+    dr_face *f = &S->scratch_face;
+    faces_begin(&it, S->sc, S->w, S->v, o->e.index);
+    while (faces_next(&it, f, S->scratch_edges, box)) {
         /* into the pools if the face and its own edges fit, after making room if
          * the first face does not */
         if (nf == 0 && !(S->nfaces < S->face_cap && ne + f->nedges <= S->edge_cap)) {
@@ -379,11 +468,13 @@ static void keep_nearer_face(dr_state *S, dr_obj *o, const dr_face *g, const dr_
     if (a < k->x0) a = k->x0;
     if (b > k->x1) b = k->x1;
     if (a >= b || g->zmin > k->self->zmax + DEPTH_APART) return; /* g lies wholly behind */
+    uint32_t front[COV_WORDS] = {0}, op[COV_WORDS] = {0};
     if (g->zmax + DEPTH_APART < k->self->zmin)
-        cov_line_set(k->keep, a, b); /* wholly in front */
+        cov_line_set(front, a, b); /* wholly in front */
     else
-        mark_in_front(k->keep, &g->pl, 1 + (int)g->obj, &k->self->pl, 1 + (int)k->self->obj, VIEW_LOOK(S->v), k->y, a,
-                      b);
+        mark_in_front(front, &g->pl, 1 + (int)g->obj, &k->self->pl, 1 + (int)k->self->obj, VIEW_LOOK(S->v), k->y, a, b);
+    int holes = face_opaque(S->sc, VIEW_LOOK(S->v), g, k->y, a, b, op); /* g hides nothing through its holes */
+    for (int w = 0; w < COV_WORDS; w++) k->keep[w] |= holes ? front[w] & op[w] : front[w];
 }
 
 /* Fill [a, b) of row y with face (a copy: looking at the other faces may rebuild
@@ -391,14 +482,20 @@ static void keep_nearer_face(dr_state *S, dr_obj *o, const dr_face *g, const dr_
  * active face is nearer. */
 static void draw_face_row(dr_state *S, dr_obj *o, const dr_face *face, int y, int a, int b, const uint32_t *mine)
 {
-    uint32_t keep[COV_WORDS];
-    for (int w = 0; w < COV_WORDS; w++) keep[w] = mine ? ~mine[w] : 0;
+    uint32_t keep[COV_WORDS], op[COV_WORDS] = {0};
+    int holes = face_opaque(S->sc, VIEW_LOOK(S->v), face, y, a, b, op); /* its holes show what lies behind */
+    for (int w = 0; w < COV_WORDS; w++) keep[w] = (mine ? ~mine[w] : 0) | (holes ? ~op[w] : 0);
     near_ctx k = {face, keep, y, a, b};
     for (uint32_t i = 0; i < S->nactive; i++) {
         dr_obj *p = &S->objs[S->active[i]];
         if (p->y0 <= y && p->y1 > y && p->x0 < b && p->x1 > a) each_face(S, p, keep_nearer_face, &k);
     }
+#if CFG_TEXTURES
+    tex_paint paint = face->model_face == SCN_NONE ? tex_sprite(S->sc, &face->spr, VIEW_LOOK(S->v), face->colour)
+                                                   : tex_flat(face->colour);
+#else
     tex_paint paint = tex_flat(face->colour);
+#endif
     if (cov_fill(S->cov, S->t, y, a, b, keep, &paint, RAST_ID(RAST_KIND_OBJECT, o->e.index)) && !o->drew) {
         o->drew = 1;
         S->st->objects_visible++;
@@ -448,6 +545,9 @@ static void draw_face_over_world(dr_state *S, dr_obj *o, const dr_face *f, const
         cov_line_set(mine, a, b); /* the face is nearer all over */
     else
         mark_in_front(mine, &f->pl, 1 + (int)f->obj, k->world, 0, VIEW_LOOK(S->v), k->y, a, b);
+    uint32_t op[COV_WORDS] = {0};
+    if (face_opaque(S->sc, VIEW_LOOK(S->v), f, k->y, a, b, op)) /* the world shows through its holes */
+        for (int w = 0; w < COV_WORDS; w++) mine[w] &= op[w];
     uint32_t any = 0;
     for (int w = 0; w < COV_WORDS; w++) any |= mine[w];
     if (!any) return;

@@ -255,10 +255,18 @@ int objd_face_plane(const scene *s, const scn_model *m, uint32_t f, const view_p
 {
     const scn_face *fc = &s->faces[f];
     const uint32_t *ix = &s->findex[fc->first_index];
+    view_pt pts[SCN_MAX_FACE_VERTS];
     int n = fc->num_index;
+    (void)m;
+    for (int k = 0; k < n && k < SCN_MAX_FACE_VERTS; k++) pts[k] = verts[ix[k]];
+    return objd_points_plane(pts, n < SCN_MAX_FACE_VERTS ? n : SCN_MAX_FACE_VERTS, pl);
+}
+
+int objd_points_plane(const view_pt *pts, int n, objd_plane *pl)
+{
     int64_t sx = 0, sy = 0, sz = 0;
     for (int k = 0; k < n; k++) {
-        const view_pt *p = &verts[ix[k]];
+        const view_pt *p = &pts[k];
         sx += p->x;
         sy += p->y;
         sz += p->z;
@@ -269,9 +277,8 @@ int objd_face_plane(const scene *s, const scn_model *m, uint32_t f, const view_p
      * View space is left-handed (x right, y up, z forward), so for vertices running
      * counter-clockwise seen from outside the sum points into the part. */
     int64_t nx = 0, ny = 0, nz = 0;
-    (void)m;
     for (int k = 0; k < n; k++) {
-        const view_pt *p = &verts[ix[k]], *q = &verts[ix[k + 1 == n ? 0 : k + 1]];
+        const view_pt *p = &pts[k], *q = &pts[k + 1 == n ? 0 : k + 1];
         int64_t px = (int64_t)p->x - cx, py = (int64_t)p->y - cy, pz = (int64_t)p->z - cz;
         int64_t qx = (int64_t)q->x - cx, qy = (int64_t)q->y - cy, qz = (int64_t)q->z - cz;
         nx += (py - qy) * (pz + qz);
@@ -296,13 +303,22 @@ int objd_face_screen(const scene *s, const scn_model *m, uint32_t f, const view_
 {
     const scn_face *fc = &s->faces[f];
     const uint32_t *ix = &s->findex[fc->first_index];
-    clip_poly p;
+    view_pt pts[CLIP_MAX_VERTS];
+    int n = fc->num_index;
     (void)m;
-    p.n = fc->num_index;
-    if (p.n > CLIP_MAX_VERTS - 5) return 0; /* the loader refuses such a face for this build */
+    if (n > CLIP_MAX_VERTS - 5) return 0; /* the loader refuses such a face for this build */
     /* counter-clockwise seen from outside runs counter-clockwise on screen too (as a
      * floor does): reversed, it is the clockwise order the fill expects */
-    for (int k = 0; k < p.n; k++) p.v[k] = verts[ix[p.n - 1 - k]];
+    for (int k = 0; k < n; k++) pts[k] = verts[ix[n - 1 - k]];
+    return objd_points_screen(pts, n, v, out);
+}
+
+int objd_points_screen(const view_pt *pts, int n, const view_xform *v, screen_pt out[CLIP_MAX_VERTS])
+{
+    clip_poly p;
+    if (n > CLIP_MAX_VERTS - 5) return 0;
+    p.n = n;
+    for (int k = 0; k < n; k++) p.v[k] = pts[k];
     if (!clip_polygon(&p, v, CLIP_ALL)) return 0;
     clip_project(v, &p, out);
     return p.n;

@@ -113,9 +113,17 @@ void objd_transform(const scene *s, const obj_state *o, const view_xform *v, vie
  * plane, if it faces the eye by more than OBJ_BACKFACE_EPS (returns 1), else 0. */
 int objd_face_plane(const scene *s, const scn_model *m, uint32_t f, const view_pt *verts, objd_plane *pl);
 
+/* The same for any convex polygon of n view-space points (at most
+ * SCN_MAX_FACE_VERTS) running counter-clockwise seen from its front. */
+int objd_points_plane(const view_pt *pts, int n, objd_plane *pl);
+
 /* Face f clipped and projected: its screen vertices, clockwise, into out; returns
  * their number, or 0 if nothing is left. */
 int objd_face_screen(const scene *s, const scn_model *m, uint32_t f, const view_pt *verts, const view_xform *v,
                      screen_pt out[CLIP_MAX_VERTS]);
+
+/* The same for n view-space points (at most CLIP_MAX_VERTS - 5) that run
+ * clockwise on screen. */
+int objd_points_screen(const view_pt *pts, int n, const view_xform *v, screen_pt out[CLIP_MAX_VERTS]);
 
 #endif

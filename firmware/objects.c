@@ -110,6 +110,7 @@ int obj_init(world_state *w, const scene *s, void *mem, uint32_t bytes)
         w->objs = (obj_state *)(void *)p;
         p += objs_bytes(s);
         w->n = s->nobjects;
+        w->own = s->objects;
         for (uint32_t i = 0; i < s->nobjects; i++) place(&w->objs[i], &s->objects[i], 0);
     }
     if (CFG_DOORS) {

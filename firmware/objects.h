@@ -40,7 +40,15 @@ typedef struct {
                         * or NULL: obj_update leaves the ceilings alone */
     uint32_t *near;  /* obj_update's scratch: one bit per sector, "triggered now" */
     uint32_t ndoors;
+    const scn_object *own; /* the scene's objects when objs are theirs (for their sprite sets), else NULL */
 } world_state;
+
+/* The sprite set object i is drawn as (docs/objects.md, "Sprites"), or SCN_NONE:
+ * as its model. Only the scene's own objects have sprites. */
+static inline uint32_t obj_sprset(const world_state *w, uint32_t i)
+{
+    return CFG_TEXTURES && w->own ? w->own[i].sprset : SCN_NONE;
+}
 
 /* Bytes of RAM the state of a scene needs (objects, every sector's ceiling, the
  * door sectors' motion, a bit per sector); a multiple of 8. */

@@ -15,7 +15,9 @@
 #include "painter.h"
 
 #include "bsp_walk.h"
+#include "cover.h"
 #include "obj_draw.h"
+#include "sprite.h"
 #include "surfaces.h"
 
 #define PAINTER_BACKGROUND 0
@@ -62,6 +64,10 @@ static void fill_polygon(void *ctx, const screen_pt *pts, int n, const tex_paint
 
 static void draw_object(const scene *sc, uint32_t i, const obj_state *o, const view_xform *v, const rast_target *t,
                         render_stats *st);
+#if CFG_TEXTURES
+static void draw_sprite(const scene *sc, uint32_t i, uint32_t sprset, const obj_state *o, const view_xform *v,
+                        const rast_target *t, render_stats *st);
+#endif
 
 /* First walk, front to back: each object's nearest leaf is the first it touches.
  * The objects are in west-edge order, so a leaf looks only at those whose boxes
@@ -101,6 +107,13 @@ static int draw_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
     if (CFG_OBJECTS && p->objs) {
         for (; p->at < p->nobjs && p->objs[p->at].leaf == leaf; p->at++) {
             uint32_t i = p->objs[p->at].index;
+#if CFG_TEXTURES
+            uint32_t set = obj_sprset(p->w, i);
+            if (set != SCN_NONE) {
+                draw_sprite(p->sc, i, set, &p->w->objs[i], p->v, p->t, p->st);
+                continue;
+            }
+#endif
             draw_object(p->sc, i, &p->w->objs[i], p->v, p->t, p->st);
         }
     }
@@ -167,6 +180,31 @@ static void draw_object(const scene *sc, uint32_t i, const obj_state *o, const v
         rast_convex(t, pts, n, &paint, RAST_ID(RAST_KIND_OBJECT, i));
     }
 }
+
+#if CFG_TEXTURES
+/* A sprite over what is drawn: its opaque pixels. */
+static void draw_sprite(const scene *sc, uint32_t i, uint32_t sprset, const obj_state *o, const view_xform *v,
+                        const rast_target *t, render_stats *st)
+{
+    spr_view sv;
+    view_pt quad[4];
+    screen_pt pts[CLIP_MAX_VERTS];
+    int16_t lo[VIEW_H], hi[VIEW_H];
+    if (!spr_view_of(sc, o, sprset, v, &sv, quad)) return;
+    int n = objd_points_screen(quad, 4, v, pts);
+    if (!n) return;
+    st->object_faces++;
+    rast_rows(pts, n, 0, VIEW_H, lo, hi);
+    tex_paint paint = tex_sprite(sc, &sv, VIEW_LOOK(v), sc->faces[sc->models[o->model].first_face].colour);
+    for (int y = 0; y < VIEW_H; y++) {
+        uint32_t op[COV_WORDS] = {0};
+        if (lo[y] >= hi[y]) continue;
+        spr_opaque(sc, &sv, VIEW_LOOK(v), y, lo[y], hi[y], op);
+        for (int x = lo[y], x0; spr_next_run(op, &x, hi[y], &x0);)
+            rast_span(t, y, x0, x, &paint, RAST_ID(RAST_KIND_OBJECT, i));
+    }
+}
+#endif
 
 void painter_render(const scene *sc, const world_state *w, const view_xform *v, const rast_target *t, render_stats *st,
                     void *work, uint32_t work_bytes)

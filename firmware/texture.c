@@ -347,6 +347,39 @@ static void sky_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
     }
 }
 
+tex_paint tex_sprite(const scene *sc, const spr_view *sv, int look, uint8_t colour)
+{
+    const scn_sprite *img = &sc->sprites[sv->image];
+    tex_paint p;
+    p.kind = TEX_SPRITE;
+    p.colour = colour;
+    p.texels = sc->texels + img->first;
+    p.lights = sc->lights + ((uint32_t)(sv->table & LIGHT_TABLE_MASK) << 8);
+    p.wmask = img->width;
+    p.hmask = img->height;
+    p.hbits = sv->mirror;
+    p.a = sv->zc;
+    p.b = sv->xl;
+    p.c = sv->yt;
+    p.look = look;
+    return p;
+}
+
+static void sprite_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
+{
+    spr_view sv = {0, p->hbits, 0, p->a, p->b, p->c};
+    int32_t w = (int32_t)p->wmask;
+    int v = spr_row(&sv, p->look, y, (int)p->hmask);
+    if (v < 0) v = 0; /* the caller's pixels are opaque, so inside the image */
+    spr_cols c;
+    spr_cols_at(&c, &sv, x0);
+    for (int x = x0; x < x1; x++, spr_cols_next(&c)) {
+        int32_t u = c.u < 0 ? 0 : (c.u >= w ? w - 1 : c.u);
+        if (p->hbits) u = w - 1 - u;
+        row[x] = p->lights[p->texels[(uint32_t)u * p->hmask + (uint32_t)v]];
+    }
+}
+
 void tex_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
 {
     if (p->kind == TEX_WALL)
@@ -355,6 +388,8 @@ void tex_span(const tex_paint *p, int y, int x0, int x1, uint8_t *row)
         plane_span(p, y, x0, x1, row);
     else if (p->kind == TEX_SKY)
         sky_span(p, y, x0, x1, row);
+    else if (p->kind == TEX_SPRITE)
+        sprite_span(p, y, x0, x1, row);
     else
         for (int x = x0; x < x1; x++) row[x] = p->colour;
 }

@@ -21,6 +21,7 @@
 #include <stdint.h>
 #include "build_config.h"
 #include "scene.h"
+#include "sprite.h"
 #include "view.h"
 
 
@@ -43,7 +44,7 @@
 #error "TEX_LIGHT_BITS: 1..5"
 #endif
 
-enum { TEX_FLAT, TEX_WALL, TEX_PLANE, TEX_SKY };
+enum { TEX_FLAT, TEX_WALL, TEX_PLANE, TEX_SKY, TEX_SPRITE };
 
 typedef struct {
     uint8_t kind;   /* TEX_* */
@@ -62,6 +63,8 @@ typedef struct {
     uint32_t v0;           /* walls: texture row at the eye's height, 16.16; planes: the eye's x, 16.16 */
     uint32_t w0;           /* planes: minus the eye's y, 16.16 */
     int32_t look;
+    /* sprites (TEX_SPRITE): texels the image's, lights its light table, wmask and hmask its width and height,
+     * hbits 1 if mirrored; a, b, c its spr_view's zc, xl, yt */
 #endif
 } tex_paint;
 
@@ -86,6 +89,10 @@ tex_paint tex_wall(const scene *sc, const view_xform *v, const scn_side *sd, uin
 tex_paint tex_plane(const scene *sc, const view_xform *v, uint32_t tex, int32_t h, uint8_t light, uint8_t colour);
 /* The sky (a sky ceiling, or a step between two). */
 tex_paint tex_sky(const scene *sc, const view_xform *v, uint8_t colour);
+
+/* A sprite image as sprite.h places it (sv: a spr_view), look the view's shear. Only the pixels the
+ * caller finds opaque (spr_opaque) may be asked for. */
+tex_paint tex_sprite(const scene *sc, const spr_view *sv, int look, uint8_t colour);
 
 /* The height of a texture's rows as Doom counts them (its unpadded height). */
 static inline int32_t tex_height(const scene *sc, uint32_t tex)

@@ -704,6 +704,7 @@ static int set_world(const options *o, engine *e, obj_state *file_objs, long nfi
                 o->scene);
     if (o->objects) {
         e->world.objs = file_objs;
+        e->world.own = NULL; /* the file's objects are models */
         e->world.n = (uint32_t)nfile;
     } else if (o->no_objects) {
         e->world.n = 0;
