@@ -257,18 +257,36 @@ static int faces_next(face_iter *it, dr_face *f, dr_edge *edges, screen_pt box[2
     return 0;
 }
 
-/* A sprite face's opaque pixels of [a, b) on row y into op (cleared by the
- * caller); 0 for a model's face, opaque all over. */
-static int face_opaque(const scene *sc, int look, const dr_face *f, int y, int a, int b, uint32_t *op)
+/* The opaque pixels of [a, b) on row y of a face with holes (a sprite, or a
+ * see-through middle texture) into op (cleared by the caller); 0 for a face
+ * opaque all over. */
+static int face_opaque(const scene *sc, const world_state *w, const view_xform *v, const dr_face *f, int y, int a,
+                       int b, uint32_t *op)
 {
 #if CFG_TEXTURES
-    if (f->model_face != SCN_NONE) return 0;
-    spr_opaque(sc, &f->spr, look, y, a, b, op);
-    return 1;
+    if (f->model_face == SCN_NONE) {
+        spr_opaque(sc, &f->spr, VIEW_LOOK(v), y, a, b, op);
+        return 1;
+    }
+    uint32_t side = obj_mid_side(w, f->obj);
+    return side != SCN_NONE && tex_mid_opaque(sc, v, side, w->objs[f->obj].z, y, a, b, op);
 #else
-    (void)sc, (void)look, (void)f, (void)y, (void)a, (void)b, (void)op;
+    (void)sc, (void)w, (void)v, (void)f, (void)y, (void)a, (void)b, (void)op;
     return 0;
 #endif
+}
+
+/* What a face's pixels are: its sprite, its middle texture, or its colour. */
+static tex_paint face_paint(const scene *sc, const world_state *w, const view_xform *v, const dr_face *f)
+{
+#if CFG_TEXTURES
+    if (f->model_face == SCN_NONE) return tex_sprite(sc, &f->spr, VIEW_LOOK(v), f->colour);
+    uint32_t side = obj_mid_side(w, f->obj);
+    if (side != SCN_NONE) return tex_mid(sc, v, side, w->objs[f->obj].z, 0);
+#else
+    (void)sc, (void)w, (void)v;
+#endif
+    return tex_flat(f->colour);
 }
 
 /* Calls visit(S, o, face, its edges, ctx) for each face of the active object o
@@ -304,7 +322,7 @@ void direct_object_rows(const scene *sc, const world_state *w, const view_xform 
             int a, b;
             uint32_t op[COV_WORDS] = {0};
             if (!face_row(&f, edges, y, &a, &b)) continue;
-            if (!face_opaque(sc, VIEW_LOOK(v), &f, y, a, b, op)) {
+            if (!face_opaque(sc, w, v, &f, y, a, b, op)) {
                 row(ctx, y, a, b);
                 continue;
             }
@@ -473,7 +491,7 @@ static void keep_nearer_face(dr_state *S, dr_obj *o, const dr_face *g, const dr_
         cov_line_set(front, a, b); /* wholly in front */
     else
         mark_in_front(front, &g->pl, 1 + (int)g->obj, &k->self->pl, 1 + (int)k->self->obj, VIEW_LOOK(S->v), k->y, a, b);
-    int holes = face_opaque(S->sc, VIEW_LOOK(S->v), g, k->y, a, b, op); /* g hides nothing through its holes */
+    int holes = face_opaque(S->sc, S->w, S->v, g, k->y, a, b, op); /* g hides nothing through its holes */
     for (int w = 0; w < COV_WORDS; w++) k->keep[w] |= holes ? front[w] & op[w] : front[w];
 }
 
@@ -483,19 +501,14 @@ static void keep_nearer_face(dr_state *S, dr_obj *o, const dr_face *g, const dr_
 static void draw_face_row(dr_state *S, dr_obj *o, const dr_face *face, int y, int a, int b, const uint32_t *mine)
 {
     uint32_t keep[COV_WORDS], op[COV_WORDS] = {0};
-    int holes = face_opaque(S->sc, VIEW_LOOK(S->v), face, y, a, b, op); /* its holes show what lies behind */
+    int holes = face_opaque(S->sc, S->w, S->v, face, y, a, b, op); /* its holes show what lies behind */
     for (int w = 0; w < COV_WORDS; w++) keep[w] = (mine ? ~mine[w] : 0) | (holes ? ~op[w] : 0);
     near_ctx k = {face, keep, y, a, b};
     for (uint32_t i = 0; i < S->nactive; i++) {
         dr_obj *p = &S->objs[S->active[i]];
         if (p->y0 <= y && p->y1 > y && p->x0 < b && p->x1 > a) each_face(S, p, keep_nearer_face, &k);
     }
-#if CFG_TEXTURES
-    tex_paint paint = face->model_face == SCN_NONE ? tex_sprite(S->sc, &face->spr, VIEW_LOOK(S->v), face->colour)
-                                                   : tex_flat(face->colour);
-#else
-    tex_paint paint = tex_flat(face->colour);
-#endif
+    tex_paint paint = face_paint(S->sc, S->w, S->v, face);
     if (cov_fill(S->cov, S->t, y, a, b, keep, &paint, RAST_ID(RAST_KIND_OBJECT, o->e.index)) && !o->drew) {
         o->drew = 1;
         S->st->objects_visible++;
@@ -546,7 +559,7 @@ static void draw_face_over_world(dr_state *S, dr_obj *o, const dr_face *f, const
     else
         mark_in_front(mine, &f->pl, 1 + (int)f->obj, k->world, 0, VIEW_LOOK(S->v), k->y, a, b);
     uint32_t op[COV_WORDS] = {0};
-    if (face_opaque(S->sc, VIEW_LOOK(S->v), f, k->y, a, b, op)) /* the world shows through its holes */
+    if (face_opaque(S->sc, S->w, S->v, f, k->y, a, b, op)) /* the world shows through its holes */
         for (int w = 0; w < COV_WORDS; w++) mine[w] &= op[w];
     uint32_t any = 0;
     for (int w = 0; w < COV_WORDS; w++) any |= mine[w];

@@ -50,6 +50,12 @@ static inline uint32_t obj_sprset(const world_state *w, uint32_t i)
     return CFG_TEXTURES && w->own ? w->own[i].sprset : SCN_NONE;
 }
 
+/* The line side whose see-through middle texture object i shows (docs/textures.md), or SCN_NONE. */
+static inline uint32_t obj_mid_side(const world_state *w, uint32_t i)
+{
+    return CFG_TEXTURES && w->own ? w->own[i].side : SCN_NONE;
+}
+
 /* Bytes of RAM the state of a scene needs (objects, every sector's ceiling, the
  * door sectors' motion, a bit per sector); a multiple of 8. */
 uint32_t obj_state_bytes(const scene *s);

@@ -67,6 +67,8 @@ static void draw_object(const scene *sc, uint32_t i, const obj_state *o, const v
 #if CFG_TEXTURES
 static void draw_sprite(const scene *sc, uint32_t i, uint32_t sprset, const obj_state *o, const view_xform *v,
                         const rast_target *t, render_stats *st);
+static void draw_mid(const scene *sc, uint32_t i, uint32_t side, const obj_state *o, const view_xform *v,
+                     const rast_target *t, render_stats *st);
 #endif
 
 /* First walk, front to back: each object's nearest leaf is the first it touches.
@@ -108,9 +110,13 @@ static int draw_leaf(void *ctx, uint32_t leaf, unsigned clip_mask)
         for (; p->at < p->nobjs && p->objs[p->at].leaf == leaf; p->at++) {
             uint32_t i = p->objs[p->at].index;
 #if CFG_TEXTURES
-            uint32_t set = obj_sprset(p->w, i);
+            uint32_t set = obj_sprset(p->w, i), side = obj_mid_side(p->w, i);
             if (set != SCN_NONE) {
                 draw_sprite(p->sc, i, set, &p->w->objs[i], p->v, p->t, p->st);
+                continue;
+            }
+            if (side != SCN_NONE) {
+                draw_mid(p->sc, i, side, &p->w->objs[i], p->v, p->t, p->st);
                 continue;
             }
 #endif
@@ -182,6 +188,32 @@ static void draw_object(const scene *sc, uint32_t i, const obj_state *o, const v
 }
 
 #if CFG_TEXTURES
+/* A face with holes: a sprite (sv), or a see-through middle texture (side, its row 0 at top). */
+typedef struct {
+    const scene *sc;
+    const view_xform *v;
+    const spr_view *sv;
+    uint32_t side;
+    int32_t top;
+} holes;
+
+/* The face's opaque pixels of the polygon pts over what is drawn. */
+static void fill_with_holes(const holes *h, const screen_pt *pts, int n, const tex_paint *paint, uint32_t id,
+                            const rast_target *t)
+{
+    int16_t lo[VIEW_H], hi[VIEW_H];
+    rast_rows(pts, n, 0, VIEW_H, lo, hi);
+    for (int y = 0; y < VIEW_H; y++) {
+        uint32_t op[COV_WORDS] = {0};
+        if (lo[y] >= hi[y]) continue;
+        if (h->sv)
+            spr_opaque(h->sc, h->sv, VIEW_LOOK(h->v), y, lo[y], hi[y], op);
+        else if (!tex_mid_opaque(h->sc, h->v, h->side, h->top, y, lo[y], hi[y], op))
+            cov_line_set(op, lo[y], hi[y]);
+        for (int x = lo[y], x0; spr_next_run(op, &x, hi[y], &x0);) rast_span(t, y, x0, x, paint, id);
+    }
+}
+
 /* A sprite over what is drawn: its opaque pixels. */
 static void draw_sprite(const scene *sc, uint32_t i, uint32_t sprset, const obj_state *o, const view_xform *v,
                         const rast_target *t, render_stats *st)
@@ -189,20 +221,31 @@ static void draw_sprite(const scene *sc, uint32_t i, uint32_t sprset, const obj_
     spr_view sv;
     view_pt quad[4];
     screen_pt pts[CLIP_MAX_VERTS];
-    int16_t lo[VIEW_H], hi[VIEW_H];
     if (!spr_view_of(sc, o, sprset, v, &sv, quad)) return;
     int n = objd_points_screen(quad, 4, v, pts);
     if (!n) return;
     st->object_faces++;
-    rast_rows(pts, n, 0, VIEW_H, lo, hi);
     tex_paint paint = tex_sprite(sc, &sv, VIEW_LOOK(v), sc->faces[sc->models[o->model].first_face].colour);
-    for (int y = 0; y < VIEW_H; y++) {
-        uint32_t op[COV_WORDS] = {0};
-        if (lo[y] >= hi[y]) continue;
-        spr_opaque(sc, &sv, VIEW_LOOK(v), y, lo[y], hi[y], op);
-        for (int x = lo[y], x0; spr_next_run(op, &x, hi[y], &x0);)
-            rast_span(t, y, x0, x, &paint, RAST_ID(RAST_KIND_OBJECT, i));
-    }
+    holes h = {sc, v, &sv, SCN_NONE, 0};
+    fill_with_holes(&h, pts, n, &paint, RAST_ID(RAST_KIND_OBJECT, i), t);
+}
+
+/* A see-through middle texture (its model's one face) over what is drawn. */
+static void draw_mid(const scene *sc, uint32_t i, uint32_t side, const obj_state *o, const view_xform *v,
+                     const rast_target *t, render_stats *st)
+{
+    const scn_model *m = &sc->models[o->model];
+    view_pt verts[CFG_MODEL_VERTS];
+    screen_pt pts[CLIP_MAX_VERTS];
+    objd_plane pl;
+    objd_transform(sc, o, v, verts);
+    if (!objd_face_plane(sc, m, m->first_face, verts, &pl)) return;
+    int n = objd_face_screen(sc, m, m->first_face, verts, v, pts);
+    if (!n) return;
+    st->object_faces++;
+    tex_paint paint = tex_mid(sc, v, side, o->z, 0);
+    holes h = {sc, v, 0, side, o->z};
+    fill_with_holes(&h, pts, n, &paint, RAST_ID(RAST_KIND_OBJECT, i), t);
 }
 #endif
 

@@ -319,9 +319,12 @@ static scene_status check_look(const scene *s, scene_error *err)
     if (!tex_ok(s, s->look->sky_tex) || s->look->flags != 0) return fail(err, SCENE_ERR_INDEX, SCN_SEC_LOOK, 0);
     for (uint32_t i = 0; i < s->ntextures; i++) {
         const scn_texture *t = &s->textures[i];
-        if (t->wbits > SCN_TEX_MAX_BITS || t->hbits > SCN_TEX_MAX_BITS || t->reserved != 0 || t->reserved2 != 0 ||
-            t->height == 0 || t->height > (1u << t->hbits))
+        if (t->wbits > SCN_TEX_MAX_BITS || t->hbits > SCN_TEX_MAX_BITS || t->reserved != 0 || t->height == 0 ||
+            t->height > (1u << t->hbits))
             return fail(err, SCENE_ERR_RANGE, SCN_SEC_TEXTURES, i);
+        if (!tex_ok(s, t->mask) || (t->mask != SCN_TEX_NONE &&
+                                    (s->textures[t->mask].wbits != t->wbits || s->textures[t->mask].hbits != t->hbits)))
+            return fail(err, SCENE_ERR_INDEX, SCN_SEC_TEXTURES, i);
         if ((uint64_t)t->first + ((uint64_t)1 << (t->wbits + t->hbits)) > s->ntexels)
             return fail(err, SCENE_ERR_INDEX, SCN_SEC_TEXTURES, i);
     }
@@ -363,6 +366,11 @@ static scene_status check_sprites(const scene *s, scene_error *err)
     }
     for (uint32_t i = 0; i < s->nobjects; i++) {
         const scn_object *o = &s->objects[i];
+        /* a see-through middle texture: a side's of a textured scene that has one, on a one-face model */
+        if (o->side != SCN_NONE &&
+            (o->side >= 2u * s->nlines || !s->look || s->sides[o->side].tex[SCN_PART_MIDDLE] == SCN_TEX_NONE ||
+             o->sprset != SCN_NONE || s->models[o->model].num_faces != 1))
+            return fail(err, SCENE_ERR_INDEX, SCN_SEC_OBJECTS, i);
         if (o->sprset == SCN_NONE) continue;
         if (o->sprset >= s->nsprsets) return fail(err, SCENE_ERR_INDEX, SCN_SEC_OBJECTS, i);
         const scn_model *m = &s->models[o->model];

@@ -167,6 +167,8 @@ typedef struct {
     uint32_t period_ms; /* one turn or one round trip; > 0 when path != SCN_PATH_NONE */
     int32_t spin;       /* degrees per second, 16.16 */
     uint32_t sprset;    /* drawn as this sprite set, or SCN_NONE: as its model [index: SPRSETS or SCN_NONE] */
+    uint32_t
+        side; /* see-through middle texture: its side's, row 0 at z (docs/textures.md) [index: SIDES or SCN_NONE] */
 } scn_object;
 
 /* ---- Textures and light (docs/textures.md) ---- */
@@ -193,7 +195,7 @@ typedef struct {
     uint8_t colour;       /* palette index nearest the texture's mean colour [index: PALETTE] */
     uint8_t reserved;     /* 0 */
     uint16_t height;      /* rows as the WAD gives them (<= 2^hbits): Doom's pegging counts these */
-    uint16_t reserved2;   /* 0 */
+    uint16_t mask;        /* its holes: texels 1 opaque, 0 a hole; NONE: opaque [index: TEXTURES or SCN_TEX_NONE] */
 } scn_texture;
 
 #define SCN_SIDE_UNPEG_TOP 1u    /* Doom's linedef flag 8: upper texture hangs from the front ceiling */
@@ -236,10 +238,10 @@ typedef struct {
 /* The images of one thing, by rotation (the angle from the eye to the thing,
  * less the thing's yaw: docs/objects.md). */
 typedef struct {
-    uint16_t image[SCN_SPRITE_ROTS]; /* [index: SPRITES] */
-    uint8_t mirror;                  /* bit r: rotation r's image is drawn mirrored left to right */
-    uint8_t flags;                   /* SCN_SPRSET_* */
-    uint16_t reserved;               /* 0 */
+    uint16_t image[8]; /* by rotation (SCN_SPRITE_ROTS) [index: SPRITES] */
+    uint8_t mirror;    /* bit r: rotation r's image is drawn mirrored left to right */
+    uint8_t flags;     /* SCN_SPRSET_* */
+    uint16_t reserved; /* 0 */
 } scn_sprset;
 
 /* What a scene needs of a renderer, written by the compiler's analysis

@@ -103,6 +103,38 @@ tex_paint tex_wall(const scene *sc, const view_xform *v, const scn_side *sd, uin
     return p;
 }
 
+/* Light table 0 of an opacity map: its texels as they are (every byte value, so
+ * a damaged map reads inside it). */
+#define ID4(n) (n), (n) + 1, (n) + 2, (n) + 3
+#define ID16(n) ID4(n), ID4((n) + 4), ID4((n) + 8), ID4((n) + 12)
+#define ID64(n) ID16(n), ID16((n) + 16), ID16((n) + 32), ID16((n) + 48)
+static const uint8_t identity[256] = {ID64(0), ID64(64), ID64(128), ID64(192)};
+
+tex_paint tex_mid(const scene *sc, const view_xform *v, uint32_t side, int32_t top, int holes)
+{
+    const scn_line *l = &sc->lines[side >> 1];
+    const scn_side *sd = &sc->sides[side];
+    uint32_t tex = sd->tex[SCN_PART_MIDDLE];
+    uint8_t colour = l->color[side & 1][SCN_PART_MIDDLE];
+    tex_paint p = tex_wall(sc, v, sd, tex, &sc->verts[l->v1], top, sc->sectors[l->sector[side & 1]].light, colour);
+    if (!holes || p.kind != TEX_WALL) return p;
+    set_texture(&p, sc, sc->textures[tex].mask);
+    p.lights = identity;
+    p.start = 0; /* every depth takes table 0 */
+    return p;
+}
+
+int tex_mid_opaque(const scene *sc, const view_xform *v, uint32_t side, int32_t top, int y, int a, int b, uint32_t *op)
+{
+    if (sc->textures[sc->sides[side].tex[SCN_PART_MIDDLE]].mask == SCN_TEX_NONE) return 0;
+    tex_paint p = tex_mid(sc, v, side, top, 1);
+    uint8_t row[VIEW_W];
+    tex_span(&p, y, a, b, row);
+    for (int x = a; x < b; x++)
+        if (row[x]) op[x >> 5] |= 1u << (x & 31);
+    return 1;
+}
+
 tex_paint tex_plane(const scene *sc, const view_xform *v, uint32_t tex, int32_t h, uint8_t light, uint8_t colour)
 {
     if (tex == SCN_TEX_NONE) return tex_flat(colour);

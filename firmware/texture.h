@@ -94,6 +94,15 @@ tex_paint tex_sky(const scene *sc, const view_xform *v, uint8_t colour);
  * caller finds opaque (spr_opaque) may be asked for. */
 tex_paint tex_sprite(const scene *sc, const spr_view *sv, int look, uint8_t colour);
 
+/* A see-through middle texture: line side `side`'s middle texture with row 0 at
+ * height top (16.16), under its sector's light; holes: instead its opacity map,
+ * whose spans come out 1 where the texture is opaque and 0 in a hole (the side's
+ * texture must have a mask). */
+tex_paint tex_mid(const scene *sc, const view_xform *v, uint32_t side, int32_t top, int holes);
+/* Set in op (a row's bits) the pixels of [a, b) on row y where that middle
+ * texture is opaque; 0 if it has no holes (op untouched). */
+int tex_mid_opaque(const scene *sc, const view_xform *v, uint32_t side, int32_t top, int y, int a, int b, uint32_t *op);
+
 /* The height of a texture's rows as Doom counts them (its unpadded height). */
 static inline int32_t tex_height(const scene *sc, uint32_t tex)
 {

@@ -14,7 +14,7 @@ _Static_assert(sizeof(scn_sector) == 16, "scn_sector layout");
 _Static_assert(sizeof(scn_model) == 28, "scn_model layout");
 _Static_assert(sizeof(scn_mvert) == 12, "scn_mvert layout");
 _Static_assert(sizeof(scn_face) == 8, "scn_face layout");
-_Static_assert(sizeof(scn_object) == 44, "scn_object layout");
+_Static_assert(sizeof(scn_object) == 48, "scn_object layout");
 _Static_assert(sizeof(scn_sprite) == 16, "scn_sprite layout");
 _Static_assert(sizeof(scn_sprset) == 20, "scn_sprset layout");
 _Static_assert(sizeof(scn_line) == 24, "scn_line layout");
@@ -141,7 +141,7 @@ static uint64_t blob_layout(const bs_scene *s, const bs_tree *t, uint32_t counts
                                        look ? lk->nsprites : 0u,
                                        look ? lk->nsprmask : 0u,
                                        look ? lk->nsprsets : 0u};
-    static const uint32_t recsz[SCN_SEC_COUNT] = {8, 12 + 4, 24, 16, 56, 20, 8,  3, 28, 12, 8, 4, 44, sizeof(scn_needs),
+    static const uint32_t recsz[SCN_SEC_COUNT] = {8, 12 + 4, 24, 16, 56, 20, 8,  3, 28, 12, 8, 4, 48, sizeof(scn_needs),
                                                   8, 256,    12, 1,  24, 4,  16, 4, 20};
     uint64_t at = sizeof(scn_header);
     for (int k = 0; k < SCN_SEC_COUNT; k++) {
@@ -340,6 +340,7 @@ static void put_objects(wr *w, const blob_src *b)
         w32(w, o->period_ms);
         wi32(w, o->spin);
         w32(w, o->sprset1 ? o->sprset1 - 1 : SCN_NONE);
+        w32(w, o->side1 ? o->side1 - 1 : SCN_NONE);
     }
 }
 
@@ -364,7 +365,7 @@ static void put_textures(wr *w, const blob_src *b)
         w8(w, lk->tex[i].colour);
         w8(w, 0);
         w16(w, lk->tex[i].height);
-        w16(w, 0);
+        w16(w, lk->tex[i].mask);
     }
 }
 

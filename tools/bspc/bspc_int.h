@@ -107,6 +107,7 @@ typedef struct {
     int32_t spin;     /* degrees per second, 16.16 */
     int src_line;     /* text: line; WAD: thing index in the lump */
     uint32_t sprset1; /* 1 + its bs_look sprite set; 0: drawn as its model */
+    uint32_t side1;   /* a see-through middle texture: 1 + its line side (line * 2 + side); 0: none */
 } bs_object;
 
 /* Limits beyond scene_format.h that keep the path arithmetic of docs/objects.md

@@ -181,7 +181,7 @@ static int store(bs_wadlook *L, const char *name, const uint8_t *pic, uint32_t w
     x->hbits = (uint8_t)hb;
     x->reserved = 0;
     x->height = (uint16_t)h;
-    x->reserved2 = 0;
+    x->mask = SCN_TEX_NONE;
     double mean[3];
     for (int k = 0; k < 3; k++) mean[k] = (double)sum[k] / ((double)cols * h);
     x->colour = nearest(lk->palette, mean[0], mean[1], mean[2]);
