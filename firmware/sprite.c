@@ -29,7 +29,7 @@ static int light_table_of(const scene *s, const obj_state *o, const scn_sprset *
 {
     if (set->flags & SCN_SPRSET_BRIGHT) return 0;
     uint32_t sec = scene_sector_at(s, o->x, o->y);
-    int level = sec == SCN_NONE ? 255 : s->sectors[sec].light;
+    int level = sec == SCN_NONE ? 0 : s->sectors[sec].light;
     int start = (15 - (level >> 4)) * 4;
     int64_t scale = ((int64_t)2560 << VIEW_SHIFT) / zc; /* Doom's scale light: 160 / z in 1/16 */
     int t = start - (int)(scale > 47 ? 47 : scale) / 2;

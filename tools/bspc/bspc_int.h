@@ -228,6 +228,8 @@ typedef struct {
 int bs_model_begin(bs_scene *s, const char *name, int src_line, char *err, size_t errlen);
 int bs_model_add_part(bs_scene *s, const bs_mpart *p, char *err, size_t errlen);
 int bs_model_end(bs_scene *s, char *err, size_t errlen);
+/* A textured WAD map's see-through middle textures as objects (mids.c). */
+int bs_mid_objects(bs_scene *s, const char *display, const bspc_options *opt, char *err, size_t errlen);
 /* Shade c one step lighter (+1) or darker (-1) within its ramp of 16. */
 uint8_t bs_shade(uint8_t c, int delta);
 
