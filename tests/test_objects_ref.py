@@ -5,7 +5,9 @@ the nearest leaf it touches and is inexact by design).
 Doom's things are boxes that often interpenetrate and stand side by side at one height, so their
 faces meet and lie in one plane; the reference breaks such exact ties by the lower object number
 (tools/refrender.py), and so must the renderer (firmware/obj_draw.c objd_front). Agreement is
-counted over the pixels where either side shows an object.
+counted over the pixels where either side shows an object. The maps are compiled flat (bspc
+--flat), where every thing is its box; in a textured scene the things Doom draws are sprites
+(tests/test_sprites_ref.py).
 """
 import json
 import math
@@ -57,8 +59,8 @@ def compare(bsc, spec, m, cam_args, mode, path):
 def test_objects_against_reference(spec, mode, tmp_path):
     freedoom(spec.split(":")[0])
     bsc = tmp_path / "map.bsc"
-    run([program("bspc", sanitized=False), spec, "-o", bsc])
-    m = refrender.load(spec)
+    run([program("bspc", sanitized=False), spec, "--flat", "-o", bsc])
+    m = refrender.load(spec, flat=True)
     cams = [[]] + [["--at", at, "--angle", repr(a), "--look", str(lk)]
                    for at, a, lk in views(m, random.Random(f"{SEED}:{spec}"), MAPS[spec])]
     total = bad = 0

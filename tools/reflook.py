@@ -9,9 +9,19 @@ within one light step and (u', v') within one texel (the 3 x 3 texels round (u, 
 texture wraps), 27 candidates.
 
 Which pixels are compared (Expect.cat): walls (1), floors (2), ceilings (3) and sky (4) with a
-texture. Not compared (0): no surface, objects (the reference casts the world alone; a comparison
-also leaves out the renderer's object pixels), and parts or planes without a texture ('-', a name
-the WAD does not have, or Doom's texture 0, which Doom never draws), which keep their flat colour.
+texture, and sprites (5: WAD things drawn as their sprites, docs/objects.md "Sprites"). Not
+compared (0): no surface, objects drawn as their boxes (flat colours), and parts or planes
+without a texture ('-', a name the WAD does not have, or Doom's texture 0, which Doom never draws),
+which keep their flat colour. compare() takes the world's pixels where the renderer's id buffer
+shows no object, and the sprite pixels where it shows the same object as the reference.
+
+A sprite pixel (refrender.cast_view gives its image and texel): the texel of the image at the
+column and row the pixel's centre ray meets (a mirrored image flipped), its light table 0 when the
+thing's frame is full-bright, else Doom's light of walls at the sprite's depth zc: start -
+min(47, floor(2560 / zc)) / 2 clamped to 0..31, start = (15 - lightnum) * 4, lightnum = light >> 4
+(at most 15) of the sector under the thing's origin, without the walls' fake contrast. Its
+candidates are the 3 x 3 texels round it that are in the image and opaque (any other stands for
+the texel itself), under the tables within one step: 27, as for the world.
 
 Doom's lookups: a texture name is the first of that name in TEXTURE1 then TEXTURE2; a patch or a
 flat is the last lump of its name (flats among the F_START..F_END lumps). Holes a texture's patches
@@ -26,8 +36,9 @@ import numpy as np
 W, H = 320, 200
 FOCAL = 160.0
 NLIGHTS = 32
-CAT_NONE, CAT_WALL, CAT_FLOOR, CAT_CEIL, CAT_SKY = 0, 1, 2, 3, 4
-CAT_NAMES = {CAT_WALL: "wall", CAT_FLOOR: "floor", CAT_CEIL: "ceiling", CAT_SKY: "sky"}
+CAT_NONE, CAT_WALL, CAT_FLOOR, CAT_CEIL, CAT_SKY, CAT_SPRITE = 0, 1, 2, 3, 4, 5
+CAT_NAMES = {CAT_WALL: "wall", CAT_FLOOR: "floor", CAT_CEIL: "ceiling", CAT_SKY: "sky",
+             CAT_SPRITE: "sprite"}
 UNPEG_TOP, UNPEG_BOTTOM = 8, 16      # Doom's linedef flags
 
 
@@ -185,6 +196,16 @@ class Look:
         self.ceil_tex = np.array([self.number(_name8(n), True) for n in sec["cf"]], np.int64)
         self.sky_tex = self.number(self.sky, False)
 
+    def sprite_number(self, image):
+        """The number of a sprite image (a refrender.SpriteImage) among the names, as
+        (lump name, "sprite"); texture() gives the image back."""
+        key = (image.name, "sprite")
+        if key not in self._num:
+            self._num[key] = len(self.names)
+            self.names.append(key)
+            self._tex[self._num[key]] = image
+        return self._num[key]
+
     def number(self, name, flat):
         key = (name, flat)
         if key not in self._num:
@@ -195,7 +216,8 @@ class Look:
         return self._num[key]
 
     def texture(self, i):
-        """Texture number i (a Texture), composed or read on first use; None if it cannot be."""
+        """Texture number i (a Texture), composed or read on first use; None if it cannot be.
+        A sprite's number gives its refrender.SpriteImage."""
         if i not in self._tex:
             name, flat = self.names[i]
             if flat:
@@ -241,10 +263,11 @@ def light_start(light, adj):
 
 
 class Expect:
-    """Per pixel (200, 320): cat (CAT_*), tex (texture number in look.names, -1), u, v (float:
-    the exact texture coordinates; for the sky, the column and row), table (light table),
-    colour (the palette index; 0 where not compared) and cand (200, 320, 27): the acceptable
-    palette indices (every one of them colour where not compared)."""
+    """Per pixel (200, 320): cat (CAT_*), tex (texture number in look.names, -1; a sprite
+    image's entry is (lump name, "sprite")), u, v (float: the exact texture coordinates; for the
+    sky, the column and row; for a sprite, its image's), table (light table), ids (the
+    reference's surface ids), colour (the palette index; 0 where not compared) and cand (200,
+    320, 27): the acceptable palette indices (every one of them colour where not compared)."""
 
     def accept(self, frame):
         """Boolean (200, 320): the frame's palette index is one of the candidates."""
@@ -257,6 +280,7 @@ def expect(view):
     lk = look_of(m)
     e = Expect()
     e.look = lk
+    e.ids = view.ids
     kind = (view.ids >> 24).astype(np.int64)
     index = (view.ids & 0xFFFFFF).astype(np.int64)
     e.cat = np.zeros((H, W), np.int8)
@@ -324,7 +348,8 @@ def expect(view):
     # colours: the exact one and the 27 candidates, texture by texture
     e.colour = np.zeros((H, W), np.uint8)
     e.cand = np.zeros((H, W, 27), np.uint8)
-    on = e.cat > 0
+    _sprites(view, lk, e)
+    on = (e.cat > 0) & (e.cat != CAT_SPRITE)
     ui = np.floor(np.where(on, e.u, 0)).astype(np.int64)
     vi = np.floor(np.where(on, e.v, 0)).astype(np.int64)
     du, dv = np.meshgrid([-1, 0, 1], [-1, 0, 1], indexing="ij")
@@ -337,19 +362,61 @@ def expect(view):
         near9 = tx.texel(u0[:, None] + du[None, :], v0[:, None] + dv[None, :])          # (n, 9)
         tabs = np.clip(tb[:, None] + np.array([-1, 0, 1])[None, :], 0, NLIGHTS - 1)     # (n, 3)
         e.cand[sel] = lk.lights[tabs[:, :, None], near9[:, None, :]].reshape(-1, 27)
-    e.cand[~on] = 0
+    e.cand[e.cat == CAT_NONE] = 0
     return e
+
+
+def sprite_table(lk, draw):
+    """The light table of a sprite (a refrender.SpriteDraw): 0 when full-bright, else Doom's
+    light of walls at its depth zc in the light of the sector under its origin (lightnum =
+    light >> 4, no fake contrast; no sector: light 0)."""
+    if draw.bright:
+        return 0
+    light = lk.sector_light[draw.sector] if draw.sector is not None else 0
+    return int(wall_table(light_start(np.array([light]), 0), np.array([draw.zc]))[0])
+
+
+def _sprites(view, lk, e):
+    """The sprite pixels of a view: cat, tex (the image's number), u, v, table, the colour
+    lights[table][texel] and the candidates: the 3 x 3 texels round it (a neighbour outside
+    the image or transparent counts as the texel itself) under the tables within one step."""
+    du, dv = np.meshgrid([-1, 0, 1], [-1, 0, 1], indexing="ij")
+    du, dv = du.ravel(), dv.ravel()
+    for d in getattr(view, "sprites", None) or []:
+        if d is None:
+            continue
+        sel = (view.obj == d.obj) & (view.spr_col >= 0)
+        if not sel.any():
+            continue
+        im = d.image
+        c0, r0 = view.spr_col[sel], view.spr_row[sel]
+        table = sprite_table(lk, d)
+        e.cat[sel] = CAT_SPRITE
+        e.tex[sel] = lk.sprite_number(im)
+        e.u[sel], e.v[sel] = view.spr_u[sel], view.spr_v[sel]
+        e.table[sel] = table
+        texel = im.texels[c0, r0]
+        e.colour[sel] = lk.lights[table, texel]
+        cn, rn = c0[:, None] + du[None, :], r0[:, None] + dv[None, :]          # (n, 9)
+        inside = (cn >= 0) & (cn < im.width) & (rn >= 0) & (rn < im.height)
+        cn, rn = np.clip(cn, 0, im.width - 1), np.clip(rn, 0, im.height - 1)
+        usable = inside & im.opaque[cn, rn]
+        near9 = np.where(usable, im.texels[cn, rn], texel[:, None])
+        tabs = np.clip(table + np.array([-1, 0, 1]), 0, NLIGHTS - 1)              # (3,)
+        e.cand[sel] = lk.lights[tabs[None, :, None], near9[:, None, :]].reshape(-1, 27)
 
 
 def compare(e, frame, ids=None):
     """Compare a renderer's frame (200, 320 palette indices) with an Expect: the pixels compared
     are those with a texture in the reference and no object in the renderer's id buffer (ids,
-    optional). Returns (ok (200, 320) bool, compared (200, 320) bool, counts {category name:
+    optional), and the reference's sprite pixels where the renderer's id buffer shows the same
+    object. Returns (ok (200, 320) bool, compared (200, 320) bool, counts {category name:
     (acceptable, compared)}, with "all")."""
     frame = np.asarray(frame, np.uint8).reshape(H, W)
     compared = e.cat > 0
     if ids is not None:
-        compared &= (np.asarray(ids).reshape(H, W) >> 24) != 4
+        ids = np.asarray(ids).reshape(H, W)
+        compared &= np.where(e.cat == CAT_SPRITE, ids == e.ids, (ids >> 24) != 4)
     ok = e.accept(frame) & compared
     counts = {name: (int(ok[e.cat == c].sum()), int(compared[e.cat == c].sum()))
               for c, name in CAT_NAMES.items()}

@@ -67,10 +67,12 @@ at at + R (cos 360k/N, sin 360k/N), the offset rounded to 16.16, then the same r
 as tools/bspc/models.c builds them; models numbered in declaration order; `object
 MODEL X Y [z=] [yaw=] [path=circle:R:MS | line:DX:DY:MS] [spin=]` numbered in file order, z by
 default the floor of the sector under (X, Y); `door=H` a sector's open ceiling. WAD maps: the
-things of tools/bspc/things.txt (type radius height colour sprite name) that are in skill 3, not
-multiplayer-only, not at x or y = -32768 and inside a sector, in THINGS order, each an upright box
-2r x 2r x height on the floor under it, yawed by its angle, one model per distinct (radius,
-height, colour) in order of first use. WAD doors: the back sector of a line with a door special,
+things of tools/bspc/things.txt (type radius height colour sprite frame name) that are in skill 3,
+not multiplayer-only, not at x or y = -32768 and inside a sector, in THINGS order, each an upright
+box 2r x 2r x height on the floor under it, yawed by its angle, one model per distinct (radius,
+height, colour) in order of first use; a thing drawn as a sprite (below) has the box of its
+images instead: r the largest of left and width - left, height the largest top, over the images
+of its rotations (at least 1). WAD doors: the back sector of a line with a door special,
 or for the remote specials 63 and 90 the sectors with the line's tag; open at the lowest ceiling
 across their two-sided lines - 4, never below their own. Yaws are taken modulo 360.
 object_states() gives the objects at a time t along their paths in exact arithmetic. A model's yaw turns model x (forward) towards map
@@ -91,19 +93,47 @@ The tie-break samples (TIE_DX, TIE_DY) are the same rays, so exact ties at objec
 the top-left fill rule has them. Doors: render_ids(ceilings={sector: h}) replaces those ceilings
 (a closed door is a sector whose ceiling is its floor).
 
+Sprites (docs/objects.md "Sprites"). A WAD map with its look (bspc compiles it textured: the WAD
+has PLAYPAL and COLORMAP and the map uses a texture or flat the WAD has; not --flat) draws each
+thing whose type has a usable sprite as that sprite, never its box; text scenes and --flat are
+boxes only. The images are read from the WAD here (its own patch decoder, nothing from bspc): the
+lumps between S_START and S_END (or SS_START/SS_END), the last of a name winning, named SSSSFR or
+SSSSFRFR with SSSS things.txt's sprite and F its frame (the second pair: that rotation shows the
+image mirrored left to right; a later lump takes a rotation from an earlier one). The frame's
+rotation-0 image serves every rotation when there is one, else its eight rotations 1..8 must all
+be there; otherwise, or when an image is not a readable patch within the loader's limits (1..512
+texels each way, offsets within +-1024), the type stays a box. For the eye E and the origin O
+(the object's position as drawn), theta = atan2(O - E) in degrees, rotation r = floor(((theta -
+yaw + 202.5) mod 360) / 45) (image of Doom's rotation r + 1; r = 0 when O = E). The image is a
+rectangle in the plane z = zc through O parallel to the screen (zc O's forward depth, xc its
+lateral position): lateral X in [xc - left, xc - left + width), heights in (O.z + top - height,
+O.z + top] and not below O.z (cut at the floor), one texel a map unit. The pixel's centre ray (the
+tie-break sample) meets that plane at X = xv zc and height eye_z + yv zc: column floor(X - (xc -
+left)) (a mirrored image: width - 1 - that), row floor(O.z + top - height met); the sprite has the
+pixel where that texel is opaque (a post covers it) and zc is nearer than everything else there
+(the world, the other objects' faces and sprites; between objects an exact tie goes to the lower
+object number, against the world to the world); a transparent texel lets the ray go on. A sprite
+with zc < 4 is not drawn. Objects keep the scene's numbering (THINGS order, as bspc's): an object
+list given to cast_view (build/render's JSON) draws its object i as the sprite of the scene's
+object i (its thing type) at the position given. The View records each pixel's texel of its
+sprite image for tools/reflook.py.
+
 Eye sector (default eye height = its floor + 41, or 41 in none): even-odd ray crossing over each
 sector's lines (a line with the sector on both sides counts twice and cancels); if several
 sectors claim the point (a map whose sectors overlap), the one facing the point across the
 nearest line crossing the ray to +x wins.
 
 Colours (a WAD map; tools/reflook.py, docs/textures.md): --raw writes the expected frame (64,000
-palette indices, 0 where not compared: objects, nothing, no texture), --expect an .npz of the
-per-pixel category, texture, u, v, light table, colour and the 27 acceptable colours,
---colour-png the expected frame in the WAD's palette. The colours are of the world alone.
+palette indices, 0 where not compared: objects drawn as boxes, nothing, no texture), --expect an
+.npz of the per-pixel category, texture, u, v, light table, colour and the 27 acceptable colours,
+--colour-png the expected frame in the WAD's palette. The colours are of the world and the
+sprites (a sprite pixel: lights[table][texel], table 0 when its frame is full-bright, else the
+light of walls at depth zc in the light of the sector under its origin; tools/reflook.py).
 
 usage: tools/refrender.py SCENE --at X,Y[,Z] --angle DEG [--look PX] [--ids OUT.bin] [--png OUT.png]
                           [--raw OUT.raw] [--expect OUT.npz] [--colour-png OUT.png]
-                          [--sky-owner far|near] [--time MS] [--no-objects] [--door SECTOR=H]...
+                          [--sky-owner far|near] [--time MS] [--no-objects] [--flat]
+                          [--door SECTOR=H]...
 """
 import argparse
 import math
@@ -145,6 +175,8 @@ class Map:
         self.models = list(models)                     # Model, numbered as bspc numbers them
         self.objects = list(objects)                   # SceneObject, in file / THINGS order
         self.open_h = self.ceil.copy() if open_h is None else np.asarray(open_h, float)
+        self.sprites = [None] * len(self.objects)     # each object's SpriteSet, None: its model
+        self.textured = False                          # a WAD map drawn with its look and sprites
 
     @property
     def nlines(self):
@@ -425,10 +457,13 @@ def colour_index(text):
     return RAMPS.index(ramp) * 16 + (int(shade) if shade else 10)
 
 
-def read_things_table(path=THINGS_TXT):
-    """tools/bspc/things.txt (type radius height colour sprite name): {type: (radius, height,
-    colour index)}; `#` starts a comment. The sprite column (bspc colours a WAD's boxes from it)
-    does not change a box's shape, which is all the reference draws of objects."""
+FRAMES = "ABCDEFGHIJKLMNOPQRSTUVWXYZ[\\]"   # Doom's frame letters (frame 0 = 'A')
+
+
+def _read_things(path=THINGS_TXT):
+    """tools/bspc/things.txt, one type a line, `type radius height colour sprite frame name`
+    (`#` starts a comment; frame a letter, `*` after it: full-bright): {type: (radius, height,
+    colour index, sprite, frame letter, bright)}."""
     table = {}
     with open(path, "r", encoding="utf-8") as fh:
         for lineno, line in enumerate(fh, 1):
@@ -436,33 +471,168 @@ def read_things_table(path=THINGS_TXT):
             if not tok:
                 continue
             try:
-                if len(tok) != 6 or len(tok[4]) != 4:
+                fr = tok[5] if len(tok) == 7 else ""
+                if len(tok) != 7 or len(tok[4]) != 4 or fr[:1] not in FRAMES or \
+                        fr[1:] not in ("", "*") or not fr:
                     raise ValueError
-                table[int(tok[0])] = (float(tok[1]), float(tok[2]), colour_index(tok[3]))
+                table[int(tok[0])] = (float(tok[1]), float(tok[2]), colour_index(tok[3]),
+                                      tok[4].upper(), fr[0], fr[1:] == "*")
             except (IndexError, ValueError):
-                raise ValueError(f"{path}:{lineno}: expected 'type radius height colour sprite name'") from None
+                raise ValueError(f"{path}:{lineno}: expected 'type radius height colour sprite "
+                                 "frame name' (frame a letter, '*' after it: full-bright)") from None
     return table
 
 
-def wad_objects(thing, table, inside):
-    """Things -> (models, objects) per docs/objects.md: the things of skill 3 that are not
-    multiplayer-only, whose type the table lists, inside the coordinate range (x, y > -32768) and
-    inside a sector (inside(x, y)), in THINGS order; one upright box model per distinct (radius,
-    height, colour), numbered in order of first use; z None (the floor)."""
-    models, by_key, objects = [], {}, []
+def read_things_table(path=THINGS_TXT):
+    """tools/bspc/things.txt: {type: (radius, height, colour index)}, each type's box (a thing
+    drawn as a sprite has a box of its images instead: wad_objects)."""
+    return {t: v[:3] for t, v in _read_things(path).items()}
+
+
+def read_things_sprites(path=THINGS_TXT):
+    """tools/bspc/things.txt: {type: (sprite, frame letter, full-bright)}."""
+    return {t: v[3:] for t, v in _read_things(path).items()}
+
+
+# ---- sprites (docs/objects.md "Sprites") --------------------------------------------------
+
+SPRITE_MAX_SIZE, SPRITE_MAX_OFFSET = 512, 1024   # the loader's limits (firmware/scene_format.h)
+
+
+class SpriteImage:
+    """A sprite lump decoded: width x height texels (column-major, texels[u, v]), opaque[u, v]
+    where a post covers the texel, and Doom's offsets: left (the origin's column counted from
+    the image's left edge) and top (the image's top above the origin)."""
+
+    def __init__(self, name, width, height, left, top, texels, opaque):
+        self.name, self.width, self.height, self.left, self.top = name, width, height, left, top
+        self.texels, self.opaque = texels, opaque
+
+
+def read_sprite_patch(data, name="?"):
+    """A patch lump as a SpriteImage, every read bounds-checked. Posts (top delta, length, a pad
+    byte, the texels, a pad byte; 0xFF ends a column) are Doom's: the top delta counts from the
+    image's top; texels past the image's height are not part of it. ValueError when the lump
+    is not a patch or its size or offsets are outside the loader's limits."""
+    if len(data) < 8:
+        raise ValueError(f"sprite {name}: shorter than a patch header")
+    w, h, left, top = struct.unpack_from("<hhhh", data, 0)
+    if not (1 <= w <= SPRITE_MAX_SIZE and 1 <= h <= SPRITE_MAX_SIZE):
+        raise ValueError(f"sprite {name}: size {w} x {h} outside 1..{SPRITE_MAX_SIZE}")
+    if abs(left) > SPRITE_MAX_OFFSET or abs(top) > SPRITE_MAX_OFFSET:
+        raise ValueError(f"sprite {name}: offsets {left}, {top} beyond {SPRITE_MAX_OFFSET}")
+    if len(data) < 8 + 4 * w:
+        raise ValueError(f"sprite {name}: column table cut short")
+    texels = np.zeros((w, h), np.uint8)
+    opaque = np.zeros((w, h), bool)
+    for c in range(w):
+        (pos,) = struct.unpack_from("<I", data, 8 + 4 * c)
+        while True:
+            if pos >= len(data):
+                raise ValueError(f"sprite {name}: column {c} runs past the lump")
+            row = data[pos]
+            if row == 0xFF:
+                break
+            if pos + 3 > len(data) or pos + 3 + data[pos + 1] > len(data):
+                raise ValueError(f"sprite {name}: column {c}: a post runs past the lump")
+            n = data[pos + 1]
+            a, b = row, min(h, row + n)
+            if a < b:
+                texels[c, a:b] = np.frombuffer(data, np.uint8, b - a, pos + 3)
+                opaque[c, a:b] = True
+            pos += n + 4
+    return SpriteImage(name, w, h, left, top, texels, opaque)
+
+
+class SpriteSet:
+    """The images a thing type shows: images[r] = (SpriteImage, mirrored) for rotation r = 0..7
+    (docs/objects.md: r = 0 seen from the front; Doom's rotation r + 1), full-bright or not, and
+    the box around them: radius the largest of left and width - left, height the largest top
+    (whole units, at least 1)."""
+
+    def __init__(self, sprite, frame, bright, images):
+        self.sprite, self.frame, self.bright, self.images = sprite, frame, bright, images
+        self.radius = max(1, max(max(im.left, im.width - im.left) for im, _ in images))
+        self.height = max(1, max(im.top for im, _ in images))
+
+    def rotation(self, ex, ey, ox, oy, yaw):
+        """r for the eye at (ex, ey) and the thing at (ox, oy) with yaw degrees:
+        floor(((theta - yaw + 202.5) mod 360) / 45), theta = atan2(O - E) in degrees; 0 when O = E."""
+        if ox == ex and oy == ey:
+            return 0
+        theta = math.degrees(math.atan2(oy - ey, ox - ex))
+        return min(7, int(math.floor(((theta - float(yaw) + 202.5) % 360.0) / 45.0)))
+
+
+def sprite_lumps(lumps):
+    """{name: lump number}: the lumps between S_START and S_END (or SS_START and SS_END), the
+    last lump of a name winning; in the order of those last lumps."""
+    out, inside = {}, False
+    for i, (_, _, name) in enumerate(lumps):
+        if name in ("S_START", "SS_START"):
+            inside = True
+        elif name in ("S_END", "SS_END"):
+            inside = False
+        elif inside:
+            out.pop(name, None)
+            out[name] = i
+    return out
+
+
+def sprite_set(data, lumps, named, sprite, frame, bright):
+    """The SpriteSet of sprite SSSS, frame F, from the sprite lumps named SSSSFR or SSSSFRFR
+    (the second pair: that rotation shows the image mirrored); a later lump taking a rotation
+    from an earlier one. Rotation 0 when the frame has one (every rotation that image), else the
+    eight rotations 1..8; None when it has neither or an image is not a readable patch."""
+    rot = {}
+    for name, i in named.items():
+        if name[:4] != sprite or len(name) not in (6, 8):
+            continue
+        pairs = [(name[4], name[5], False)] + ([(name[6], name[7], True)] if len(name) == 8 else [])
+        for f, r, mirrored in pairs:
+            if f == frame and r in "012345678":
+                rot[int(r)] = (name, mirrored)
+    if 0 in rot:
+        chosen = [rot[0]] * 8
+    elif all(k in rot for k in range(1, 9)):
+        chosen = [rot[k] for k in range(1, 9)]
+    else:
+        return None
+    images = {}
+    try:
+        for name, _ in chosen:
+            if name not in images:
+                pos, size, _ = lumps[named[name]]
+                images[name] = read_sprite_patch(data[pos:pos + size], name)
+    except (ValueError, struct.error):
+        return None
+    return SpriteSet(sprite, frame, bright, [(images[n], mir) for n, mir in chosen])
+
+
+def wad_objects(thing, table, inside, sets=None):
+    """Things -> (models, objects, sprite sets) per docs/objects.md: the things of skill 3 that
+    are not multiplayer-only, whose type the table lists, inside the coordinate range (x, y >
+    -32768) and inside a sector (inside(x, y)), in THINGS order; one upright box model per
+    distinct (radius, height, colour), numbered in order of first use; z None (the floor).
+    sets: {type: SpriteSet} (a textured scene's sprites): such a thing is drawn as its sprite,
+    its box the SpriteSet's radius and height; the third list gives each object's set or None."""
+    sets = sets or {}
+    models, by_key, objects, sprites = [], {}, [], []
     for t in thing:
         typ, flags, x, y = int(t["type"]), int(t["fl"]), int(t["x"]), int(t["y"])
         if typ in NOT_OBJECTS or typ not in table or not flags & 0x0002 or flags & 0x0010:
             continue
         if x == -32768 or y == -32768 or not inside(x, y):
             continue
-        key = table[typ]
+        s = sets.get(typ)
+        key = table[typ] if s is None else (float(s.radius), float(s.height), table[typ][2])
         if key not in by_key:
             r, h, _ = key
             by_key[key] = len(models)
             models.append(Model(f"thing{typ}", [box_part(2 * r, 2 * r, h)]))
         objects.append(SceneObject(by_key[key], float(x), float(y), None, float(int(t["a"]) % 360)))
-    return models, objects
+        sprites.append(s)
+    return models, objects, sprites
 
 
 def wad_door_heights(sec_ceil, sec_tag, lin_special, lin_tag, front, back):
@@ -487,7 +657,8 @@ def wad_door_heights(sec_ceil, sec_tag, lin_special, lin_tag, front, back):
     return open_h
 
 
-def read_wad(spec):
+def read_wad(spec, flat=False):
+    """A WAD map (see the header); flat: as bspc --flat compiles it (no look: things are boxes)."""
     wadname, mapname = spec.rsplit(":", 1)
     path = find_wad(wadname)
     if path is None:
@@ -550,26 +721,49 @@ def read_wad(spec):
     # for the map's look (tools/reflook.py): the file, the map's lumps, and each kept line's
     # linedef number
     m.wad_file, m.wad_lumps, m.wad_lines = path, got, np.nonzero(keep)[0]
+    m.textured = not flat and _wad_textured(m)
     if os.path.exists(THINGS_TXT):
-        m.models, m.objects = wad_objects(thing, read_things_table(),
-                                          lambda x, y: sector_at(m, x, y) is not None)
+        things = _read_things()
+        table = {t: v[:3] for t, v in things.items()}
+        sets = {}
+        if m.textured:
+            named = sprite_lumps(lumps)
+            for typ in sorted(set(int(t) for t in thing["type"]) & set(things)):
+                spr, frame, bright = things[typ][3:]
+                sets[typ] = sprite_set(data, lumps, named, spr, frame, bright)
+        m.models, m.objects, m.sprites = wad_objects(thing, table,
+                                                     lambda x, y: sector_at(m, x, y) is not None,
+                                                     sets)
     return m
+
+
+def _wad_textured(m):
+    """Whether bspc compiles the map with its look (docs/textures.md): the WAD has PLAYPAL and
+    COLORMAP and the map uses a wall texture or flat the WAD has (the sky counted when a ceiling
+    is sky). A WAD whose texture lumps cannot be read is not."""
+    try:
+        import reflook
+        lk = reflook.Look(m)
+    except (ValueError, TypeError, KeyError, IndexError, AttributeError, struct.error):
+        return False
+    return bool((lk.side_tex >= 0).any() or (lk.floor_tex >= 0).any() or (lk.ceil_tex >= 0).any()
+                or (m.sky.any() and lk.sky_tex >= 0))
 
 
 _cache = {}
 
 
-def load(spec):
-    """A Map from a scene spec (text scene path or file.wad:MAP), cached by spec."""
+def load(spec, flat=False):
+    """A Map from a scene spec (text scene path or file.wad:MAP), cached by spec. flat: a WAD map
+    as bspc --flat compiles it (its things all boxes; text scenes are always so)."""
     if isinstance(spec, Map):
         return spec
-    if spec not in _cache:
-        head, _, tail = spec.rpartition(":")
-        if head.lower().endswith(".wad") and tail:
-            _cache[spec] = read_wad(spec)
-        else:
-            _cache[spec] = read_text(spec)
-    return _cache[spec]
+    head, _, tail = spec.rpartition(":")
+    wad = head.lower().endswith(".wad") and tail
+    key = (spec, True) if flat and wad else spec
+    if key not in _cache:
+        _cache[key] = read_wad(spec, bool(flat)) if wad else read_text(spec)
+    return _cache[key]
 
 
 # ---- eye sector ---------------------------------------------------------------------------
@@ -640,16 +834,19 @@ def object_states(scene, t_ms=0):
     return out
 
 
-def world_parts(m, states):
+def world_parts(m, states, skip=()):
     """Every convex part of every object in world space: [(object index, verts (n, 3), normals
     (f, 3), offsets (f,))], where the part is {p : normals @ p <= offsets}. The normals come
-    from the faces' vertices (Newell's sum) and point away from the part's centroid."""
+    from the faces' vertices (Newell's sum) and point away from the part's centroid. Objects in
+    skip (those drawn as sprites) have no parts; their model must exist all the same."""
     parts = []
     for i, (model, x, y, z, yaw) in enumerate(states):
         model = int(model)
         if not 0 <= model < len(m.models):
             raise ValueError(f"object {i}: model {model} does not exist (the scene has "
                              f"{len(m.models)})")
+        if i in skip:
+            continue
         c, s_ = math.cos(math.radians(float(yaw))), math.sin(math.radians(float(yaw)))
         for verts, faces in m.models[model].parts:
             w = np.empty_like(verts)
@@ -714,6 +911,78 @@ def _object_hits(parts, ex, ey, ez, fxd, fyd, rx, ry, look, dx, dy, yv):
     return best, who
 
 
+SPRITE_ZMIN = 4.0    # a sprite nearer than this (forward depth) is not drawn (Doom's MINZ)
+
+
+class SpriteDraw:
+    """One object drawn as a sprite in a view: its object index, origin (x, y, z), the rotation
+    r seen and its image (SpriteImage, mirrored), the view depth zc and lateral position xc of
+    the origin, full-bright or not, and the sector under the origin (None: none)."""
+
+
+def sprite_draws(m, states, ex, ey, fxd, fyd, rx, ry):
+    """[SpriteDraw or None] per object of states: those whose scene object has a SpriteSet and
+    whose origin is at least SPRITE_ZMIN ahead of the eye."""
+    out = []
+    for i, (_, ox, oy, oz, yaw) in enumerate(states):
+        sset = m.sprites[i] if i < len(m.sprites) else None
+        if sset is None:
+            out.append(None)
+            continue
+        relx, rely = float(ox) - ex, float(oy) - ey
+        zc = relx * fxd + rely * fyd
+        if not zc >= SPRITE_ZMIN:
+            out.append(None)
+            continue
+        d = SpriteDraw()
+        d.obj, d.x, d.y, d.z, d.zc, d.xc = i, float(ox), float(oy), float(oz), zc, relx * rx + rely * ry
+        d.rotation = sset.rotation(ex, ey, float(ox), float(oy), yaw)
+        d.image, d.mirrored = sset.images[d.rotation]
+        d.bright = sset.bright
+        d.sector = sector_at(m, d.x, d.y)
+        out.append(d)
+    return out
+
+
+def _sprite_hits(draws, best, who, ez, xv, yv):
+    """Draw the sprites into (best, who) (depth and object per pixel, as _object_hits leaves
+    them): a sprite takes a pixel where the pixel's centre ray meets an opaque texel of its
+    rectangle and zc is nearer than what the pixel has (an exact tie: the lower object number).
+    Returns per pixel the image column and row (-1: no sprite) and the exact image coordinates
+    (u, v; nan), valid where who is a sprite's object."""
+    col = np.full((H, W), -1, np.int64)
+    row = np.full((H, W), -1, np.int64)
+    su, sv = np.full((H, W), np.nan), np.full((H, W), np.nan)
+    for d in draws:
+        if d is None:
+            continue
+        im, zc = d.image, d.zc
+        a = xv * zc - (d.xc - im.left)                 # from the image's left edge, per column
+        hh = ez + yv * zc                              # height met, per row
+        b = d.z + im.top - hh                          # from the image's top, per row
+        cs = np.nonzero((a >= 0) & (a < im.width))[0]
+        rs = np.nonzero((b >= 0) & (b < im.height) & (hh >= d.z))[0]   # cut at the floor
+        if not len(cs) or not len(rs):
+            continue
+        ai = np.floor(a[cs]).astype(np.int64)
+        ci = im.width - 1 - ai if d.mirrored else ai
+        ri = np.floor(b[rs]).astype(np.int64)
+        ix = np.ix_(rs, cs)
+        sub_best, sub_who = best[ix], who[ix]
+        nearer = im.opaque[ci[None, :], ri[:, None]] & \
+            ((zc < sub_best) | ((zc == sub_best) & (d.obj < sub_who)))
+        if not nearer.any():
+            continue
+        best[ix] = np.where(nearer, zc, sub_best)
+        who[ix] = np.where(nearer, d.obj, sub_who)
+        col[ix] = np.where(nearer, ci[None, :], col[ix])
+        row[ix] = np.where(nearer, ri[:, None], row[ix])
+        uu = (im.width - a[cs]) if d.mirrored else a[cs]
+        su[ix] = np.where(nearer, uu[None, :], su[ix])
+        sv[ix] = np.where(nearer, b[rs][:, None], sv[ix])
+    return col, row, su, sv
+
+
 # ---- rendering ----------------------------------------------------------------------------
 
 class View:
@@ -722,18 +991,22 @@ class View:
     pixel (200, 320): ids (uint32 surface ids), t (the world surface's forward depth, inf for
     none; objects are not in it), line (the linedef of a wall pixel, else -1), part (0 upper,
     1 middle, 2 lower for a wall pixel; 3 where the ray went over the missing upper wall between
-    two sky ceilings and met sky; -1 else). ceil: the ceiling heights used (doors applied)."""
+    two sky ceilings and met sky; -1 else). ceil: the ceiling heights used (doors applied).
+    Objects: obj (the object a pixel shows, -1 none) and obj_t (its forward depth, inf);
+    sprites[i] the SpriteDraw of object i (None: not drawn as a sprite), and per pixel of a
+    sprite spr_col, spr_row (the texel of its image; -1 elsewhere) and spr_u, spr_v (the exact
+    image coordinates, u from the right edge for a mirrored image; nan elsewhere)."""
 
 
 def render_ids(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="near",
-               objects=None, ceilings=None):
+               objects=None, ceilings=None, flat=False):
     """Surface ids of the view from (x, y, z) at angle degrees: numpy uint32 (200, 320).
     (cast_view(...).ids; the arguments are cast_view's.)"""
-    return cast_view(scene_spec, x, y, z, angle, look, fx, sky_owner, objects, ceilings).ids
+    return cast_view(scene_spec, x, y, z, angle, look, fx, sky_owner, objects, ceilings, flat).ids
 
 
 def cast_view(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="near",
-              objects=None, ceilings=None):
+              objects=None, ceilings=None, flat=False):
     """The View from (x, y, z) at angle degrees (see View).
 
     z None: the floor of the eye's sector + 41. fx: round the camera to 16.16 first, as
@@ -742,9 +1015,12 @@ def cast_view(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="n
     side, as Doom's visplanes have it, the default) or "far" (the sector beyond).
     objects: [(model, x, y, z, yaw)] in map units and degrees (build/render's JSON "objects",
     as dicts with those keys or as tuples), drawn with ids 4 << 24 | their position in the
-    list; None: the scene's own objects at time 0 (object_states). ceilings: {sector: height}
-    (keys may be strings, as in build/render's JSON "ceilings"), for doors."""
-    m = load(scene_spec)
+    list; None: the scene's own objects at time 0 (object_states). Object i of the list is drawn
+    as the sprite of the scene's object i (its thing type, in THINGS order) when that one has
+    sprites, else as its model. ceilings: {sector: height} (keys may be strings, as in
+    build/render's JSON "ceilings"), for doors. flat: a WAD map as bspc --flat compiles it
+    (scene_spec a spec, not a Map): no sprites, every thing its box."""
+    m = load(scene_spec, flat)
     rnd = fx_round if fx else float
     x, y, angle = rnd(x), rnd(y), rnd(angle)
     z = None if z is None else rnd(z)
@@ -758,7 +1034,6 @@ def cast_view(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="n
         states = [(o["model"], o["x"], o["y"], o["z"], o["yaw"]) if isinstance(o, dict) else tuple(o)
                   for o in objects]
         states = [(int(mo), rnd(ox), rnd(oy), rnd(oz), rnd(oyaw)) for mo, ox, oy, oz, oyaw in states]
-    parts = world_parts(m, states)
     a = np.radians(float(angle) % 360.0)
     fxd, fyd = np.cos(a), np.sin(a)
     rx, ry = fyd, -fxd
@@ -876,14 +1151,27 @@ def cast_view(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="n
             part = np.where(upper, 0, np.where(mid, 1, np.where(lower, 2, 3)))[rows, j]
             hit_line[:, px] = np.where(crossing, li[j], -1)
             hit_part[:, px] = np.where(crossing, part, -1)
+    draws = sprite_draws(m, states, x, y, fxd, fyd, rx, ry)
+    skip = {i for i in range(len(states)) if i < len(m.sprites) and m.sprites[i] is not None}
+    parts = world_parts(m, states, skip)
+    obj_t, obj = np.full((H, W), np.inf), np.full((H, W), -1, np.int64)
     if parts:
         obj_t, obj = _object_hits(parts, x, y, z, fxd, fyd, rx, ry, look, dx, dy, yv)
-        front = obj_t < world_t
-        out[front] = ((KIND_OBJECT << 24) | obj[front]).astype(np.uint32)
+    spr = _sprite_hits(draws, obj_t, obj, z, xv, yv)
+    front = obj_t < world_t
+    out[front] = ((KIND_OBJECT << 24) | obj[front]).astype(np.uint32)
+    obj[~front] = -1
+    obj_t[~front] = np.inf
+    is_spr = np.array([d is not None for d in draws] + [False], bool)[obj]   # obj -1: the last
+    spr_col, spr_row, spr_u, spr_v = spr
+    spr_col[~is_spr], spr_row[~is_spr] = -1, -1
+    spr_u[~is_spr], spr_v[~is_spr] = np.nan, np.nan
     v = View()
     v.scene, v.x, v.y, v.z, v.angle, v.look = m, x, y, z, float(angle), look
     v.dx, v.dy, v.yv = dx, dy, yv
     v.ids, v.t, v.line, v.part, v.ceil = out, world_t, hit_line, hit_part, ce[:-1]
+    v.obj, v.obj_t, v.sprites = obj, obj_t, draws
+    v.spr_col, v.spr_row, v.spr_u, v.spr_v = spr_col, spr_row, spr_u, spr_v
     return v
 
 
@@ -916,7 +1204,14 @@ def main(argv=None):
     ap = argparse.ArgumentParser(
         prog="refrender.py",
         description="Reference renderer: ray-cast surface ids of a source map (no BSP tree), "
-                    "320x200 little-endian uint32, kind << 24 | index.")
+                    "320x200 little-endian uint32, kind << 24 | index. Objects are their models' "
+                    "faces; in a WAD map with its look (not --flat), a thing whose type has "
+                    "sprites is its sprite instead (docs/objects.md \"Sprites\"): the image "
+                    "of its rotation as seen from the eye (a mirrored lump flipped), a "
+                    "rectangle parallel to the screen at its origin's depth, one texel a map "
+                    "unit, cut at the floor under it, its transparent texels letting the ray "
+                    "through, sorted against everything else by that depth; not drawn nearer "
+                    "than 4 units.")
     ap.add_argument("scene", help="text scene, or FILE.wad:MAP01 / FILE.wad:E1M1")
     ap.add_argument("--at", help="X,Y[,Z] eye position (default: the player start; Z: the "
                                  "floor of the eye's sector + 41)")
@@ -939,11 +1234,15 @@ def main(argv=None):
     ap.add_argument("--time", type=int, default=0,
                     help="the scene's objects along their paths at MS milliseconds (default 0)")
     ap.add_argument("--no-objects", action="store_true", help="draw no objects")
+    ap.add_argument("--flat", action="store_true",
+                    help="a WAD map as bspc --flat compiles it: its things boxes, no sprites "
+                         "(by default a WAD map with its look draws the things Doom draws as "
+                         "their sprites)")
     ap.add_argument("--door", action="append", default=[], metavar="SECTOR=H",
                     help="set a sector's ceiling (repeatable)")
     a = ap.parse_args([v for v in argv if v != ""])
     try:
-        m = load(a.scene)
+        m = load(a.scene, a.flat)
         px, py, pa = m.player if m.player else (0.0, 0.0, 0.0)
         z = None
         if a.at:
@@ -965,16 +1264,16 @@ def main(argv=None):
         if not (a.ids or a.raw or a.expect or a.colour_png):
             ap.error("no output: give --ids, --raw, --expect or --colour-png")
         objs = [] if a.no_objects else object_states(m, a.time)
-        ids = render_ids(m, px, py, z, pa, a.look, sky_owner=a.sky_owner, objects=objs,
+        view = cast_view(m, px, py, z, pa, a.look, sky_owner=a.sky_owner, objects=objs,
                          ceilings=ceilings)
+        ids = view.ids
         if a.ids:
             write_ids(a.ids, ids)
         if a.png:
             write_png_rgb(a.png, false_colour(ids))
         if a.raw or a.expect or a.colour_png:
             import reflook
-            e = reflook.expect(cast_view(m, px, py, z, pa, a.look, sky_owner=a.sky_owner,
-                                         objects=[], ceilings=ceilings))
+            e = reflook.expect(view)
             if a.raw:
                 e.colour.tofile(a.raw)
             if a.colour_png:

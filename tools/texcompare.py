@@ -3,15 +3,18 @@
 
 Given a WAD map, a camera (build/render's --at/--angle/--look/--door) and the renderer's frame
 (--raw: 64,000 palette indices) and id buffer (--ids), it casts the reference's view
-(tools/refrender.py, the world alone) and its expected colours (tools/reflook.py), and reports the
-share of compared pixels whose colour is acceptable: within one texel and one light step of the
-reference's (docs/textures.md). Compared: wall, floor, ceiling and sky pixels with a texture in
-the reference, leaving out the pixels where the renderer's id buffer shows an object. Prints one
-JSON object; --diff writes the frame with the failures in red (the pixels not compared dimmed).
-Exit status 0, or 1 on bad input.
+(tools/refrender.py: the world and the map's things at time 0, those Doom draws as their sprites,
+docs/objects.md "Sprites"; --no-objects: the world alone) and its expected colours
+(tools/reflook.py), and reports the share of compared pixels whose colour is acceptable: within
+one texel and one light step of the reference's (docs/textures.md; a sprite's texel in its
+image, its light table by the sprites' light rule). Compared: wall, floor, ceiling and sky pixels
+with a texture in the reference where the renderer's id buffer shows no object, and the
+reference's sprite pixels where the renderer's id buffer shows the same object ("sprite" in the
+counts). Prints one JSON object; --diff writes the frame with the failures in red (the pixels not
+compared dimmed). Exit status 0, or 1 on bad input.
 
 usage: tools/texcompare.py WAD:MAP --raw FRAME --ids IDS [--at X,Y[,Z]] [--angle DEG] [--look PX]
-                           [--door SECTOR=H]... [--diff OUT.png]
+                           [--door SECTOR=H]... [--no-objects] [--diff OUT.png]
 """
 import argparse
 import json
@@ -25,9 +28,11 @@ import reflook  # noqa: E402
 import refrender  # noqa: E402
 
 
-def reference(scene, at=None, angle=None, look=0, ceilings=None):
+def reference(scene, at=None, angle=None, look=0, ceilings=None, objects=None):
     """The reference's Expect for build/render's camera arguments (strings or numbers; None:
-    the player start, the eye 41 above the floor)."""
+    the player start, the eye 41 above the floor). objects: as refrender.cast_view takes them
+    (build/render's JSON "objects"; [] the world alone); None: the map's own things, which is
+    what build/render draws at time 0."""
     m = refrender.load(scene)
     x, y, a = m.player if m.player else (0.0, 0.0, 0.0)
     z = None
@@ -39,7 +44,7 @@ def reference(scene, at=None, angle=None, look=0, ceilings=None):
         z = parts[2] if len(parts) == 3 else None
     if angle is not None:
         a = angle
-    view = refrender.cast_view(m, x, y, z, a, int(look), objects=[], ceilings=ceilings or {})
+    view = refrender.cast_view(m, x, y, z, a, int(look), objects=objects, ceilings=ceilings or {})
     return reflook.expect(view)
 
 
@@ -67,6 +72,8 @@ def main(argv=None):
     ap.add_argument("--raw", required=True, help="the renderer's frame: 64,000 palette indices")
     ap.add_argument("--ids", help="the renderer's id buffer (its object pixels are left out)")
     ap.add_argument("--diff", help="write the frame with the failures in red (PNG)")
+    ap.add_argument("--no-objects", action="store_true",
+                    help="the reference without the map's things (build/render --no-objects)")
     argv = list(sys.argv[1:] if argv is None else argv)
     for i in range(len(argv) - 1):     # let "--at -192,-160" through argparse
         if argv[i] in ("--at", "--angle", "--look") and argv[i + 1].startswith("-"):
@@ -83,7 +90,7 @@ def main(argv=None):
         ids = None
         if a.ids:
             ids = read_u8(a.ids, 256000, "id buffer").view("<u4")
-        e = reference(a.scene, a.at, a.angle, a.look, ceilings)
+        e = reference(a.scene, a.at, a.angle, a.look, ceilings, [] if a.no_objects else None)
         ok, compared, counts = reflook.compare(e, frame, ids)
         if a.diff:
             refrender.write_png_rgb(a.diff, reflook.diff_rgb(e, frame, ok, compared))
