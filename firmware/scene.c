@@ -377,7 +377,7 @@ static scene_status check_sprites(const scene *s, scene_error *err)
         for (int r = 0; r < SCN_SPRITE_ROTS; r++) {
             const scn_sprite *p = &s->sprites[s->sprsets[o->sprset].image[r]];
             int32_t reach = p->left > p->width - p->left ? p->left : p->width - p->left;
-            if ((int64_t)reach << 16 > m->radius || (int64_t)p->top << 16 > m->zmax || m->zmin > 0)
+            if ((int64_t)reach << 16 > m->radius || (int64_t)p->top * 65536 > m->zmax || m->zmin > 0)
                 return fail(err, SCENE_ERR_RANGE, SCN_SEC_OBJECTS, i);
         }
     }

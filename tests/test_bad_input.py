@@ -43,7 +43,8 @@ def refused(args, *needles, status=1):
 
 # ---- compiled scenes ------------------------------------------------------------------------
 
-HEADER_BYTES = 204  # sizeof(scn_header)
+HEADER_BYTES = 228  # sizeof(scn_header): 44 bytes, then 23 sections of 8
+VERSION = 5  # SCN_VERSION
 VERTICES, SECTORS, LINES, SEGS, NODES, LEAVES, PVERTS, PALETTE = range(8)
 NEEDS = 13
 LOOK, LIGHTS, TEXTURES, TEXELS, SIDES, PLANES = range(14, 20)
@@ -138,14 +139,14 @@ COMPILED = [
     ("truncated-in-segs", truncate(lambda d: section(d, SEGS)[0] + 5), ["truncated", "header total_bytes"]),
     ("truncated-one-byte-short", truncate(lambda d: len(d) - 1), ["truncated", "header total_bytes"]),
     ("wrong-magic", wrong_magic, ["magic", "BSCN"]),
-    ("wrong-version", set_version, ["header", "unsupported version 99", "reads version 4"]),
+    ("wrong-version", set_version, ["header", "unsupported version 99", f"reads version {VERSION}"]),
     ("bad-crc", bad_crc, ["bad CRC-32", "header crc32", "damaged"]),
     ("total-bytes-beyond-file", header_field(8, lambda d: len(d) + 4),
      ["truncated", "header total_bytes"]),
     ("total-bytes-short-of-file", appended, ["header: total_bytes", "but the file has"]),
     ("total-bytes-not-multiple-of-4", lambda d: header_field(8, len(d) + 2)(d + b"\0\0"),
      ["header: total_bytes", "not a multiple of 4"]),
-    ("header-bytes", header_field(4, lambda d: 4 | (HEADER_BYTES - 4) << 16),
+    ("header-bytes", header_field(4, lambda d: VERSION | (HEADER_BYTES - 4) << 16),
      [f"header: header_bytes = {HEADER_BYTES - 4}", f"expected {HEADER_BYTES}"]),
     ("flags", header_field(16, 1), ["header: flags = 0x1", "reserved"]),
     ("segs-offset-past-end", header_field(44 + 8 * SEGS, lambda d: len(d)),

@@ -14,6 +14,7 @@ from texture_bytes import flat_names, map_lumps, name8, read_wad, sections, side
 
 SEC_LOOK, SEC_LIGHTS, SEC_TEXTURES, SEC_TEXELS, SEC_SIDES, SEC_PLANES = range(14, 20)
 SEC_LINES, SEC_SECTORS, SEC_PALETTE = 2, 1, 7
+SEC_SPRITES = 20
 TEX_NONE = 0xFFFF
 
 
@@ -113,11 +114,14 @@ def test_look_sections_hold_exactly_what_the_map_uses(tmp_path, wad, mapname):
     o = sec[SEC_LIGHTS][0]
     assert blob[o:o + 32 * 256] == last(lumps, "COLORMAP")[:32 * 256]
     texs = textures(blob)
-    # stored one after another, each 2^(wbits + hbits) texels
+    # stored one after another, each 2^(wbits + hbits) texels; the things' sprite images follow
+    # (docs/objects.md, "Sprites"; tests/test_bspc_sprites.py)
     at = 0
     for first, wb, hb, _, reserved in texs:
         assert first == at and reserved == 0
         at += 1 << (wb + hb)
+    off, nspr = sec[SEC_SPRITES]
+    at += sum(w * h for _, _, w, h in (struct.unpack_from("<IIHH", blob, off + 16 * i) for i in range(nspr)))
     assert sec[SEC_TEXELS][1] == at
 
     # the names the map uses, as the WAD gives them (zero-length linedefs are left out)

@@ -95,7 +95,8 @@ def measure(bspc, wad, mapname, tmp):
     nbytes = lambda t: 1 << (tex[t][1] + tex[t][2])
     return {
         "map": mapname, "textures": ntex - len(flats), "flats": len(flats),
-        "texel_bytes": sec[SEC_TEXELS][1], "light_bytes": sec[SEC_LIGHTS][1] * 256,
+        # the textures' texels (the things' sprite images follow them in the section: docs/objects.md)
+        "texel_bytes": sum(1 << (t[1] + t[2]) for t in tex), "light_bytes": sec[SEC_LIGHTS][1] * 256,
         "flat_bytes": sum(nbytes(t) for t in flats), "blob": len(blob), "tex": tex, "flat_set": flats,
         "blob_data": blob,
     }

@@ -273,6 +273,7 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
         if (walked != SCN_NONE) s.player_sector = walked;
     }
     place_objects(&s, &t, &opt);
+    bs_sprites_prune(&s);
     if (bs_write_blob(&s, &t, blob, len, err, errlen)) goto out;
     needs_report needs;
     if (fill_needs(&s, *blob, *len, &needs, err, errlen)) goto out;
@@ -287,6 +288,8 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
             t.mean_depth, t.tj_pverts, t1 - t0);
     bs_note(&opt, "%s: %u models (%u vertices, %u faces), %u objects, %u doors", s.name, s.nmodels, s.nmverts, s.nfaces,
             s.nobjects, s.ndoors);
+    if (s.look.present && s.look.nsprsets)
+        bs_note(&opt, "%s: %u sprite sets, %u sprite images", s.name, s.look.nsprsets, s.look.nsprites);
     if (stats) {
         memset(stats, 0, sizeof *stats);
         stats->input_walls = s.nlines;
@@ -301,6 +304,16 @@ int bspc_compile(const char *spec, const bspc_options *opt_in, uint8_t **blob, s
         stats->models = s.nmodels;
         stats->objects = s.nobjects;
         stats->doors = s.ndoors;
+        if (s.look.present) {
+            const bs_look *lk = &s.look;
+            stats->sprites = lk->nsprites;
+            stats->sprite_sets = lk->nsprsets;
+            for (uint32_t i = 0; i < lk->nsprites; i++)
+                stats->sprite_texels += (uint64_t)lk->sprites[i].width * lk->sprites[i].height;
+            stats->sprite_mask_bytes = 4ull * lk->nsprmask;
+            stats->sprite_bytes = stats->sprite_texels + stats->sprite_mask_bytes + sizeof(scn_sprite) * lk->nsprites +
+                                  sizeof(scn_sprset) * lk->nsprsets;
+        }
         stats->needs = needs;
     }
     rc = 0;

@@ -32,6 +32,10 @@ typedef struct {
     double mean_depth;               /* mean over leaves */
     double build_ms;                 /* wall-clock milliseconds for the tree build and blob write */
     uint32_t models, objects, doors; /* docs/objects.md */
+    uint32_t sprites, sprite_sets;   /* docs/objects.md, "Sprites": images and sets in the blob */
+    uint64_t sprite_texels;          /* their texels (bytes of SCN_SEC_TEXELS) */
+    uint64_t sprite_mask_bytes;      /* SCN_SEC_SPRMASK */
+    uint64_t sprite_bytes;           /* texels, mask and the two sections' records */
     needs_report needs;              /* what the scene needs (docs/needs.md), as written in the blob */
 } bspc_stats;
 

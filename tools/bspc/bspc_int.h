@@ -199,6 +199,18 @@ int bs_look_side(bs_wadlook *L, uint32_t li, int k, const uint8_t rec[30], unsig
 /* A thing's box colour: the sprite's mean colour, or fallback (a default-palette
  * colour of things.txt) moved to the nearest PLAYPAL colour. */
 uint8_t bs_look_thing_colour(bs_wadlook *L, const char prefix[4], uint8_t fallback);
+/* sprites.c: the sprite set of a thing type (docs/objects.md, "Sprites"):
+ * its sprite, frame letter and SCN_SPRSET_* flags from things.txt. 0 and
+ * *set1 = 1 + the set's index in s->look.sprsets, with the box around its
+ * images (radius, height: whole units, at least 1); or 0 and *set1 = 0 when the
+ * type stays a box (no look, --flat, or the WAD lacks the images: -v says
+ * why); -1 with a message for damaged sprite data. A set asked for again is
+ * the same set; each lump is stored once. */
+int bs_look_thing_sprite(bs_wadlook *L, const char sprite[4], char frame, unsigned flags, uint32_t *set1,
+                         int32_t *radius, int32_t *height, char *err, size_t errlen);
+/* Keep only the sprite sets the scene's objects name, and the images those
+ * use (after objects were left out), in their order. */
+void bs_sprites_prune(bs_scene *s);
 /* Done (also after a failure): the look is kept unless --flat (the Doom palette
  * and colours stay either way). */
 void bs_look_close(bs_wadlook *L);

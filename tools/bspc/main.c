@@ -133,10 +133,13 @@ static void print_stats(const char *map, const bspc_stats *st)
     printf("\"input_walls\": %u, \"segs\": %u, \"splits\": %u, \"leaves\": %u, \"nodes\": %u, "
            "\"vertices\": %u, \"max_depth\": %u, \"mean_depth\": %.3f, \"build_ms\": %.3f, "
            "\"models\": %u, \"objects\": %u, \"features\": %u, \"max_edges\": %u, \"max_surfaces\": %u, "
-           "\"all_edges\": %u, \"all_surfaces\": %u}\n",
+           "\"all_edges\": %u, \"all_surfaces\": %u, \"sprites\": %u, \"sprite_sets\": %u, "
+           "\"sprite_texels\": %llu, \"sprite_mask_bytes\": %llu, \"sprite_bytes\": %llu}\n",
            st->input_walls, st->segs, st->splits, st->leaves, st->nodes, st->vertices, st->max_depth, st->mean_depth,
            st->build_ms, st->models, st->objects, st->needs.needs.features, st->needs.needs.edges,
-           st->needs.needs.surfaces, st->needs.all_edges, st->needs.all_surfaces);
+           st->needs.needs.surfaces, st->needs.all_edges, st->needs.all_surfaces, st->sprites, st->sprite_sets,
+           (unsigned long long)st->sprite_texels, (unsigned long long)st->sprite_mask_bytes,
+           (unsigned long long)st->sprite_bytes);
 }
 
 /* Write blob[0..len) to path whole, or remove what was written and say why. */

@@ -93,6 +93,9 @@ void bs_scene_free(bs_scene *s)
     free(s->look.texels);
     free(s->look.sides);
     free(s->look.planes);
+    free(s->look.sprites);
+    free(s->look.sprmask);
+    free(s->look.sprsets);
     memset(s, 0, sizeof *s);
 }
 

@@ -7,7 +7,8 @@
  * marks a Hexen-format map, which is refused. Every index is validated.
  *
  * Things listed in tools/bspc/things.txt (built in as things_txt.h) become
- * objects on box models, and sectors opened by door specials become doors
+ * objects on box models, drawn as their sprites in a textured scene
+ * (sprites.c), and sectors opened by door specials become doors
  * (docs/objects.md). The WAD's palette, textures, flats and sprites give the
  * scene its look and colours (wad_look.c, docs/textures.md).
  */
@@ -68,7 +69,12 @@ typedef struct {
     uint8_t colour;
     uint8_t table_colour; /* things.txt's colour: kinds share a model by it, as tools/refrender.py counts them */
     char sprite[4];       /* Doom's sprite name */
+    char frame;           /* the letter of its spawn state's frame */
+    uint8_t sprflags;     /* SCN_SPRSET_BRIGHT: that state is full-bright */
     int coloured;         /* colour taken from the sprite (or PLAYPAL's nearest) */
+    int looked;           /* its sprite set was asked for (sprset1, mr, mh set) */
+    uint32_t sprset1;     /* 1 + its sprite set; 0: drawn as its box */
+    int32_t mr, mh;       /* its model's radius and height: the table's, or the box around its sprite */
 } thing_kind;
 
 /* Parse the built-in table into kinds[] (at most cap); returns the count, or -1
@@ -89,13 +95,15 @@ static int read_thing_table(thing_kind *kinds, int cap, char *err, size_t errlen
         lineno++;
         char *hash = strchr(line, '#');
         if (hash) *hash = 0;
-        char *col[7];
+        char *col[8];
         int nc = 0;
         char *save = NULL;
-        for (char *c = strtok_r(line, " \t\r", &save); c && nc < 7; c = strtok_r(NULL, " \t\r", &save)) col[nc++] = c;
+        for (char *c = strtok_r(line, " \t\r", &save); c && nc < 8; c = strtok_r(NULL, " \t\r", &save)) col[nc++] = c;
         if (nc == 0) continue;
         long v[3];
-        int bad = nc != 6 || strlen(col[4]) != 4;
+        int bad = nc != 7 || strlen(col[4]) != 4;
+        /* the frame: a letter, '*' after it when full-bright */
+        if (!bad) bad = !(col[5][0] >= 'A' && col[5][0] <= 'Z') || (col[5][1] && (col[5][1] != '*' || col[5][2]));
         for (int j = 0; j < 4 && !bad; j++)
             bad = !isupper((unsigned char)col[4][j]) && !isdigit((unsigned char)col[4][j]);
         for (int j = 0; j < 3 && !bad; j++) {
@@ -117,12 +125,19 @@ static int read_thing_table(thing_kind *kinds, int cap, char *err, size_t errlen
         }
         if (bad)
             return bs_fail(err, errlen,
-                           "things.txt:%d: expected 'type radius height colour sprite name' "
-                           "(radius 1..%d)",
+                           "things.txt:%d: expected 'type radius height colour sprite frame name' "
+                           "(radius 1..%d, frame a letter A..Z, '*' after it when full-bright)",
                            lineno, SCN_MODEL_MAX);
         if (n == cap) return bs_fail(err, errlen, "things.txt: more than %d thing types", cap);
-        kinds[n] = (thing_kind){(uint16_t)v[0], (int32_t)v[1], (int32_t)v[2], (uint8_t)colour, (uint8_t)colour, {0}, 0};
-        memcpy(kinds[n++].sprite, col[4], 4);
+        thing_kind *t = &kinds[n++];
+        memset(t, 0, sizeof *t);
+        t->type = (uint16_t)v[0];
+        t->radius = t->mr = (int32_t)v[1];
+        t->height = t->mh = (int32_t)v[2];
+        t->colour = t->table_colour = (uint8_t)colour;
+        memcpy(t->sprite, col[4], 4);
+        t->frame = col[5][0];
+        t->sprflags = col[5][1] == '*' ? SCN_SPRSET_BRIGHT : 0;
     }
     return n;
 }
@@ -131,7 +146,9 @@ static int read_thing_table(thing_kind *kinds, int cap, char *err, size_t errlen
 #define THING_MULTI_ONLY 0x0010u
 
 /* Things of listed types, on skill 3 and in single player, become objects, one
- * box model per distinct (radius, height, colour), models in order of first use. */
+ * box model per distinct (radius, height, colour), models in order of first use.
+ * In a textured scene a type drawn as its sprite has the box around its images
+ * (docs/objects.md, "Sprites"). */
 static int read_things(bs_scene *s, bs_wadlook *look, const uint8_t *recs, uint32_t count, const char *display,
                        const bspc_options *opt, char *err, size_t errlen)
 {
@@ -169,23 +186,36 @@ static int read_things(bs_scene *s, bs_wadlook *look, const uint8_t *recs, uint3
             skipped++;
             continue;
         }
-        if (look && !kinds[k].coloured) {
-            kinds[k].colour = bs_look_thing_colour(look, kinds[k].sprite, kinds[k].colour);
-            kinds[k].coloured = 1;
+        thing_kind *t = &kinds[k];
+        if (look && !t->coloured) {
+            t->colour = bs_look_thing_colour(look, t->sprite, t->colour);
+            t->coloured = 1;
+        }
+        if (look && !t->looked) {
+            int32_t sr = 0, sh = 0;
+            if (bs_look_thing_sprite(look, t->sprite, t->frame, t->sprflags, &t->sprset1, &sr, &sh, msg, sizeof msg)) {
+                rc = bs_fail(err, errlen, "%s", msg);
+                goto done;
+            }
+            if (t->sprset1) {
+                t->mr = sr;
+                t->mh = sh;
+            }
+            t->looked = 1;
         }
         /* kinds sharing a size and things.txt colour share a model (the first one's sprite colours it) */
         for (int j = 0; j < nk && model_of[k] == SCN_NONE; j++)
-            if (model_of[j] != SCN_NONE && kinds[j].radius == kinds[k].radius && kinds[j].height == kinds[k].height &&
-                kinds[j].table_colour == kinds[k].table_colour)
+            if (model_of[j] != SCN_NONE && kinds[j].mr == t->mr && kinds[j].mh == t->mh &&
+                kinds[j].table_colour == t->table_colour)
                 model_of[k] = model_of[j];
         if (model_of[k] == SCN_NONE) {
             bs_mpart p;
             memset(&p, 0, sizeof p);
             p.box = 1;
             p.sides = 4;
-            p.w = p.d = kinds[k].radius * 2 * 65536;
-            p.h = kinds[k].height * 65536;
-            p.top = p.bottom = p.side = kinds[k].colour;
+            p.w = p.d = t->mr * 2 * 65536;
+            p.h = t->mh * 65536;
+            p.top = p.bottom = p.side = t->colour;
             if (bs_model_begin(s, NULL, 0, msg, sizeof msg) || bs_model_add_part(s, &p, msg, sizeof msg) ||
                 bs_model_end(s, msg, sizeof msg)) {
                 rc = bs_fail(err, errlen, "%s: thing type %u: %s", display, type, msg);
@@ -211,6 +241,7 @@ static int read_things(bs_scene *s, bs_wadlook *look, const uint8_t *recs, uint3
         o->yaw = a * 65536;
         o->path = SCN_PATH_NONE;
         o->src_line = (int)i;
+        o->sprset1 = t->sprset1;
     }
     if (unknown) bs_note(opt, "%s: %u thing(s) of types not in things.txt left out", display, unknown);
     if (skipped) bs_note(opt, "%s: %u thing(s) out of range left out", display, skipped);

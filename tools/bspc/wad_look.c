@@ -1,7 +1,8 @@
 /* wad_look.c - a WAD map's look (docs/textures.md): PLAYPAL, COLORMAP, the wall
  * textures composed from their patches (TEXTURE1/2, PNAMES), flats, the sky,
  * each side's texture mapping and each sector's planes, and the colours of
- * the flat-shaded view and of things taken from the same data.
+ * the flat-shaded view and of things taken from the same data. Patches are
+ * decoded by patch.c; the things' sprite images are built by sprites.c.
  *
  * Only what the map uses is composed and stored, each name once. Every byte
  * read from the WAD is bounds-checked: a damaged lump of a texture the map
@@ -15,51 +16,8 @@
 
 #include "bspc_int.h"
 #include "look_cache.h"
-#include "name_table.h"
-
-enum { KIND_WALL, KIND_FLAT };
-
-typedef struct {
-    char name[9];
-    int kind;
-    uint16_t tex;  /* SCN_TEX_NONE: unknown (warned once) */
-    uint32_t hash; /* of name: most entries are told apart by it alone */
-} used_name;
-
-struct bs_wadlook {
-    FILE *f;
-    size_t flen;
-    const bs_wadlump *dir;
-    uint32_t ndir;
-    const char *wad; /* the scene spec, for messages */
-    const bspc_options *opt;
-    bs_scene *s;
-    bs_look *lk;
-    uint8_t *pnames;
-    uint32_t npnames;
-    uint8_t *tdef[2];
-    uint32_t tdsize[2];
-    used_name *used;
-    uint32_t nused, ucap;
-    uint32_t nlines_cap; /* sides has room for 2 * nlines_cap */
-    const char *sky_name;
-    uint8_t neutral;   /* palette index of a mid grey, for parts without a texture */
-    uint32_t *flats;   /* the lumps between flat markers, in directory order (found once) */
-    uint32_t nflats;   /* valid once flats is set */
-    uint32_t *sprites; /* the same for the sprite markers */
-    uint32_t nsprites;
-    name_table lumps;     /* the directory, the last of a name winning (lumps.e NULL until needed) */
-    name_table flat_name; /* the flats, the same */
-    name_table texdefs;   /* TEXTURE1 then TEXTURE2 up to the first bad entry, the first winning:
-                           * entry i of TEXTURE1 is i, entry i of TEXTURE2 is texdef_n0 + i */
-    uint32_t texdef_n0;
-    int bad_kind;             /* what stopped that indexing: BAD_NONE, BAD_COUNT or BAD_ENTRY ... */
-    int bad_lump;             /* ... in TEXTURE1 (0) or TEXTURE2 (1) ... */
-    uint32_t bad_entry;       /* ... at this entry */
-    uint8_t def_palette[768]; /* the flat-shaded palette (bs_palette), for things.txt's colours */
-    int have_def_palette;
-    const char *wadpath; /* the file, as the look cache knows it */
-};
+#include "patch.h"
+#include "wad_look_int.h"
 
 enum { BAD_NONE, BAD_COUNT, BAD_ENTRY };
 
@@ -91,8 +49,7 @@ static uint32_t find_lump(const bs_wadlook *L, const char *name, uint32_t from, 
     return L->ndir;
 }
 
-/* Read lump i whole (at least min bytes); malloc'd into *out. */
-static int load_lump(const bs_wadlook *L, uint32_t i, uint32_t min, uint8_t **out, char *err, size_t errlen)
+int bs_wl_load_lump(const bs_wadlook *L, uint32_t i, uint32_t min, uint8_t **out, char *err, size_t errlen)
 {
     const bs_wadlump *e = &L->dir[i];
     *out = NULL;
@@ -204,55 +161,46 @@ static int store_kept(bs_wadlook *L, const lc_entry *e, uint16_t *out, char *err
     return 0;
 }
 
-/* ---- pictures (Doom's patch format: columns of posts) ---- */
+/* ---- pictures (Doom's patch format, patch.c) ---- */
+
+/* a texture's patch: the rows of each post inside the column-major w x h picture, at (ox, oy) */
+typedef struct {
+    uint8_t *pic;
+    int32_t h, ox, oy;
+} tex_draw;
+
+static void tex_post(void *ctx, int32_t c, uint32_t top, const uint8_t *src, uint32_t len)
+{
+    const tex_draw *d = ctx;
+    int32_t y0 = d->oy + (int32_t)top, k0 = y0 < 0 ? -y0 : 0, k1 = (int32_t)len;
+    if (y0 + k1 > d->h) k1 = d->h - y0;
+    if (k0 < k1) memcpy(d->pic + (d->ox + c) * d->h + y0 + k0, src + k0, (size_t)(k1 - k0));
+}
 
 /* Draw patch data p[0..size) into the column-major w x h picture at (ox, oy),
- * clipped. what names the lump for messages. opaque counts the pixels drawn
- * and sum their colours (either may be NULL). */
+ * clipped (the columns outside it are not read). what names the lump. */
 static int draw_patch(const bs_wadlook *L, const uint8_t *p, uint32_t size, const char *what, uint8_t *pic, int32_t w,
-                      int32_t h, int32_t ox, int32_t oy, uint64_t *opaque, double sum[3], char *err, size_t errlen)
+                      int32_t h, int32_t ox, int32_t oy, char *err, size_t errlen)
 {
-    if (size < 8)
-        return bs_fail(err, errlen, "%s: patch %s: %u bytes, shorter than its 8-byte header", L->wad, what, size);
-    int32_t pw = rds16(p), ph = rds16(p + 2);
-    if (pw <= 0 || ph <= 0 || (uint64_t)8 + 4u * (uint64_t)pw > size)
-        return bs_fail(err, errlen, "%s: patch %s: size %d x %d does not fit its %u bytes", L->wad, what, pw, ph, size);
-    for (int32_t c = 0; c < pw; c++) {
-        int32_t x = ox + c;
-        if (pic && (x < 0 || x >= w)) continue;
-        uint32_t at = rd32(p + 8 + 4 * c);
-        for (;;) { /* at grows by at least 4 a post */
-            if (at >= size)
-                return bs_fail(err, errlen, "%s: patch %s: column %d runs past the end of the lump", L->wad, what, c);
-            uint32_t top = p[at];
-            if (top == 0xFF) break;
-            if ((uint64_t)at + 3 > size)
-                return bs_fail(err, errlen, "%s: patch %s: column %d: post header past the end", L->wad, what, c);
-            uint32_t len = p[at + 1];
-            if ((uint64_t)at + 3 + len > size)
-                return bs_fail(err, errlen,
-                               "%s: patch %s: column %d: post of %u bytes at %u runs past the end "
-                               "(%u bytes)",
-                               L->wad, what, c, len, at, size);
-            const uint8_t *src = p + at + 3;
-            if (pic && !opaque && !sum) { /* a texture's patch: the rows of the post inside the picture */
-                int32_t y0 = oy + (int32_t)top, k0 = y0 < 0 ? -y0 : 0, k1 = (int32_t)len;
-                if (y0 + k1 > h) k1 = h - y0;
-                if (k0 < k1) memcpy(pic + x * h + y0 + k0, src + k0, (size_t)(k1 - k0));
-                at += len + 4;
-                continue;
-            }
-            for (uint32_t k = 0; k < len; k++) {
-                int32_t y = oy + (int32_t)(top + k);
-                if (opaque) (*opaque)++;
-                if (sum)
-                    for (int g = 0; g < 3; g++) sum[g] += L->lk->palette[3 * src[k] + g];
-                if (pic && y >= 0 && y < h) pic[x * h + y] = src[k];
-            }
-            at += len + 4;
-        }
-    }
-    return 0;
+    tex_draw d = {pic, h, ox, oy};
+    return bs_patch_walk(p, size, L->wad, what, -ox, w - ox, tex_post, &d, err, errlen);
+}
+
+/* the texels of a patch: how many, and the sums of their colours' components */
+typedef struct {
+    const uint8_t *palette;
+    uint64_t count;
+    double sum[3];
+} mean_acc;
+
+static void mean_post(void *ctx, int32_t c, uint32_t top, const uint8_t *src, uint32_t len)
+{
+    (void)c;
+    (void)top;
+    mean_acc *m = ctx;
+    m->count += len;
+    for (uint32_t k = 0; k < len; k++)
+        for (int g = 0; g < 3; g++) m->sum[g] += m->palette[3 * src[k] + g];
 }
 
 /* ---- wall textures ---- */
@@ -374,8 +322,8 @@ static int compose_wall(bs_wadlook *L, const char *name, uint16_t *out, char *er
             break;
         }
         uint8_t *p;
-        rc = load_lump(L, li, 0, &p, err, errlen);
-        if (rc == 0) rc = draw_patch(L, p, L->dir[li].size, pn, pic, w, h, ox, oy, NULL, NULL, err, errlen);
+        rc = bs_wl_load_lump(L, li, 0, &p, err, errlen);
+        if (rc == 0) rc = draw_patch(L, p, L->dir[li].size, pn, pic, w, h, ox, oy, err, errlen);
         free(p);
     }
     if (rc == 0) rc = store(L, name, pic, (uint32_t)w, (uint32_t)h, out, err, errlen);
@@ -436,7 +384,7 @@ static int compose_flat(bs_wadlook *L, const char *name, uint16_t *out, char *er
         return 0;
     }
     uint8_t *p;
-    if (load_lump(L, li, 4096, &p, err, errlen)) return -1;
+    if (bs_wl_load_lump(L, li, 4096, &p, err, errlen)) return -1;
     uint8_t pic[4096];
     for (int u = 0; u < 64; u++)
         for (int v = 0; v < 64; v++) pic[u * 64 + v] = p[v * 64 + u]; /* the lump is row-major */
@@ -536,21 +484,21 @@ int bs_look_open(FILE *f, const char *wadpath, size_t flen, const bs_wadlump *di
     *L = tmp;
     bs_look *lk = &s->look;
     uint8_t *b = NULL;
-    if (load_lump(L, at[0], 768, &b, err, errlen)) goto fail;
+    if (bs_wl_load_lump(L, at[0], 768, &b, err, errlen)) goto fail;
     memcpy(lk->palette, b, 768);
     free(b);
-    if (load_lump(L, at[1], 256 * SCN_LIGHT_MAPS, &lk->lights, err, errlen)) goto fail;
-    if (load_lump(L, at[2], 4, &L->pnames, err, errlen)) goto fail;
+    if (bs_wl_load_lump(L, at[1], 256 * SCN_LIGHT_MAPS, &lk->lights, err, errlen)) goto fail;
+    if (bs_wl_load_lump(L, at[2], 4, &L->pnames, err, errlen)) goto fail;
     L->npnames = rd32(L->pnames);
     if (L->npnames > (dir[at[2]].size - 4) / 8) {
         bs_fail(err, errlen, "%s: lump PNAMES: %u names do not fit its %u bytes", s->name, L->npnames, dir[at[2]].size);
         goto fail;
     }
-    if (load_lump(L, at[3], 4, &L->tdef[0], err, errlen)) goto fail;
+    if (bs_wl_load_lump(L, at[3], 4, &L->tdef[0], err, errlen)) goto fail;
     L->tdsize[0] = dir[at[3]].size;
     uint32_t t2 = find_lump(L, "TEXTURE2", 0, ndir);
     if (t2 != ndir) {
-        if (load_lump(L, t2, 4, &L->tdef[1], err, errlen)) goto fail;
+        if (bs_wl_load_lump(L, t2, 4, &L->tdef[1], err, errlen)) goto fail;
         L->tdsize[1] = dir[t2].size;
     }
     lk->doom_palette = 1;
@@ -661,8 +609,7 @@ static int is_sprite_end(const char *n)
     return strcmp(n, "S_END") == 0 || strcmp(n, "SS_END") == 0;
 }
 
-/* the lumps between S_START/S_END or SS_START/SS_END, listed on the first call */
-static int list_sprites(bs_wadlook *L)
+int bs_wl_list_sprites(bs_wadlook *L)
 {
     if (L->sprites) return 0;
     L->sprites = malloc(sizeof *L->sprites * (L->ndir + 1));
@@ -688,20 +635,19 @@ uint8_t bs_look_thing_colour(bs_wadlook *L, const char prefix[4], uint8_t fallba
     }
     const uint8_t *def = L->def_palette;
     uint8_t colour = nearest(L->lk->palette, def[3 * fallback], def[3 * fallback + 1], def[3 * fallback + 2]);
-    if (list_sprites(L)) return colour; /* out of memory: things.txt's colour */
+    if (bs_wl_list_sprites(L)) return colour; /* out of memory: things.txt's colour */
     for (uint32_t k = 0; k < L->nsprites; k++) {
         uint32_t i = L->sprites[k];
         const char *n = L->dir[i].name;
         if (n[0] == prefix[0] && strncmp(n, prefix, 4) == 0 && n[4] == 'A' && (n[5] == '0' || n[5] == '1')) {
             uint8_t *p;
             char msg[300];
-            uint64_t count = 0;
-            double sum[3] = {0, 0, 0};
-            int rc = load_lump(L, i, 0, &p, msg, sizeof msg);
-            if (rc == 0) rc = draw_patch(L, p, L->dir[i].size, n, NULL, 0, 0, 0, 0, &count, sum, msg, sizeof msg);
-            if (rc == 0 && count)
-                colour = nearest(L->lk->palette, sum[0] / (double)count, sum[1] / (double)count,
-                                 sum[2] / (double)count);
+            mean_acc m = {L->lk->palette, 0, {0, 0, 0}};
+            int rc = bs_wl_load_lump(L, i, 0, &p, msg, sizeof msg);
+            if (rc == 0) rc = bs_patch_walk(p, L->dir[i].size, L->wad, n, 0, INT32_MAX, mean_post, &m, msg, sizeof msg);
+            if (rc == 0 && m.count)
+                colour = nearest(L->lk->palette, m.sum[0] / (double)m.count, m.sum[1] / (double)m.count,
+                                 m.sum[2] / (double)m.count);
             else
                 bs_warn(L->opt, "%s: sprite %s: %s; the box keeps things.txt's colour", L->wad, n,
                         rc ? msg : "no opaque pixels");
@@ -729,6 +675,7 @@ void bs_look_close(bs_wadlook *L)
     free(L->used);
     free(L->flats);
     free(L->sprites);
+    bs_wl_sprites_free(L);
     nt_free(&L->lumps);
     nt_free(&L->flat_name);
     nt_free(&L->texdefs);
