@@ -199,6 +199,10 @@ int bs_look_side(bs_wadlook *L, uint32_t li, int k, const uint8_t rec[30], unsig
 /* A thing's box colour: the sprite's mean colour, or fallback (a default-palette
  * colour of things.txt) moved to the nearest PLAYPAL colour. */
 uint8_t bs_look_thing_colour(bs_wadlook *L, const char prefix[4], uint8_t fallback);
+/* Wall texture tex's holes (docs/textures.md): if a patch leaves any texel of
+ * it uncovered, an opacity map (texels 1 and 0) is stored as a texture and
+ * named by tex's mask. 0, or -1 with a message. */
+int bs_look_mask(bs_wadlook *L, uint16_t tex, char *err, size_t errlen);
 /* sprites.c: the sprite set of a thing type (docs/objects.md, "Sprites"):
  * its sprite, frame letter and SCN_SPRSET_* flags from things.txt. 0 and
  * *set1 = 1 + the set's index in s->look.sprsets, with the box around its
@@ -240,8 +244,13 @@ typedef struct {
 int bs_model_begin(bs_scene *s, const char *name, int src_line, char *err, size_t errlen);
 int bs_model_add_part(bs_scene *s, const bs_mpart *p, char *err, size_t errlen);
 int bs_model_end(bs_scene *s, char *err, size_t errlen);
-/* A textured WAD map's see-through middle textures as objects (mids.c). */
-int bs_mid_objects(bs_scene *s, const char *display, const bspc_options *opt, char *err, size_t errlen);
+/* A textured WAD map's see-through middle textures (mids.c): the opacity maps
+ * of the middle textures of two-sided lines (before the things' sprites,
+ * whose texels bs_sprites_prune compacts at the end), then the objects that
+ * show them (after the things, whose objects keep THINGS order). */
+int bs_mid_masks(bs_scene *s, bs_wadlook *look, const bspc_options *opt, char *err, size_t errlen);
+int bs_mid_objects(bs_scene *s, bs_wadlook *look, const char *display, const bspc_options *opt, char *err,
+                   size_t errlen);
 /* Shade c one step lighter (+1) or darker (-1) within its ramp of 16. */
 uint8_t bs_shade(uint8_t c, int delta);
 

@@ -613,8 +613,9 @@ static int wad_load_map(wad_map *m, const char *map, bs_scene *s)
     if (find_doors(s, m->ld[L_LINEDEFS], m->cnt[L_LINEDEFS], m->ld[L_SIDEDEFS], m->ld[L_SECTORS], m->display, m->err,
                    m->errlen))
         return -1;
+    if (bs_mid_masks(s, m->look, m->opt, m->err, m->errlen)) return -1;
     if (read_things(s, m->look, m->ld[L_THINGS], m->cnt[L_THINGS], m->display, m->opt, m->err, m->errlen)) return -1;
-    return bs_mid_objects(s, m->display, m->opt, m->err, m->errlen);
+    return bs_mid_objects(s, m->look, m->display, m->opt, m->err, m->errlen);
 }
 
 int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_scene *s, const bspc_options *opt,

@@ -177,13 +177,23 @@ static void tex_post(void *ctx, int32_t c, uint32_t top, const uint8_t *src, uin
     if (k0 < k1) memcpy(d->pic + (d->ox + c) * d->h + y0 + k0, src + k0, (size_t)(k1 - k0));
 }
 
+/* the same rows marked 1: where a texture is opaque */
+static void cover_post(void *ctx, int32_t c, uint32_t top, const uint8_t *src, uint32_t len)
+{
+    const tex_draw *d = ctx;
+    int32_t y0 = d->oy + (int32_t)top, k0 = y0 < 0 ? -y0 : 0, k1 = (int32_t)len;
+    (void)src;
+    if (y0 + k1 > d->h) k1 = d->h - y0;
+    if (k0 < k1) memset(d->pic + (d->ox + c) * d->h + y0 + k0, 1, (size_t)(k1 - k0));
+}
+
 /* Draw patch data p[0..size) into the column-major w x h picture at (ox, oy),
  * clipped (the columns outside it are not read). what names the lump. */
 static int draw_patch(const bs_wadlook *L, const uint8_t *p, uint32_t size, const char *what, uint8_t *pic, int32_t w,
-                      int32_t h, int32_t ox, int32_t oy, char *err, size_t errlen)
+                      int32_t h, int32_t ox, int32_t oy, int cover, char *err, size_t errlen)
 {
     tex_draw d = {pic, h, ox, oy};
-    return bs_patch_walk(p, size, L->wad, what, -ox, w - ox, tex_post, &d, err, errlen);
+    return bs_patch_walk(p, size, L->wad, what, -ox, w - ox, cover ? cover_post : tex_post, &d, err, errlen);
 }
 
 /* the texels of a patch: how many, and the sums of their colours' components */
@@ -281,17 +291,19 @@ static int index_lumps(bs_wadlook *L)
     return 0;
 }
 
-static int compose_wall(bs_wadlook *L, const char *name, uint16_t *out, char *err, size_t errlen)
+/* Wall texture name composed of its patches into a new w x h picture (*pic,
+ * column-major; cover: 1 where a patch covers it, 0 in a hole). 1 if composed,
+ * 0 if the WAD has no such texture, -1 with a message. */
+static int compose_pic(bs_wadlook *L, const char *name, int cover, uint8_t **out, int32_t *pw, int32_t *ph, char *err,
+                       size_t errlen)
 {
     const char *const *lumpname = texdef_lump;
     if (index_lumps(L)) return bs_fail(err, errlen, "%s: out of memory", L->wad);
     int which = 0;
     uint32_t off = 0;
+    *out = NULL;
     int f = find_texdef(L, name, &which, &off, err, errlen);
-    if (f <= 0) {
-        *out = SCN_TEX_NONE;
-        return f;
-    }
+    if (f <= 0) return f;
     const uint8_t *d = L->tdef[which] + off;
     uint32_t room = L->tdsize[which] - off;
     int32_t w = rds16(d + 12), h = rds16(d + 14);
@@ -323,12 +335,54 @@ static int compose_wall(bs_wadlook *L, const char *name, uint16_t *out, char *er
         }
         uint8_t *p;
         rc = bs_wl_load_lump(L, li, 0, &p, err, errlen);
-        if (rc == 0) rc = draw_patch(L, p, L->dir[li].size, pn, pic, w, h, ox, oy, err, errlen);
+        if (rc == 0) rc = draw_patch(L, p, L->dir[li].size, pn, pic, w, h, ox, oy, cover, err, errlen);
         free(p);
     }
-    if (rc == 0) rc = store(L, name, pic, (uint32_t)w, (uint32_t)h, out, err, errlen);
+    if (rc < 0) {
+        free(pic);
+        return -1;
+    }
+    *out = pic;
+    *pw = w;
+    *ph = h;
+    return 1;
+}
+
+static int compose_wall(bs_wadlook *L, const char *name, uint16_t *out, char *err, size_t errlen)
+{
+    uint8_t *pic;
+    int32_t w, h;
+    int f = compose_pic(L, name, 0, &pic, &w, &h, err, errlen);
+    if (f <= 0) {
+        *out = SCN_TEX_NONE;
+        return f;
+    }
+    int rc = store(L, name, pic, (uint32_t)w, (uint32_t)h, out, err, errlen);
     free(pic);
     return rc < 0 ? -1 : 1;
+}
+
+int bs_look_mask(bs_wadlook *L, uint16_t tex, char *err, size_t errlen)
+{
+    bs_look *lk = L->lk;
+    if (tex >= lk->ntex || lk->tex[tex].mask != SCN_TEX_NONE) return 0;
+    const char *name = NULL;
+    for (uint32_t i = 0; i < L->nused && !name; i++)
+        if (L->used[i].kind == KIND_WALL && L->used[i].tex == tex) name = L->used[i].name;
+    if (!name) return 0;
+    uint8_t *pic;
+    int32_t w, h;
+    int f = compose_pic(L, name, 1, &pic, &w, &h, err, errlen);
+    if (f <= 0) return f;
+    /* the columns the texture shows (up to the largest power of two, as store keeps them) */
+    int32_t shown = 1 << log2_floor((uint32_t)w);
+    int holes = memchr(pic, 0, (size_t)shown * (size_t)h) != NULL;
+    uint16_t m = SCN_TEX_NONE;
+    int rc = holes ? store(L, name, pic, (uint32_t)w, (uint32_t)h, &m, err, errlen) : 0;
+    free(pic);
+    if (rc < 0) return -1;
+    lk->tex[tex].mask = m;
+    return 0;
 }
 
 /* ---- flats ---- */
