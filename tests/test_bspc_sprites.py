@@ -38,8 +38,9 @@ class Blob:
         return [struct.unpack_from(fmt, self.data, off + size * i) for i in range(n)]
 
     def objects(self):
-        """[(model, x, y, sprset)]"""
-        return [(r[0], r[1] >> 16, r[2] >> 16, r[10]) for r in self.records("OBJECTS", "<IiiiiIiiIiI")]
+        """[(model, x, y, sprset)] of the things (see-through middle textures, side != NONE, follow them)"""
+        return [(r[0], r[1] >> 16, r[2] >> 16, r[10]) for r in self.records("OBJECTS", "<IiiiiIiiIiII")
+                if r[11] == 0xFFFFFFFF]
 
     def models(self):
         return self.records("MODELS", "<IIIIiii")
