@@ -14,17 +14,62 @@ static void swap(void *list, uint32_t i, uint32_t j, uint32_t size)
     }
 }
 
-/* Heap order on the west edges, in place: no memory beyond the list. */
-static void sift_down(void *list, uint32_t i, uint32_t n, uint32_t size)
+/* Sorting by west edge, in place (no memory beyond the list and a few hundred
+ * bytes of stack): the records are first dealt into SORT_BUCKETS buckets by
+ * their edge's place between the smallest and largest (American flag sort),
+ * then an insertion sort puts each bucket in order. Things spread over a map,
+ * so a bucket holds a few: about linear, where a heap sort was n log n. */
+#define SORT_BUCKETS 64
+
+static uint32_t bucket(void *list, uint32_t i, uint32_t size, int32_t lo, unsigned shift)
 {
-    for (;;) {
-        uint32_t c = 2 * i + 1;
-        if (c >= n) return;
-        if (c + 1 < n && objl_at(list, c + 1, size)->left > objl_at(list, c, size)->left) c++;
-        if (objl_at(list, c, size)->left <= objl_at(list, i, size)->left) return;
-        swap(list, i, c, size);
-        i = c;
+    return (uint32_t)((int64_t)objl_at(list, i, size)->left - lo) >> shift;
+}
+
+static void sort_by_west(void *list, uint32_t n, uint32_t size)
+{
+    if (n < 2) return;
+    int32_t lo = INT32_MAX, hi = INT32_MIN;
+    for (uint32_t i = 0; i < n; i++) {
+        int32_t l = objl_at(list, i, size)->left;
+        lo = l < lo ? l : lo;
+        hi = l > hi ? l : hi;
     }
+    unsigned shift = 0;
+    while (((uint64_t)((int64_t)hi - lo) >> shift) >= SORT_BUCKETS) shift++;
+    uint16_t next[SORT_BUCKETS] = {0}, end[SORT_BUCKETS]; /* n <= SCN_MAX_OBJECTS */
+    for (uint32_t i = 0; i < n; i++) next[bucket(list, i, size, lo, shift)]++;
+    for (uint32_t b = 0, at = 0; b < SORT_BUCKETS; b++) {
+        at += next[b];
+        end[b] = (uint16_t)at;
+        next[b] = (uint16_t)(at - next[b]);
+    }
+    for (uint32_t b = 0; b < SORT_BUCKETS; b++)
+        while (next[b] < end[b]) { /* each swap puts one record in its bucket for good */
+            uint32_t c = bucket(list, next[b], size, lo, shift);
+            if (c == b)
+                next[b]++;
+            else
+                swap(list, next[b], next[c]++, size);
+        }
+    for (uint32_t i = 1; i < n; i++)
+        for (uint32_t j = i; j > 0 && objl_at(list, j - 1, size)->left > objl_at(list, j, size)->left; j--)
+            swap(list, j - 1, j, size);
+}
+
+_Static_assert(SCN_MAX_OBJECTS <= 65535, "sort_by_west's counters");
+
+/* A see-through middle texture shows only to an eye in front of its side (its
+ * one face is culled from behind), which this finds before any projection. */
+static int mid_faces_eye(const scene *sc, uint32_t side, const view_xform *v)
+{
+    const scn_line *l = &sc->lines[side >> 1];
+    const scn_vertex *a = &sc->verts[l->v1], *b = &sc->verts[l->v2];
+    /* differences below 2^33 raw, shifted to 2^25: the cross product fits 64 bits */
+    int64_t dx = ((int64_t)b->x - a->x) >> 8, dy = ((int64_t)b->y - a->y) >> 8;
+    int64_t ex = (v->cx - a->x) >> 8, ey = (v->cy - a->y) >> 8;
+    int64_t cross = dx * ey - dy * ex; /* < 0: the eye on the right, the front side */
+    return (side & 1) ? cross > 0 : cross < 0;
 }
 
 uint32_t objl_in_view(const scene *sc, const world_state *w, const view_xform *v, void *list, uint32_t size,
@@ -36,17 +81,15 @@ uint32_t objl_in_view(const scene *sc, const world_state *w, const view_xform *v
     for (uint32_t i = 0; i < w->n; i++) {
         const obj_state *o = &w->objs[i];
         if (o->model >= sc->nmodels || !objd_in_view(sc, o, v)) continue;
+        uint32_t side = obj_mid_side(w, i);
+        if (side != SCN_NONE && !mid_faces_eye(sc, side, v)) continue;
         int32_t r = (sc->models[o->model].radius >> 16) + 1; /* whole units, rounded up */
         if (r > *reach) *reach = r;
         uint32_t *rec = (uint32_t *)(void *)objl_at(list, n++, size);
         for (uint32_t k = 0; k < size / 4; k++) rec[k] = 0;
         *(objl_entry *)(void *)rec = (objl_entry){(int32_t)((o->x >> 16) - r), (uint16_t)i, 0, 0};
     }
-    for (uint32_t i = n / 2; i-- > 0;) sift_down(list, i, n, size);
-    for (uint32_t end = n; end-- > 1;) {
-        swap(list, 0, end, size);
-        sift_down(list, 0, end, size);
-    }
+    sort_by_west(list, n, size);
     return n;
 }
 
