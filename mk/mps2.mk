@@ -54,7 +54,7 @@ FULL     ?=
 FW_MODES ?= columns
 # Mode columns' visplanes (firmware/build_config.h, 652 bytes each): a full pool is
 # drawn early, nothing is lost.
-COLS_PLANES ?= 12
+COLS_PLANES ?= 10
 # Mode direct's face pools (firmware/build_config.h): small on the board; objects
 # beyond them are worked out again where needed, never dropped.
 DIRECT_FACES ?= 16
