@@ -43,7 +43,7 @@ def refused(args, *needles, status=1):
 
 # ---- compiled scenes ------------------------------------------------------------------------
 
-HEADER_BYTES = 204  # sizeof(scn_header)
+HEADER_BYTES = 236  # sizeof(scn_header): 44 + 8 per section
 VERTICES, SECTORS, LINES, SEGS, NODES, LEAVES, PVERTS, PALETTE = range(8)
 NEEDS = 13
 LOOK, LIGHTS, TEXTURES, TEXELS, SIDES, PLANES = range(14, 20)
@@ -138,14 +138,14 @@ COMPILED = [
     ("truncated-in-segs", truncate(lambda d: section(d, SEGS)[0] + 5), ["truncated", "header total_bytes"]),
     ("truncated-one-byte-short", truncate(lambda d: len(d) - 1), ["truncated", "header total_bytes"]),
     ("wrong-magic", wrong_magic, ["magic", "BSCN"]),
-    ("wrong-version", set_version, ["header", "unsupported version 99", "reads version 4"]),
+    ("wrong-version", set_version, ["header", "unsupported version 99", "reads version 6"]),
     ("bad-crc", bad_crc, ["bad CRC-32", "header crc32", "damaged"]),
     ("total-bytes-beyond-file", header_field(8, lambda d: len(d) + 4),
      ["truncated", "header total_bytes"]),
     ("total-bytes-short-of-file", appended, ["header: total_bytes", "but the file has"]),
     ("total-bytes-not-multiple-of-4", lambda d: header_field(8, len(d) + 2)(d + b"\0\0"),
      ["header: total_bytes", "not a multiple of 4"]),
-    ("header-bytes", header_field(4, lambda d: 4 | (HEADER_BYTES - 4) << 16),
+    ("header-bytes", header_field(4, lambda d: int.from_bytes(d[4:6], "little") | (HEADER_BYTES - 4) << 16),
      [f"header: header_bytes = {HEADER_BYTES - 4}", f"expected {HEADER_BYTES}"]),
     ("flags", header_field(16, 1), ["header: flags = 0x1", "reserved"]),
     ("segs-offset-past-end", header_field(44 + 8 * SEGS, lambda d: len(d)),
@@ -191,7 +191,7 @@ LOOK_DAMAGE = [
      ["textures record 1", "outside the proven-safe range"]),
     ("texture-taller-than-stored", record_field(TEXTURES, TEXTURE_BYTES, 1, 8, lambda d: 2048),
      ["textures record 1", "outside the proven-safe range"]),
-    ("side-flags", record_field(SIDES, SIDE_BYTES, 5, 20, lambda d: 0x00040000),
+    ("side-flags", record_field(SIDES, SIDE_BYTES, 5, 20, lambda d: 0x00080000),
      ["sides record 5", "outside the proven-safe range"]),
     ("plane-texture-index", record_field(PLANES, 4, 7, 0, lambda d: section(d, TEXTURES)[1] + 1),
      ["planes record 7", "index out of range"]),

@@ -93,6 +93,7 @@ void bs_scene_free(bs_scene *s)
     free(s->look.texels);
     free(s->look.sides);
     free(s->look.planes);
+    free(s->look.anims);
     memset(s, 0, sizeof *s);
 }
 
