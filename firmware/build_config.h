@@ -78,6 +78,8 @@
 #define CFG_FLAT 0
 #endif
 #define CFG_TEXTURES (CFG_HAS(SCN_NEED_TEXTURES) && !CFG_FLAT)
+/* Textures by time (firmware/anim.h): only a textured build draws them. */
+#define CFG_ANIM (CFG_HAS(SCN_NEED_ANIM) && CFG_TEXTURES)
 
 /* The most vertices of a polygon before clipping: a wall (4), a leaf floor, an
  * object's face. */

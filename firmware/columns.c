@@ -2,6 +2,7 @@
  * columns, floors and ceilings from visplanes. */
 #include "columns.h"
 
+#include "anim.h"
 #include "bsp_walk.h"
 #include "clip.h"
 #include "cover.h"
@@ -230,7 +231,8 @@ static tex_paint plane_paint(const cols_state *S, const cols_plane *p)
         if (ceiling && CFG_SKY && (sec->flags & SCN_SECTOR_SKY)) return tex_sky(S->sc, S->v, colour);
         const scn_plane *pl = &S->sc->planes[sector];
         int32_t h = ceiling ? surf_ceil_now(S->sc, S->ceil, sector) : sec->floor_h;
-        return tex_plane(S->sc, S->v, ceiling ? pl->ceil_tex : pl->floor_tex, h, sec->light, colour);
+        uint32_t tex = anim_tex(S->sc, anim_tic(S->w), ceiling ? pl->ceil_tex : pl->floor_tex);
+        return tex_plane(S->sc, S->v, tex, h, sec->light, colour);
     }
 #endif
     return tex_flat(colour);
@@ -400,7 +402,8 @@ static void seg_columns(cols_state *S, seg_look *k, int c0, int c1)
 static tex_paint part(const cols_state *S, const scn_seg *g, int part, int32_t ff, int32_t fc, int32_t bf, int32_t bc,
                       uint8_t light, uint8_t colour)
 {
-    return S->textured ? surf_part_paint(S->sc, S->v, g, part, ff, fc, bf, bc, light, colour) : tex_flat(colour);
+    return S->textured ? surf_part_paint(S->sc, S->v, g, part, ff, fc, bf, bc, light, colour, anim_tic(S->w))
+                       : tex_flat(colour);
 }
 
 static void seg(cols_state *S, uint32_t gi, unsigned mask)

@@ -48,9 +48,11 @@ int eng_set_work(engine *e, void *mem, uint32_t bytes)
     return 0;
 }
 
+/* The world the renderer draws: NULL when it holds nothing but the compiled
+ * scene (no objects, no doors, no level time for animated textures to follow). */
 static const world_state *world_of(const engine *e)
 {
-    return (e->world.ceil || e->world.objs) ? &e->world : 0;
+    return (e->world.ceil || e->world.objs || (CFG_ANIM && (e->sc.needs->features & SCN_NEED_ANIM))) ? &e->world : 0;
 }
 
 void eng_render(engine *e, uint32_t *ids)

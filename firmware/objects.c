@@ -190,6 +190,7 @@ static void door_step(obj_door *d, uint32_t full, int triggered, uint32_t dt)
 void obj_update(world_state *w, const scene *s, uint32_t t_ms, uint32_t dt_ms, fx_t px, fx_t py)
 {
     if (!w) return;
+    w->tic = obj_tic(t_ms);
     uint32_t n = w->n < s->nobjects ? w->n : s->nobjects;
     if (CFG_OBJECTS && w->objs)
         for (uint32_t i = 0; i < n; i++) place(&w->objs[i], &s->objects[i], t_ms);

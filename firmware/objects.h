@@ -13,6 +13,7 @@
 #define OBJ_DOOR_REACH 64      /* units: a door opens for a player this near one of its walls */
 #define OBJ_DOOR_SPEED 128     /* units per second, up and down */
 #define OBJ_DOOR_WAIT_MS 3000u /* open this long after the player left, then close */
+#define OBJ_TIC_HZ 35u         /* Doom's tics a second: the level time of animated textures */
 
 typedef struct {
     uint32_t model; /* index into the scene's models */
@@ -41,7 +42,14 @@ typedef struct {
     uint32_t *near;  /* obj_update's scratch: one bit per sector, "triggered now" */
     uint32_t ndoors;
     const scn_object *own; /* the scene's objects when objs are theirs (for their sprite sets), else NULL */
+    uint32_t tic;          /* level time in tics, obj_tic of obj_update's time (firmware/anim.h) */
 } world_state;
+
+/* The level time in tics at t_ms: floor(t_ms * 35 / 1000), below 2^28. */
+static inline uint32_t obj_tic(uint32_t t_ms)
+{
+    return (uint32_t)((uint64_t)t_ms * OBJ_TIC_HZ / 1000u);
+}
 
 /* The sprite set object i is drawn as (docs/objects.md, "Sprites"), or SCN_NONE:
  * as its model. Only the scene's own objects have sprites. */
@@ -64,9 +72,10 @@ uint32_t obj_state_bytes(const scene *s);
  * and ceiling as compiled (time 0, doors closed). Returns 0, or -1 if mem is too small. */
 int obj_init(world_state *w, const scene *s, void *mem, uint32_t bytes);
 
-/* Objects along their paths at time t_ms; doors open when (px, py) is within 64
- * units of one of their walls and close 3 s after it left, moving 128 units per
- * second (dt_ms since the last call drives them).
+/* The world at time t_ms: the level time (w->tic = obj_tic(t_ms), which animated
+ * textures follow), objects along their paths at t_ms; doors open when (px, py)
+ * is within 64 units of one of their walls and close 3 s after it left, moving
+ * 128 units per second (dt_ms since the last call drives them).
  *
  * Paths (docs/objects.md), exact functions of t_ms, with s = t_ms mod period:
  *   circle: origin = centre + R (cos th, sin th), th = 360 s / period degrees,

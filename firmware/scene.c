@@ -18,7 +18,7 @@ static const uint32_t record_bytes[SCN_SEC_COUNT] = {
     sizeof(scn_texture), 1,
     sizeof(scn_side),    sizeof(scn_plane),
     sizeof(scn_sprite),  sizeof(uint32_t),
-    sizeof(scn_sprset),
+    sizeof(scn_sprset),  sizeof(scn_anim),
 };
 
 const char *scene_status_text(scene_status st)
@@ -47,7 +47,7 @@ const char *scene_section_name(int section)
         "vertices",     "sectors",      "lines",          "segs",   "nodes",        "leaves",  "leaf polygon vertices",
         "palette",      "models",       "model vertices", "faces",  "face indices", "objects", "needs",
         "look",         "light tables", "textures",       "texels", "sides",        "planes",  "sprites",
-        "sprite masks", "sprite sets",
+        "sprite masks", "sprite sets",  "animations",
     };
     return (section >= 0 && section < SCN_SEC_COUNT) ? names[section] : "header";
 }
@@ -74,13 +74,21 @@ static scene_status refuse(scene_error *err, uint32_t item, uint32_t need, uint3
 const char *scene_item_name(uint32_t item)
 {
     static const char *const names[SCENE_ITEM_COUNT] = {
-        "objects",         "doors",
-        "two-sided walls", "height changes",
-        "sky steps",       "look up/down",
-        "y-clipping",      "textures",
-        "edges per frame", "surfaces per frame",
-        "tree depth",      "leaf polygon vertices",
-        "model vertices",  "face vertices",
+        "objects",
+        "doors",
+        "two-sided walls",
+        "height changes",
+        "sky steps",
+        "look up/down",
+        "y-clipping",
+        "textures",
+        "animation",
+        "edges per frame",
+        "surfaces per frame",
+        "tree depth",
+        "leaf polygon vertices",
+        "model vertices",
+        "face vertices",
     };
     return item < SCENE_ITEM_COUNT ? names[item] : "?";
 }
@@ -91,15 +99,16 @@ static int coord_ok(int32_t v, int32_t limit_units)
     return v >= -lim && v <= lim;
 }
 
-/* The look's sections: none at all (a flat-shaded scene), or one look record
- * with all 32 light tables, a side per line side and a plane per sector. */
+/* The look's sections: none at all (a flat-shaded scene: every section after
+ * the look is empty), or one look record with all 32 light tables, a side per
+ * line side and a plane per sector. */
 static scene_status check_look_sections(scene *s, const uint8_t *base, const scn_header *h, scene_error *err)
 {
     const scn_section *sec = h->sec;
     uint32_t look = sec[SCN_SEC_LOOK].count;
     if (look > 1) return fail(err, SCENE_ERR_SECTION, SCN_SEC_LOOK, 0);
     if (look == 0) {
-        for (int i = SCN_SEC_LIGHTS; i <= SCN_SEC_SPRSETS; i++)
+        for (int i = SCN_SEC_LIGHTS; i < SCN_SEC_COUNT; i++)
             if (sec[i].count != 0) return fail(err, SCENE_ERR_SECTION, i, 0);
         s->look = 0;
     } else {
@@ -121,6 +130,8 @@ static scene_status check_look_sections(scene *s, const uint8_t *base, const scn
     s->nsprites = sec[SCN_SEC_SPRITES].count;
     s->nsprmask = sec[SCN_SEC_SPRMASK].count;
     s->nsprsets = sec[SCN_SEC_SPRSETS].count;
+    s->anims = (const scn_anim *)(base + sec[SCN_SEC_ANIMS].offset);
+    s->nanims = sec[SCN_SEC_ANIMS].count;
     s->nlights = sec[SCN_SEC_LIGHTS].count;
     s->ntextures = sec[SCN_SEC_TEXTURES].count;
     s->ntexels = sec[SCN_SEC_TEXELS].count;
@@ -311,6 +322,24 @@ static int tex_ok(const scene *s, uint32_t t)
     return t == SCN_TEX_NONE || t < s->ntextures;
 }
 
+/* Every sequence of frames inside the textures (an index), then within the
+ * format's limits, sorted and apart from the one before (docs/textures.md,
+ * "Animation"): a texture is a frame of one sequence at most, so the
+ * translation by time (firmware/anim.h) is one answer. */
+static scene_status check_anims(const scene *s, scene_error *err)
+{
+    uint64_t end = 0; /* past the last frame of the sequence before */
+    for (uint32_t i = 0; i < s->nanims; i++) {
+        const scn_anim *a = &s->anims[i];
+        if ((uint64_t)a->first + a->count > s->ntextures) return fail(err, SCENE_ERR_INDEX, SCN_SEC_ANIMS, i);
+        if (a->count < 2 || a->count > SCN_ANIM_MAX_FRAMES || a->phase >= a->count || a->tics < 1 ||
+            a->tics > SCN_ANIM_MAX_TICS || a->reserved != 0 || a->first < end)
+            return fail(err, SCENE_ERR_RANGE, SCN_SEC_ANIMS, i);
+        end = (uint64_t)a->first + a->count;
+    }
+    return SCENE_OK;
+}
+
 /* Every texture inside the texels, every texture index in range, every side's
  * mapping a unit vector's size, every reserved field 0 (docs/textures.md). */
 static scene_status check_look(const scene *s, scene_error *err)
@@ -333,14 +362,14 @@ static scene_status check_look(const scene *s, scene_error *err)
         const scn_side *d = &s->sides[i];
         if (!tex_ok(s, d->tex[0]) || !tex_ok(s, d->tex[1]) || !tex_ok(s, d->tex[2]))
             return fail(err, SCENE_ERR_INDEX, SCN_SEC_SIDES, i);
-        if ((d->flags & ~(SCN_SIDE_UNPEG_TOP | SCN_SIDE_UNPEG_BOTTOM)) || d->light_adj < -1 || d->light_adj > 1 ||
-            d->ux < -one || d->ux > one || d->uy < -one || d->uy > one)
+        if ((d->flags & ~(SCN_SIDE_UNPEG_TOP | SCN_SIDE_UNPEG_BOTTOM | SCN_SIDE_SCROLL)) || d->light_adj < -1 ||
+            d->light_adj > 1 || d->ux < -one || d->ux > one || d->uy < -one || d->uy > one)
             return fail(err, SCENE_ERR_RANGE, SCN_SEC_SIDES, i);
     }
     for (uint32_t i = 0; i < s->nsectors; i++)
         if (!tex_ok(s, s->planes[i].floor_tex) || !tex_ok(s, s->planes[i].ceil_tex))
             return fail(err, SCENE_ERR_INDEX, SCN_SEC_PLANES, i);
-    return SCENE_OK;
+    return check_anims(s, err);
 }
 
 /* Every sprite image inside the texels and masks and within its size limits,
@@ -484,6 +513,9 @@ uint32_t scene_derived_features(const scene *s)
 {
     uint32_t f = s->nmodels ? SCN_NEED_OBJECTS : 0;
     if (s->look) f |= SCN_NEED_TEXTURES;
+    if (s->nanims) f |= SCN_NEED_ANIM;
+    for (uint32_t i = 0; s->look && i < 2u * s->nlines; i++)
+        if (s->sides[i].flags & SCN_SIDE_SCROLL) f |= SCN_NEED_ANIM;
     for (uint32_t i = 0; i < s->nsectors; i++) {
         const scn_sector *a = &s->sectors[i], *b = &s->sectors[0];
         if (a->flags & SCN_SECTOR_DOOR) f |= SCN_NEED_DOORS;

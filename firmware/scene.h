@@ -41,6 +41,12 @@ typedef struct {
     const uint32_t *sprmask;
     const scn_sprset *sprsets;
     uint32_t nsprites, nsprmask, nsprsets;
+    /* Textures by time (docs/textures.md, "Animation"): none without a look.
+     * The loader guarantees every sequence lies inside textures[], has 2 ..
+     * SCN_ANIM_MAX_FRAMES frames, a phase below them and 1 .. SCN_ANIM_MAX_TICS
+     * tics a frame, and that the sequences are sorted and do not overlap. */
+    const scn_anim *anims;
+    uint32_t nanims;
     uint32_t nlights, ntextures, ntexels;
     uint32_t nverts, nsectors, nlines, nsegs, nnodes, nleaves, npverts;
     uint32_t nmodels, nmverts, nfaces, nfindex, nobjects;
@@ -89,7 +95,7 @@ enum {
 /* What a build provides, item by item (SCENE_ERR_BUILD's index): the features
  * SCN_NEED_* by bit number, then the sizes. */
 enum {
-    SCENE_ITEM_EDGES = 8,
+    SCENE_ITEM_EDGES = 9,
     SCENE_ITEM_SURFACES,
     SCENE_ITEM_DEPTH,
     SCENE_ITEM_LEAF_VERTS,

@@ -26,7 +26,7 @@
 #include <stdint.h>
 
 #define SCN_MAGIC 0x4E435342u /* bytes "BSCN" */
-#define SCN_VERSION 5u
+#define SCN_VERSION 6u
 #define SCN_NONE 0xFFFFFFFFu     /* "no sector" / "no index" */
 #define SCN_LEAF_BIT 0x80000000u /* child index refers to a leaf */
 
@@ -68,6 +68,8 @@ enum scn_section_id {
     SCN_SEC_SPRITES, /* scn_sprite[]: sprite images (their texels are in SCN_SEC_TEXELS) */
     SCN_SEC_SPRMASK, /* uint32_t[]: the images' opacity bits */
     SCN_SEC_SPRSETS, /* scn_sprset[]: a thing's image for each of the 8 rotations */
+    /* Textures by time (docs/textures.md, "Animation"); none without a look, none in a map without. */
+    SCN_SEC_ANIMS, /* scn_anim[]: animated textures and flats, by first frame, not overlapping */
     SCN_SEC_COUNT
 };
 
@@ -200,6 +202,7 @@ typedef struct {
 
 #define SCN_SIDE_UNPEG_TOP 1u    /* Doom's linedef flag 8: upper texture hangs from the front ceiling */
 #define SCN_SIDE_UNPEG_BOTTOM 2u /* Doom's linedef flag 16: lower from the front ceiling, middle from the floor */
+#define SCN_SIDE_SCROLL 4u       /* Doom's line special 48: the texture column grows by 1 unit a tic */
 
 /* How a line side's wall parts are textured. The texture column at map point
  * P (16.16) is u(P) = ((ux * P.x + uy * P.y) >> 30) + u0: (ux, uy) is the unit
@@ -244,6 +247,25 @@ typedef struct {
     uint16_t reserved; /* 0 */
 } scn_sprset;
 
+/* ---- Textures by time (docs/textures.md, "Animation") ---- */
+
+#define SCN_ANIM_MAX_FRAMES 64 /* frames of one sequence (Doom's longest has 4) */
+#define SCN_ANIM_MAX_TICS 3500 /* tics a frame shows (Doom's: 8; 35 tics a second) */
+
+/* Doom's animated wall textures and flats: the frames of a sequence are the
+ * textures [first, first + count), stored in the WAD's own order. At level time
+ * T tics (floor(t_ms * 35 / 1000)) texture first + k shows texture
+ * first + ((T / tics + phase + k) mod count): phase is the WAD's number of the
+ * first frame (its texture or flat number) modulo count, as Doom's
+ * P_UpdateSpecials counts it. Records are sorted by first and do not overlap. */
+typedef struct {
+    uint32_t first;    /* the first frame [range: TEXTURES, count] */
+    uint16_t count;    /* 2 .. SCN_ANIM_MAX_FRAMES [count of first] */
+    uint16_t phase;    /* 0 .. count - 1 */
+    uint16_t tics;     /* 1 .. SCN_ANIM_MAX_TICS */
+    uint16_t reserved; /* 0 */
+} scn_anim;
+
 /* What a scene needs of a renderer, written by the compiler's analysis
  * (tools/bspc/needs.c, docs/needs.md). A build compiled for one scene
  * (firmware/build_config.h) leaves out every feature whose bit is clear and
@@ -259,7 +281,8 @@ typedef struct {
 #define SCN_NEED_LOOK (1u << 5)      /* the camera may look up and down */
 #define SCN_NEED_YCLIP (1u << 6)     /* a polygon can cross the top or bottom screen edge */
 #define SCN_NEED_TEXTURES (1u << 7)  /* textures, light tables and a sky (docs/textures.md) */
-#define SCN_NEED_ALL ((1u << 8) - 1u)
+#define SCN_NEED_ANIM (1u << 8)      /* animated textures or flats, or scrolling walls (docs/textures.md) */
+#define SCN_NEED_ALL ((1u << 9) - 1u)
 
 typedef struct {
     uint32_t features;     /* SCN_NEED_* */

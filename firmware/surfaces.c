@@ -5,6 +5,7 @@
  * leaves neither gap nor overlap between them. */
 #include "surfaces.h"
 
+#include "anim.h"
 #include "clip.h"
 #include "eye.h"
 #include "raster.h"
@@ -34,16 +35,17 @@ typedef struct {
     uint8_t light;          /* the sector's light level */
     const scn_seg *g;       /* LOOK_PART */
     int32_t ff, fc, bf, bc; /* LOOK_PART: front floor and ceiling, back floor and ceiling, now */
-    uint32_t tex;           /* LOOK_PLANE */
+    uint32_t tex;           /* LOOK_PLANE: the flat shown now (anim_tex) */
     int32_t h;              /* LOOK_PLANE: its height */
+    uint32_t tic;           /* LOOK_PART: the level time (anim.h) */
 } surf_look;
 
 tex_paint surf_part_paint(const scene *sc, const view_xform *v, const scn_seg *g, int part, int32_t ff, int32_t fc,
-                          int32_t bf, int32_t bc, uint8_t light, uint8_t colour)
+                          int32_t bf, int32_t bc, uint8_t light, uint8_t colour, uint32_t tic)
 {
 #if CFG_TEXTURES
     const scn_side *sd = &sc->sides[g->line * 2u + g->side];
-    uint32_t tex = sd->tex[part];
+    uint32_t tex = sd->tex[part]; /* pegged by the side's own texture, as Doom does, drawn with the frame shown */
     int32_t top;
     if (part == SCN_PART_MIDDLE)
         top = (sd->flags & SCN_SIDE_UNPEG_BOTTOM) ? ff + tex_height(sc, tex) : fc;
@@ -51,16 +53,18 @@ tex_paint surf_part_paint(const scene *sc, const view_xform *v, const scn_seg *g
         top = (sd->flags & SCN_SIDE_UNPEG_TOP) ? fc : bc + tex_height(sc, tex);
     else
         top = (sd->flags & SCN_SIDE_UNPEG_BOTTOM) ? fc : bf;
-    return tex_wall(sc, v, sd, tex, &sc->verts[g->v1], top, light, colour);
+    tex_paint p = tex_wall(sc, v, sd, anim_tex(sc, tic, tex), &sc->verts[g->v1], top, light, colour);
+    if (p.kind == TEX_WALL) p.u0 += anim_scroll(sd, tic);
+    return p;
 #else
-    (void)sc, (void)v, (void)g, (void)part, (void)ff, (void)fc, (void)bf, (void)bc, (void)light;
+    (void)sc, (void)v, (void)g, (void)part, (void)ff, (void)fc, (void)bf, (void)bc, (void)light, (void)tic;
     return tex_flat(colour);
 #endif
 }
 
 static tex_paint part_paint(const scene *sc, const view_xform *v, const surf_look *k)
 {
-    return surf_part_paint(sc, v, k->g, k->part, k->ff, k->fc, k->bf, k->bc, k->light, k->colour);
+    return surf_part_paint(sc, v, k->g, k->part, k->ff, k->fc, k->bf, k->bc, k->light, k->colour, k->tic);
 }
 
 static tex_paint paint_of(const scene *sc, const view_xform *v, const surf_sink *sink, const surf_look *k)
@@ -142,7 +146,7 @@ static void close_columns(const view_xform *v, const scn_vertex *a, const scn_ve
     occ_close(occ, rast_first_sample(xa), rast_first_sample(xb));
 }
 
-static void seg_parts(const scene *sc, const fx_t *ceil, const view_xform *v, uint32_t gi, unsigned mask,
+static void seg_parts(const scene *sc, const fx_t *ceil, uint32_t tic, const view_xform *v, uint32_t gi, unsigned mask,
                       const surf_sink *sink, occ_columns *occ, render_stats *st)
 {
     const scn_seg *g = &sc->segs[gi];
@@ -176,7 +180,8 @@ static void seg_parts(const scene *sc, const fx_t *ceil, const view_xform *v, ui
                    front->floor_h,
                    front_ceil,
                    0,
-                   0};
+                   0,
+                   tic};
     if (!CFG_TWO_SIDED || back_index == SCN_NONE) {
         wall_part(sc, v, pa, pb, front->floor_h, front_ceil, mask, sink, &k, id, gi, st);
         if (occ) close_columns(v, a, b, pa, pb, mask, occ);
@@ -213,16 +218,16 @@ static void seg_parts(const scene *sc, const fx_t *ceil, const view_xform *v, ui
     if (occ && top <= bottom) close_columns(v, a, b, pa, pb, mask, occ);
 }
 
-/* A floor's or ceiling's look: its flat, or the sky. */
-static surf_look plane_look(const scene *sc, uint32_t sector, int ceiling, int32_t h)
+/* A floor's or ceiling's look: its flat as shown at level time tic, or the sky. */
+static surf_look plane_look(const scene *sc, uint32_t sector, int ceiling, int32_t h, uint32_t tic)
 {
     const scn_sector *sec = &sc->sectors[sector];
-    surf_look k = {LOOK_PLANE,   0, ceiling ? sec->ceil_color : sec->floor_color, sec->light, 0, 0, 0, 0, 0,
-                   SCN_TEX_NONE, h};
+    surf_look k = {LOOK_PLANE, 0, ceiling ? sec->ceil_color : sec->floor_color, sec->light, 0, 0, 0, 0, 0, SCN_TEX_NONE,
+                   h,          0};
     if (ceiling && CFG_SKY && (sec->flags & SCN_SECTOR_SKY))
         k.kind = LOOK_SKY;
     else if (CFG_TEXTURES && sc->look)
-        k.tex = ceiling ? sc->planes[sector].ceil_tex : sc->planes[sector].floor_tex;
+        k.tex = anim_tex(sc, tic, ceiling ? sc->planes[sector].ceil_tex : sc->planes[sector].floor_tex);
     return k;
 }
 
@@ -257,11 +262,11 @@ void surf_leaf_planes(const scene *sc, const world_state *w, const view_xform *v
             pts[i] = view_point(v, q->x, q->y, 0);
         }
     if (floor) {
-        surf_look k = plane_look(sc, f->sector, 0, sec->floor_h);
+        surf_look k = plane_look(sc, f->sector, 0, sec->floor_h, anim_tic(w));
         plane(sc, v, pts, n, sec->floor_h, 1, mask, sink, &k, RAST_ID(RAST_KIND_FLOOR, f->sector), st);
     }
     if (ceiling) {
-        surf_look k = plane_look(sc, f->sector, 1, top);
+        surf_look k = plane_look(sc, f->sector, 1, top, anim_tic(w));
         plane(sc, v, pts, n, top, 0, mask, sink, &k, RAST_ID(RAST_KIND_CEILING, f->sector), st);
     }
 }
@@ -270,7 +275,9 @@ void surf_leaf_walls(const scene *sc, const world_state *w, const view_xform *v,
                      const surf_sink *sink, occ_columns *occ, render_stats *st)
 {
     const scn_leaf *f = &sc->leaves[leaf];
-    for (uint32_t i = 0; i < f->num_segs; i++) seg_parts(sc, w ? w->ceil : 0, v, f->first_seg + i, mask, sink, occ, st);
+    const fx_t *ceil = w ? w->ceil : 0;
+    uint32_t tic = anim_tic(w);
+    for (uint32_t i = 0; i < f->num_segs; i++) seg_parts(sc, ceil, tic, v, f->first_seg + i, mask, sink, occ, st);
 }
 
 void surf_leaf(const scene *sc, const world_state *w, const view_xform *v, uint32_t leaf, unsigned mask,

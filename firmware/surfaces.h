@@ -62,9 +62,10 @@ int surf_faces_eye(const view_xform *v, const scn_vertex *a, const scn_vertex *b
 /* A wall part's paint (part: SCN_PART_*): its texture, hung by Doom's pegging
  * from the heights the sectors have now (front floor and ceiling, back floor and
  * ceiling: a door's texture moves with the door), or its flat colour in a build
- * without textures. light: the front sector's light level. */
+ * without textures. light: the front sector's light level; tic: the level time
+ * (anim.h: the frame an animated texture shows, how far a scrolling side moved). */
 tex_paint surf_part_paint(const scene *sc, const view_xform *v, const scn_seg *g, int part, int32_t ff, int32_t fc,
-                          int32_t bf, int32_t bc, uint8_t light, uint8_t colour);
+                          int32_t bf, int32_t bc, uint8_t light, uint8_t colour, uint32_t tic);
 
 /* A sector's ceiling now: obj_ceil's rule, with its test of w made once per leaf
  * (ceil: w->ceil, or NULL for the ceilings as compiled). */

@@ -321,6 +321,8 @@ static void parse_info(const char *line, fl_frame_info *fi)
     if (m) fi->mode = (uint8_t)atoi(m + 8);
     const char *pr = strstr(line, "\"present\": ");
     if (pr) fi->present = (uint8_t)atoi(pr + 11);
+    const char *t = strstr(line, "\"t_ms\": ");
+    if (t) fi->time_ms = (uint32_t)strtoul(t + 8, NULL, 10);
 }
 
 static int cmd_encode(int argc, char **argv, int bench)
@@ -448,9 +450,9 @@ static const char *reason_name(fl_reason r)
 static void print_info(const fl_frame_info *i)
 {
     printf("\"info\": {\"x\": %d, \"y\": %d, \"z\": %d, \"angle\": %d, \"look\": %d, \"mode\": %u, \"present\": %u, "
-           "\"crc32\": \"%08x\", \"no_crc\": %u}",
+           "\"crc32\": \"%08x\", \"no_crc\": %u, \"time_ms\": %u}",
            (int)i->x, (int)i->y, (int)i->z, (int)i->angle, (int)i->look, i->mode, i->present, (unsigned)i->crc,
-           i->no_crc);
+           i->no_crc, (unsigned)i->time_ms);
 }
 
 static void on_event(void *ctx, const fl_event *ev)

@@ -43,8 +43,8 @@ def refused(args, *needles, status=1):
 
 # ---- compiled scenes ------------------------------------------------------------------------
 
-HEADER_BYTES = 228  # sizeof(scn_header): 44 bytes, then 23 sections of 8
-VERSION = 5  # SCN_VERSION
+HEADER_BYTES = 236  # sizeof(scn_header): 44 bytes, then 24 sections of 8
+VERSION = 6  # SCN_VERSION
 VERTICES, SECTORS, LINES, SEGS, NODES, LEAVES, PVERTS, PALETTE = range(8)
 NEEDS = 13
 LOOK, LIGHTS, TEXTURES, TEXELS, SIDES, PLANES = range(14, 20)
@@ -192,7 +192,7 @@ LOOK_DAMAGE = [
      ["textures record 1", "outside the proven-safe range"]),
     ("texture-taller-than-stored", record_field(TEXTURES, TEXTURE_BYTES, 1, 8, lambda d: 2048),
      ["textures record 1", "outside the proven-safe range"]),
-    ("side-flags", record_field(SIDES, SIDE_BYTES, 5, 20, lambda d: 0x00040000),
+    ("side-flags", record_field(SIDES, SIDE_BYTES, 5, 20, lambda d: 0x00080000),
      ["sides record 5", "outside the proven-safe range"]),
     ("plane-texture-index", record_field(PLANES, 4, 7, 0, lambda d: section(d, TEXTURES)[1] + 1),
      ["planes record 7", "index out of range"]),

@@ -67,12 +67,12 @@ def raw_frames(data):
     palette = data[i + 4:i + 4 + 768]
     frames, pos = [], i + 4 + 768
     while (j := data.find(b"RAWF", pos)) >= 0:
-        f, x, y, z, a, look, mode, present, crc = struct.unpack("<IiiiiiBBxxI", data[j + 4:j + 36])
-        pixels = data[j + 36:j + 36 + 64000]
+        f, x, y, z, a, look, mode, present, crc, t = struct.unpack("<IiiiiiBBxxII", data[j + 4:j + 40])
+        pixels = data[j + 40:j + 40 + 64000]
         assert len(pixels) == 64000
-        frames.append((dict(frame=f, x=x, y=y, z=z, angle=a, look=look, mode=mode, present=present, crc32=crc),
-                       pixels))
-        pos = j + 36 + 64000
+        frames.append((dict(frame=f, x=x, y=y, z=z, angle=a, look=look, mode=mode, present=present, crc32=crc,
+                            time_ms=t), pixels))
+        pos = j + 40 + 64000
     end = data.find(b"RAWE", pos)
     assert end >= 0, "no end record"
     assert struct.unpack("<I", data[end + 4:end + 8])[0] == len(frames)
@@ -136,7 +136,8 @@ def test_frames_stream_and_match_the_host_renderer(raw_firmware, tmp_path):
     for info, _ in frames[::11]:
         cam = [fx_text(info["x"]), fx_text(info["y"]), fx_text(info["z"])]
         proc = subprocess.run([str(BUILD / "render"), str(BUILD / "default.bsc"), "--at", ",".join(cam),
-                               "--angle", fx_text(info["angle"]), "--look", str(info["look"])],
+                               "--angle", fx_text(info["angle"]), "--look", str(info["look"]),
+                               "--time", str(info["time_ms"])],
                               capture_output=True, text=True, check=True)
         assert int(json.loads(proc.stdout)["crc32"], 16) == info["crc32"], info
 
@@ -322,5 +323,6 @@ def test_map12_fits_in_200000_bytes_and_matches_the_host_renderer(tmp_path):
             cam = [fx_text(info["x"]), fx_text(info["y"]), fx_text(info["z"])]
             ref = subprocess.run([str(BUILD / "render"), str(out / "scene.bsc"), "--at", ",".join(cam),
                                   "--angle", fx_text(info["angle"]), "--look", str(info["look"]), "--mode", mode,
-                                  "--present", present], capture_output=True, text=True, check=True)
+                                  "--present", present, "--time", str(info["time_ms"])], capture_output=True,
+                                 text=True, check=True)
             assert int(json.loads(ref.stdout)["crc32"], 16) == info["crc32"], (present, info)

@@ -82,11 +82,13 @@ def sent_crcs(walk):
 
 
 def test_walk_is_reproducible_by_render(walk_textured):
-    """The camera fltool walk writes is the camera exactly as used: build/render redraws the frame."""
+    """The camera and time fltool walk writes are those used: build/render redraws the frame (its
+    animated textures at the walk's time, its doors where the walk left them)."""
     _, raw, lines = walk_textured
     for l in (lines[0], lines[FRAMES // 2], lines[-1]):
         c = l["camera"]
-        got = render("freedoom2.wad:MAP01", "--look", str(c["look"]),
+        doors = [a for s, h in l["ceilings"].items() for a in ("--door", f"{s}={h}")]
+        got = render("freedoom2.wad:MAP01", "--look", str(c["look"]), "--time", str(l["t_ms"]), *doors,
                      at=f"{c['x']},{c['y']},{c['z']}", angle=str(c["angle"]), sanitized=False)
         assert got["crc32"] == l["crc32"]
         k = l["frame"]

@@ -1,7 +1,7 @@
 """A WAD map's look in the compiled scene (docs/textures.md, firmware/scene_format.h): the
-sections' counts, only the textures and flats the map uses, texels against an independent
-composition from the WAD, --flat, and damaged texture data refused with a message (never a crash,
-under the sanitizer build)."""
+sections' counts, only the textures and flats the map uses (and the other frames of the animated
+ones), texels against an independent composition from the WAD, --flat, and damaged texture data
+refused with a message (never a crash, under the sanitizer build)."""
 import struct
 import sys
 
@@ -78,6 +78,41 @@ def compose(lumps, tdef):
 
 
 
+# Doom's animated textures and flats (P_InitPicAnims: first and last frame; docs/textures.md)
+ANIM_FLATS = [("NUKAGE1", "NUKAGE3"), ("FWATER1", "FWATER4"), ("SWATER1", "SWATER4"), ("LAVA1", "LAVA4"),
+              ("BLOOD1", "BLOOD3"), ("RROCK05", "RROCK08"), ("SLIME01", "SLIME04"), ("SLIME05", "SLIME08"),
+              ("SLIME09", "SLIME12")]
+ANIM_WALLS = [("BLODGR1", "BLODGR4"), ("SLADRIP1", "SLADRIP3"), ("BLODRIP1", "BLODRIP4"), ("FIREWALA", "FIREWALL"),
+              ("GSTFONT1", "GSTFONT3"), ("FIRELAV3", "FIRELAVA"), ("FIREMAG1", "FIREMAG3"), ("FIREBLU1", "FIREBLU2"),
+              ("ROCKRED1", "ROCKRED3"), ("BFALL1", "BFALL4"), ("SFALL1", "SFALL4"), ("WFALL1", "WFALL4"),
+              ("DBRAIN1", "DBRAIN4")]
+
+
+def with_animations(lumps, walls, flats):
+    """The wall and flat names, each with every frame of the sequences it is a frame of: the names
+    between the sequence's first and last in the WAD's order (texture numbers, TEXTURE1 then
+    TEXTURE2; the flats' lumps)."""
+    order = []
+    for lname in ("TEXTURE1", "TEXTURE2"):
+        d = last(lumps, lname)
+        if d is not None:
+            order += [name8(d[o:o + 8]) for o in struct.unpack_from(f"<{struct.unpack_from('<I', d)[0]}I", d, 4)]
+    lumpnames = [n for n, _ in lumps]
+    lastlump = {n: i for i, n in enumerate(lumpnames)}
+    walls, flats = set(walls), set(flats)
+    for a, b in ANIM_WALLS:
+        if a in order and b in order:
+            seq = set(order[order.index(a):order.index(b) + 1])
+            if seq & walls:
+                walls |= seq
+    for a, b in ANIM_FLATS:
+        if a in lastlump and b in lastlump:
+            seq = set(lumpnames[lastlump[a]:lastlump[b] + 1])
+            if seq & flats:
+                flats |= seq
+    return walls, flats
+
+
 # ---- the compiled scene ----------------------------------------------------------------------
 
 
@@ -139,6 +174,8 @@ def test_look_sections_hold_exactly_what_the_map_uses(tmp_path, wad, mapname):
     if sky:
         n = int(mapname[3:]) if mapname.startswith("MAP") else None
         walls.add(("SKY1" if n < 12 else "SKY2" if n < 21 else "SKY3") if n else f"SKY{mapname[1]}")
+    # a frame of an animation brings its whole sequence
+    walls, used_flats = with_animations(lumps, walls & set(defs), used_flats & flats)
     expected = len(walls & set(defs)) + len(used_flats & flats)
     assert len(texs) == expected, (len(texs), expected)
     look_sky = struct.unpack_from("<I", blob, sec[SEC_LOOK][0])[0]

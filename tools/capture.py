@@ -14,7 +14,8 @@ it). Writes, in DIR:
     frames.jsonl      one JSON object per frame: its number, CRC-32, whether it was a keyframe,
                       the camera exactly as the firmware used it (x, y, z and angle as exact
                       decimals of their 16.16 values, look in pixels; raw 16.16 integers too),
-                      the render and present modes, the scene the sender named in its hello
+                      the render and present modes, the world's time (`time_ms`: objects, doors and
+                      animated textures), the scene the sender named in its hello
                       (`scene`, `scene_crc32`: the CRC-32 of its compiled blob), and `render_args`:
                       the arguments that make build/render reproduce the frame bit for bit, the
                       scene first (run from the repository's root), and `stream_end`: the bytes
@@ -74,6 +75,7 @@ def frame_record(ev, hello=None):
     cam = {k: fx_decimal(info[k]) for k in ("x", "y", "z", "angle")}
     mode = MODES[info["mode"]] if info["mode"] < len(MODES) else str(info["mode"])
     present = PRESENTS[info["present"]] if info["present"] < len(PRESENTS) else str(info["present"])
+    t = info.get("time_ms", 0)
     return {
         "frame": ev["frame"],
         "crc32": info["crc32"],
@@ -82,10 +84,11 @@ def frame_record(ev, hello=None):
         "camera_raw": {k: info[k] for k in ("x", "y", "z", "angle")},
         "mode": mode,
         "present": present,
+        "time_ms": t,
         "scene": scene,
         "scene_crc32": hello["scene_crc32"] if hello else "00000000",
         "render_args": ([scene] if scene else []) + ["--at", f"{cam['x']},{cam['y']},{cam['z']}", "--angle", cam["angle"],
-                        "--look", str(info["look"]), "--mode", mode, "--present", present],
+                        "--look", str(info["look"]), "--mode", mode, "--present", present, "--time", str(t)],
     }
 
 

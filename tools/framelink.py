@@ -23,14 +23,14 @@ model's initial probabilities from streams, docs/frame-link.md "Model").
 import struct
 import zlib
 
-VERSION = 2
+VERSION = 3
 W, H = 320, 200
 FRAME_BYTES = W * H
 PALETTE_BYTES = 768
 HEADER_BYTES = 9
 CRC_BYTES = 4
-INFO_BYTES = 26
-FRAME_PRE = 31
+INFO_BYTES = 30
+FRAME_PRE = 35
 PAYLOAD_MAX = 65536
 MSG_MAX = HEADER_BYTES + PAYLOAD_MAX + CRC_BYTES
 
@@ -424,9 +424,9 @@ def encode_message(mtype, frame_no, payload, version=VERSION):
 
 
 def unpack_info(b):
-    x, y, z, angle, look, mode, present, crc = struct.unpack("<iiiiiBBI", bytes(b[:INFO_BYTES]))
+    x, y, z, angle, look, mode, present, crc, t = struct.unpack("<iiiiiBBII", bytes(b[:INFO_BYTES]))
     return {"x": x, "y": y, "z": z, "angle": angle, "look": look, "mode": mode, "present": present,
-            "crc32": f"{crc:08x}", "no_crc": 0 if b[INFO_BYTES] & 1 else 1}
+            "crc32": f"{crc:08x}", "no_crc": 0 if b[INFO_BYTES] & 1 else 1, "time_ms": t}
 
 
 class _Reader:
@@ -702,7 +702,8 @@ class Decoder:
         {"event": "hello", "frame", "version", "width", "height", "gun_bits", "key_interval", "window", "methods",
          "scene": name ("" when not said), "scene_crc32": 8 hex digits of the scene blob's CRC-32 ("00000000": not said)}
         {"event": "palette", "frame", "crc32", "palette": 768 bytes}
-        {"event": "frame", "frame", "keyframe", "info": {x, y, z, angle, look, mode, present, crc32, no_crc},
+        {"event": "frame", "frame", "keyframe",
+         "info": {x, y, z, angle, look, mode, present, crc32, no_crc, time_ms},
          "pixels": the 64,000 bytes shown}      (.frame is the latest frame shown, after the whole call)
         {"event": "drop", "frame", "type", "reason"}   an intact frame message not shown
         {"event": "bad", "reason"}                     a damaged or invalid message discarded

@@ -28,6 +28,7 @@ flat is the last lump of its name (flats among the F_START..F_END lumps). Holes 
 leave are texel 0. The sky texture is Doom's: freedoom2/Doom II MAPxx: SKY1 below MAP12, SKY2
 below MAP21, else SKY3; ExMy: SKYx.
 """
+import copy
 import math
 import struct
 
@@ -244,6 +245,103 @@ def look_of(m):
     return _looks[m.name]
 
 
+# ---- textures by time (docs/textures.md, "Animation") ----------------------------------------
+
+TIC_HZ = 35
+ANIM_TICS = 8
+# Doom's table (P_InitPicAnims): (flat, first frame, last frame)
+DOOM_ANIMS = [(True, "NUKAGE1", "NUKAGE3"), (True, "FWATER1", "FWATER4"), (True, "SWATER1", "SWATER4"),
+              (True, "LAVA1", "LAVA4"), (True, "BLOOD1", "BLOOD3"), (True, "RROCK05", "RROCK08"),
+              (True, "SLIME01", "SLIME04"), (True, "SLIME05", "SLIME08"), (True, "SLIME09", "SLIME12"),
+              (False, "BLODGR1", "BLODGR4"), (False, "SLADRIP1", "SLADRIP3"), (False, "BLODRIP1", "BLODRIP4"),
+              (False, "FIREWALA", "FIREWALL"), (False, "GSTFONT1", "GSTFONT3"), (False, "FIRELAV3", "FIRELAVA"),
+              (False, "FIREMAG1", "FIREMAG3"), (False, "FIREBLU1", "FIREBLU2"), (False, "ROCKRED1", "ROCKRED3"),
+              (False, "BFALL1", "BFALL4"), (False, "SFALL1", "SFALL4"), (False, "WFALL1", "WFALL4"),
+              (False, "DBRAIN1", "DBRAIN4")]
+
+
+def level_tic(time_ms):
+    """Doom's level time in tics at time_ms: floor(time_ms * 35 / 1000)."""
+    return time_ms * TIC_HZ // 1000
+
+
+def texture_numbers(wad):
+    """Doom's wall texture numbers: the names of TEXTURE1's entries, then TEXTURE2's."""
+    names = []
+    for lname in ("TEXTURE1", "TEXTURE2"):
+        d = wad.lump(lname)
+        if d is None:
+            continue
+        (n,) = struct.unpack_from("<i", d, 0)
+        names += [_name8(d[o:o + 8]) for o in struct.unpack_from(f"<{n}i", d, 4)]
+    return names
+
+
+def anim_sequences(wad):
+    """{(name, flat): (frames, k, base)}: each frame of each of Doom's sequences the WAD holds (both
+    ends there, two frames or more, in the WAD's order: texture numbers, or the flats' lumps), its
+    place k in the sequence and the WAD's number of the first frame (P_InitPicAnims)."""
+    tnames = texture_numbers(wad)
+    tnum = {}
+    for i, n in enumerate(tnames):
+        tnum.setdefault(n, i)
+    fstart = wad.last.get("F_START", wad.last.get("FF_START", -1)) + 1
+    out = {}
+    for flat, first, last in DOOM_ANIMS:
+        if flat:
+            if first not in wad.last or last not in wad.last:
+                continue
+            a, b = wad.last[first], wad.last[last]
+            frames, base = [wad.dir[i][2] for i in range(a, b + 1)], a - fstart
+        else:
+            if first not in tnum or last not in tnum:
+                continue
+            a, b = tnum[first], tnum[last]
+            frames, base = tnames[a:b + 1], a
+        if len(frames) >= 2:
+            for k, name in enumerate(frames):
+                out.setdefault((name, flat), (frames, k, base))
+    return out
+
+
+def scrolled(m):
+    """Per sidedef of the map, the lines of special 48 (Doom's scrolling wall) it is the front of:
+    its texture moves that many units a tic (P_UpdateSpecials)."""
+    lk = look_of(m)
+    lin = np.frombuffer(m.wad_lumps["LINEDEFS"], np.dtype([("v1", "<u2"), ("v2", "<u2"), ("fl", "<u2"),
+                                                             ("sp", "<u2"), ("tag", "<u2"), ("s0", "<u2"),
+                                                             ("s1", "<u2")]))
+    front = lin["s0"][(lin["sp"] == 48) & (lin["s0"] < len(lk.xoff))]
+    return np.bincount(front.astype(np.int64), minlength=len(lk.xoff))
+
+
+def look_at(m, time_ms):
+    """The look of WAD map m at time_ms: every texture and flat number replaced by the frame its
+    sequence shows at level tic T (frame k of a sequence whose first frame is the WAD's number base
+    shows frame (T / 8 + base + k) mod n), every scrolling sidedef's x offset moved T units a line."""
+    lk = look_of(m)
+    tic = level_tic(int(time_ms))
+    if not hasattr(lk, "anims"):
+        lk.anims, lk.scroll = anim_sequences(lk.wad), scrolled(m)
+    if not lk.anims and not lk.scroll.any():
+        return lk
+    at = copy.copy(lk)
+
+    def shown(nums, flat):
+        out = np.array(nums, np.int64)
+        for i in np.unique(out[out >= 0]):
+            key = lk.names[int(i)]
+            if key in lk.anims:
+                frames, k, base = lk.anims[key]
+                out[out == i] = lk.number(frames[(tic // ANIM_TICS + base + k) % len(frames)], flat)
+        return out
+
+    at.side_tex = shown(lk.side_tex, False)
+    at.floor_tex, at.ceil_tex = shown(lk.floor_tex, True), shown(lk.ceil_tex, True)
+    at.xoff = lk.xoff + tic * lk.scroll
+    return at
+
+
 def wall_table(start, z):
     """Doom's scale light: start - min(47, floor(2560 / z)) / 2, clamped to 0..31."""
     with np.errstate(divide="ignore"):
@@ -277,7 +375,7 @@ class Expect:
 def expect(view):
     """The Expect of a refrender.View of a WAD map."""
     m = view.scene
-    lk = look_of(m)
+    lk = look_at(m, getattr(view, "time_ms", 0))
     e = Expect()
     e.look = lk
     e.ids = view.ids

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """texcompare.py - a renderer's textured frame against the reference's texels and light.
 
-Given a WAD map, a camera (build/render's --at/--angle/--look/--door) and the renderer's frame
+Given a WAD map, a camera (build/render's --at/--angle/--look/--door/--time) and the renderer's frame
 (--raw: 64,000 palette indices) and id buffer (--ids), it casts the reference's view
 (tools/refrender.py: the world and the map's things at time 0, those Doom draws as their sprites,
 docs/objects.md "Sprites"; --no-objects: the world alone) and its expected colours
@@ -14,7 +14,10 @@ counts). Prints one JSON object; --diff writes the frame with the failures in re
 compared dimmed). Exit status 0, or 1 on bad input.
 
 usage: tools/texcompare.py WAD:MAP --raw FRAME --ids IDS [--at X,Y[,Z]] [--angle DEG] [--look PX]
-                           [--door SECTOR=H]... [--no-objects] [--diff OUT.png]
+                           [--door SECTOR=H]... [--no-objects] [--time MS] [--diff OUT.png]
+
+--time MS: the frames animated textures and flats show and how far scrolling walls moved at that
+time (docs/textures.md, "Animation"), as build/render --time draws them.
 """
 import argparse
 import json
@@ -28,11 +31,11 @@ import reflook  # noqa: E402
 import refrender  # noqa: E402
 
 
-def reference(scene, at=None, angle=None, look=0, ceilings=None, objects=None):
+def reference(scene, at=None, angle=None, look=0, ceilings=None, objects=None, time_ms=0):
     """The reference's Expect for build/render's camera arguments (strings or numbers; None:
-    the player start, the eye 41 above the floor). objects: as refrender.cast_view takes them
-    (build/render's JSON "objects"; [] the world alone); None: the map's own things, which is
-    what build/render draws at time 0."""
+    the player start, the eye 41 above the floor) at time time_ms. objects: as refrender.cast_view
+    takes them (build/render's JSON "objects"; [] the world alone); None: the map's own things,
+    which is what build/render draws at time 0."""
     m = refrender.load(scene)
     x, y, a = m.player if m.player else (0.0, 0.0, 0.0)
     z = None
@@ -45,6 +48,7 @@ def reference(scene, at=None, angle=None, look=0, ceilings=None, objects=None):
     if angle is not None:
         a = angle
     view = refrender.cast_view(m, x, y, z, a, int(look), objects=objects, ceilings=ceilings or {})
+    view.time_ms = int(time_ms)
     return reflook.expect(view)
 
 
@@ -69,6 +73,7 @@ def main(argv=None):
     ap.add_argument("--angle")
     ap.add_argument("--look", type=int, default=0)
     ap.add_argument("--door", action="append", default=[], metavar="SECTOR=H")
+    ap.add_argument("--time", type=int, default=0, metavar="MS", help="the time animated textures show")
     ap.add_argument("--raw", required=True, help="the renderer's frame: 64,000 palette indices")
     ap.add_argument("--ids", help="the renderer's id buffer (its object pixels are left out)")
     ap.add_argument("--diff", help="write the frame with the failures in red (PNG)")
@@ -90,7 +95,7 @@ def main(argv=None):
         ids = None
         if a.ids:
             ids = read_u8(a.ids, 256000, "id buffer").view("<u4")
-        e = reference(a.scene, a.at, a.angle, a.look, ceilings, [] if a.no_objects else None)
+        e = reference(a.scene, a.at, a.angle, a.look, ceilings, [] if a.no_objects else None, a.time)
         ok, compared, counts = reflook.compare(e, frame, ids)
         if a.diff:
             refrender.write_png_rgb(a.diff, reflook.diff_rgb(e, frame, ok, compared))

@@ -18,6 +18,7 @@ ROOT = Path(__file__).resolve().parent.parent
 WADDIR = Path("/usr/share/games/doom")
 SEC_LINES, SEC_SECTORS = 2, 1
 SEC_LOOK, SEC_LIGHTS, SEC_TEXTURES, SEC_TEXELS, SEC_SIDES, SEC_PLANES = range(14, 20)
+SEC_ANIMS, SEC_COUNT = 23, 24
 
 
 def read_wad(path):
@@ -78,7 +79,7 @@ def flat_names(lumps):
 
 
 def sections(blob):
-    return [struct.unpack_from("<II", blob, 44 + 8 * i) for i in range(23)]
+    return [struct.unpack_from("<II", blob, 44 + 8 * i) for i in range(SEC_COUNT)]
 
 
 def measure(bspc, wad, mapname, tmp):
@@ -92,6 +93,11 @@ def measure(bspc, wad, mapname, tmp):
     poff, npl = sec[SEC_PLANES]
     for i in range(npl):
         flats |= set(struct.unpack_from("<HH", blob, poff + 4 * i)) - {0xFFFF}
+    aoff, nan = sec[SEC_ANIMS]
+    for i in range(nan):  # the other frames of an animated flat are flats too
+        first, count = struct.unpack_from("<IH", blob, aoff + 12 * i)
+        if flats & set(range(first, first + count)):
+            flats |= set(range(first, first + count))
     nbytes = lambda t: 1 << (tex[t][1] + tex[t][2])
     return {
         "map": mapname, "textures": ntex - len(flats), "flats": len(flats),

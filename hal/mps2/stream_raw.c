@@ -3,7 +3,8 @@
  * Little-endian records, each starting with a 4-byte tag; no framing, no acks:
  *   "RAWP" + 768 palette bytes                                        (once, first)
  *   "RAWF" + frame u32, x, y, z, angle i32 (16.16), look i32, mode u8,
- *          present u8, 2 zero bytes, crc32 u32, then 64,000 pixel bytes (each frame)
+ *          present u8, 2 zero bytes, crc32 u32, time_ms u32 (the engine's t_ms),
+ *          then 64,000 pixel bytes (each frame)
  *   "RAWE" + frames u32                                               (at the end)
  * Text (log.h) may stand between records. tests/test_firmware.py reads it.
  */
@@ -60,6 +61,7 @@ int stream_frame(const engine *e, uint32_t frame_no)
     put32((uint32_t)e->cam.view.look);
     put32((uint32_t)e->mode | (uint32_t)e->present << 8);
     put32(crc_update(0, page, HAL_PAGE_BYTES));
+    put32(e->t_ms);
     uart_write(page, HAL_PAGE_BYTES);
     return 0;
 }

@@ -1,5 +1,5 @@
 /* fl_engine_info.h - what the frame link says about an engine's frame: its
- * camera and modes (fl_frame_info), for every sender (hal/mps2/stream_fl.c,
+ * camera, modes and time (fl_frame_info), for every sender (hal/mps2/stream_fl.c,
  * host/link_send.c's callers). Inline, so it is compiled with the includer's
  * build_config.h: the engine's layout depends on the build, and the frame
  * link's codec itself does not know the engine. */
@@ -19,6 +19,7 @@ static inline fl_frame_info fl_engine_info(const engine *e)
         .look = e->cam.view.look,
         .mode = (uint8_t)e->mode,
         .present = (uint8_t)e->present,
+        .time_ms = e->t_ms,
     };
     return info;
 }

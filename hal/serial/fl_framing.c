@@ -250,6 +250,7 @@ void fl_info_pack(uint8_t *o, const fl_frame_info *in)
     o[20] = in->mode;
     o[21] = in->present;
     fl_put32(o + 22, in->crc);
+    fl_put32(o + 26, in->time_ms);
 }
 
 void fl_info_unpack(fl_frame_info *out, const uint8_t *i)
@@ -262,4 +263,5 @@ void fl_info_unpack(fl_frame_info *out, const uint8_t *i)
     out->mode = i[20];
     out->present = i[21];
     out->crc = fl_get32(i + 22);
+    out->time_ms = fl_get32(i + 26);
 }

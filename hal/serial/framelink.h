@@ -12,9 +12,9 @@
  * Frames travel as keyframes or as deltas against the frame sent just before,
  * coded row by row as colour transitions predicted from the row above (an
  * adaptive binary range coder); every frame message carries fl_frame_info
- * (camera, modes, the CRC-32 of the 64,000 pixel bytes unless the sender opts
- * out) and a frame check computed by the encoder; the receiver checks both on
- * the reconstructed frame before it shows it.
+ * (camera, modes, the world's time, the CRC-32 of the 64,000 pixel bytes
+ * unless the sender opts out) and a frame check computed by the encoder; the
+ * receiver checks both on the reconstructed frame before it shows it.
  *
  * Files: fl_framing.c (COBS, header, CRC), fl_codec.c (picture coding),
  * fl_encoder.c (sender), fl_decoder.c (receiver).
@@ -24,7 +24,7 @@
 
 #include <stdint.h>
 
-#define FL_VERSION 2 /* 2: method RAW_HASH (its message CRC leaves the pixels to the frame check) */
+#define FL_VERSION 3 /* 2: method RAW_HASH (its message CRC leaves the pixels to the frame check); 3: the time */
 #define FL_W 320
 #define FL_H 200
 #define FL_FRAME_BYTES (FL_W * FL_H)
@@ -32,8 +32,8 @@
 
 #define FL_HEADER_BYTES 9 /* version, type, frame u32, payload length u24 */
 #define FL_CRC_BYTES 4
-#define FL_INFO_BYTES 26      /* fl_frame_info on the wire (without no_crc) */
-#define FL_FRAME_PRE 31       /* info, flags, frame check: the start of every frame payload */
+#define FL_INFO_BYTES 30      /* fl_frame_info on the wire (without no_crc) */
+#define FL_FRAME_PRE 35       /* info, flags, frame check: the start of every frame payload */
 #define FL_PAYLOAD_MAX 65536u /* largest payload a receiver accepts */
 #define FL_MSG_MAX (FL_HEADER_BYTES + FL_PAYLOAD_MAX + FL_CRC_BYTES)
 #define FL_WINDOW_MAX 32     /* largest flow-control window */
@@ -57,14 +57,15 @@ enum { FL_METHOD_RAW = 0, FL_METHOD_EDGE = 1, FL_METHOD_RAW_HASH = 2 };
 
 /* What the receiver knows about a frame besides its pixels. */
 typedef struct {
-    int32_t x, y, z; /* camera, 16.16 map units (view.h: camera) */
-    int32_t angle;   /* degrees, 16.16 */
-    int32_t look;    /* pixels */
-    uint8_t mode;    /* render mode (render.h) */
-    uint8_t present; /* present mode (hal.h) */
-    uint32_t crc;    /* crc_update(0, pixels, 64000) */
-    uint8_t no_crc;  /* sender: nonzero if crc was not computed (the link's own frame
+    int32_t x, y, z;  /* camera, 16.16 map units (view.h: camera) */
+    int32_t angle;    /* degrees, 16.16 */
+    int32_t look;     /* pixels */
+    uint8_t mode;     /* render mode (render.h) */
+    uint8_t present;  /* present mode (hal.h) */
+    uint32_t crc;     /* crc_update(0, pixels, 64000) */
+    uint8_t no_crc;   /* sender: nonzero if crc was not computed (the link's own frame
                           * check still protects the frame; the receiver fills crc in) */
+    uint32_t time_ms; /* the world's time (engine.h: t_ms): objects, doors, animated textures */
 } fl_frame_info;
 
 /* Sender capabilities and the scene it draws (the HELLO payload). */

@@ -267,7 +267,8 @@ static void test_node_direction_range(void **state)
 }
 
 /* The features a scene needs follow from what it holds: textures exactly when it
- * has a look (a flat scene needs none), objects exactly when it has models. */
+ * has a look (a flat scene needs none), objects exactly when it has models,
+ * animation exactly when a look has a sequence of frames or a scrolling side. */
 static void test_derived_features(void **state)
 {
     (void)state;
@@ -282,9 +283,20 @@ static void test_derived_features(void **state)
     assert_int_equal(flat & SCN_NEED_OBJECTS, s.nmodels ? SCN_NEED_OBJECTS : 0);
     scn_look look;
     memset(&look, 0, sizeof look);
+    scn_side *sides = calloc(2u * s.nlines, sizeof *sides); /* a look has a side per line side */
+    assert_non_null(sides);
     scene t = s;
     t.look = &look;
+    t.sides = sides;
     assert_int_equal(scene_derived_features(&t), flat | SCN_NEED_TEXTURES);
+    sides[2u * s.nlines - 1].flags = SCN_SIDE_SCROLL;
+    assert_int_equal(scene_derived_features(&t), flat | SCN_NEED_TEXTURES | SCN_NEED_ANIM);
+    sides[2u * s.nlines - 1].flags = 0;
+    scn_anim anim = {0, 2, 0, 8, 0};
+    t.anims = &anim;
+    t.nanims = 1;
+    assert_int_equal(scene_derived_features(&t), flat | SCN_NEED_TEXTURES | SCN_NEED_ANIM);
+    free(sides);
     free(aligned);
 }
 

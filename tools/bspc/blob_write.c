@@ -25,6 +25,7 @@ _Static_assert(sizeof(scn_look) == 8, "scn_look layout");
 _Static_assert(sizeof(scn_texture) == 12, "scn_texture layout");
 _Static_assert(sizeof(scn_side) == 24, "scn_side layout");
 _Static_assert(sizeof(scn_plane) == 4, "scn_plane layout");
+_Static_assert(sizeof(scn_anim) == 12, "scn_anim layout");
 
 typedef struct {
     uint8_t *p;
@@ -140,9 +141,10 @@ static uint64_t blob_layout(const bs_scene *s, const bs_tree *t, uint32_t counts
                                        look ? s->nsectors : 0u,
                                        look ? lk->nsprites : 0u,
                                        look ? lk->nsprmask : 0u,
-                                       look ? lk->nsprsets : 0u};
+                                       look ? lk->nsprsets : 0u,
+                                       look ? lk->nanims : 0u};
     static const uint32_t recsz[SCN_SEC_COUNT] = {8, 12 + 4, 24, 16, 56, 20, 8,  3, 28, 12, 8, 4, 48, sizeof(scn_needs),
-                                                  8, 256,    12, 1,  24, 4,  16, 4, 20};
+                                                  8, 256,    12, 1,  24, 4,  16, 4, 20, 12};
     uint64_t at = sizeof(scn_header);
     for (int k = 0; k < SCN_SEC_COUNT; k++) {
         at = (at + 3) & ~(uint64_t)3;
@@ -425,6 +427,18 @@ static void put_sprsets(wr *w, const blob_src *b)
     }
 }
 
+static void put_anims(wr *w, const blob_src *b)
+{
+    for (uint32_t i = 0; i < b->s->look.nanims; i++) {
+        const scn_anim *a = &b->s->look.anims[i];
+        w32(w, a->first);
+        w16(w, a->count);
+        w16(w, a->phase);
+        w16(w, a->tics);
+        w16(w, 0);
+    }
+}
+
 /* One writer per section, in enum order. The needs record (SCN_SEC_NEEDS) has
  * none: it stays zero here, and bspc.c fills it in from the analysis of this
  * very blob and recomputes the CRC. */
@@ -436,7 +450,7 @@ static void (*const put_section[SCN_SEC_COUNT])(wr *, const blob_src *) = {
     [SCN_SEC_OBJECTS] = put_objects,   [SCN_SEC_LOOK] = put_look,       [SCN_SEC_LIGHTS] = put_lights,
     [SCN_SEC_TEXTURES] = put_textures, [SCN_SEC_TEXELS] = put_texels,   [SCN_SEC_SIDES] = put_sides,
     [SCN_SEC_PLANES] = put_planes,     [SCN_SEC_SPRITES] = put_sprites, [SCN_SEC_SPRMASK] = put_sprmask,
-    [SCN_SEC_SPRSETS] = put_sprsets,
+    [SCN_SEC_SPRSETS] = put_sprsets,   [SCN_SEC_ANIMS] = put_anims,
 };
 
 int bs_write_blob(const bs_scene *s, const bs_tree *t, uint8_t **blob, size_t *len, char *err, size_t errlen)

@@ -137,6 +137,9 @@ typedef struct {
     uint32_t nsprmask, smcap;
     scn_sprset *sprsets;
     uint32_t nsprsets, sscap;
+    /* animated textures and flats (anims.c): sequences of frames stored one after another */
+    scn_anim *anims;
+    uint32_t nanims, acap;
 } bs_look;
 
 typedef struct {

@@ -15,6 +15,7 @@ static const struct {
     {"the scene allows it", "the scene says 'look off'"},
     {"a polygon seen from just beside it crosses the screen's top or bottom", "nothing to draw"},
     {"the scene has wall textures, flats and light tables", "flat-shaded"},
+    {"an animated texture or flat, or a scrolling wall", "every texture stands still"},
 };
 _Static_assert(SCN_NEED_ALL == (1u << (sizeof feature_text / sizeof feature_text[0])) - 1u, "one text per feature");
 #define NFEATURES (sizeof feature_text / sizeof feature_text[0])

@@ -96,6 +96,7 @@ void bs_scene_free(bs_scene *s)
     free(s->look.sprites);
     free(s->look.sprmask);
     free(s->look.sprsets);
+    free(s->look.anims);
     memset(s, 0, sizeof *s);
 }
 

@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "anims.h"
 #include "bspc_int.h"
 #include "things_txt.h" /* bs_things_txt[], bs_things_txt_len: tools/bspc/things.txt */
 
@@ -334,6 +335,7 @@ typedef struct {
     uint32_t cnt[L_N]; /* their record counts */
     uint8_t *vused;    /* [nverts]: the vertex ends a kept linedef */
     bs_wadlook *look;  /* textures and light tables; NULL with --flat */
+    uint8_t *scroll;   /* [nsidedefs]: moved by a scrolling line (anims.h), or NULL: none is */
 } wad_map;
 
 /* The 12-byte header and the lump directory. */
@@ -501,6 +503,7 @@ static int wad_load_side(wad_map *m, bs_scene *s, bs_line *l, uint32_t i, int k,
     l->color[k][SCN_PART_UPPER] = (up[0] && strcmp(up, "-") != 0) ? bs_wall_color(up, light, contrast) : cm;
     l->color[k][SCN_PART_LOWER] = (lo[0] && strcmp(lo, "-") != 0) ? bs_wall_color(lo, light, contrast) : cm;
     if (m->look && bs_look_side(m->look, s->nlines, k, sr, line_flags, m->err, m->errlen)) return -1;
+    if (m->look && m->scroll && m->scroll[sd]) s->look.sides[2 * s->nlines + (uint32_t)k].flags |= SCN_SIDE_SCROLL;
     return 0;
 }
 
@@ -606,6 +609,9 @@ static int wad_load_map(wad_map *m, const char *map, bs_scene *s)
     if (bs_look_open(m->f, m->wadpath, m->len, m->dir, m->nlumps, m->want, s, m->cnt[L_SECTORS], m->cnt[L_LINEDEFS],
                      m->opt, &m->look, m->err, m->errlen))
         return -1;
+    int oom;
+    m->scroll = bs_anim_scrolling(m->ld[L_LINEDEFS], m->cnt[L_LINEDEFS], m->cnt[L_SIDEDEFS], &oom);
+    if (oom) return bs_fail(m->err, m->errlen, "%s: out of memory", m->display);
     if (wad_load_sectors(m, s) || wad_load_vertexes(m, s) || wad_load_linedefs(m, s) || wad_check_vertexes(m, s) ||
         wad_load_player(m, s))
         return -1;
@@ -631,6 +637,7 @@ int bs_read_wad(const char *wadpath, const char *map, const char *display, bs_sc
     bs_look_close(m.look);
     for (int k = 0; k < L_N; k++) free(m.ld[k]);
     free(m.vused);
+    free(m.scroll);
     free(m.dir);
     free(m.dirbuf);
     fclose(m.f);

@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "anims.h"
 #include "bspc_int.h"
 #include "look_cache.h"
 #include "patch.h"
@@ -446,8 +447,17 @@ static int compose_flat(bs_wadlook *L, const char *name, uint16_t *out, char *er
     return store(L, name, pic, 64, 64, out, err, errlen) ? -1 : 1;
 }
 
+static int texture(bs_wadlook *L, const char *name, int kind, uint16_t *out, char *err, size_t errlen);
+
+/* A frame of an animation, for bs_anim_store: stored as any texture is. */
+static int anim_frame(void *ctx, int flat, const char *name, uint16_t *out, char *err, size_t errlen)
+{
+    return texture(ctx, name, flat ? KIND_FLAT : KIND_WALL, out, err, errlen);
+}
+
 /* A texture of this kind and name: its index, stored on first use; unknown
- * names and "-" give SCN_TEX_NONE (an unknown name warned once). */
+ * names and "-" give SCN_TEX_NONE (an unknown name warned once). The first use
+ * of a frame of an animation stores its whole sequence, in order (anims.c). */
 static int texture(bs_wadlook *L, const char *name, int kind, uint16_t *out, char *err, size_t errlen)
 {
     *out = SCN_TEX_NONE;
@@ -458,6 +468,13 @@ static int texture(bs_wadlook *L, const char *name, int kind, uint16_t *out, cha
             *out = L->used[i].tex;
             return 0;
         }
+    const bs_anim_seq *q = L->anim_busy ? NULL : bs_anim_of(L->anims, kind == KIND_FLAT, name);
+    if (q) {
+        L->anim_busy = 1;
+        int rc = bs_anim_store(q, L->lk, anim_frame, L, L->opt, L->wad, err, errlen);
+        L->anim_busy = 0;
+        return rc ? -1 : texture(L, name, kind, out, err, errlen);
+    }
     bspc_look_cache *cache = L->opt->look_cache;
     const lc_entry *e = cache ? lc_find(cache, L->wadpath, kind, name) : NULL;
     int f;
@@ -554,6 +571,10 @@ int bs_look_open(FILE *f, const char *wadpath, size_t flen, const bs_wadlump *di
     if (t2 != ndir) {
         if (bs_wl_load_lump(L, t2, 4, &L->tdef[1], err, errlen)) goto fail;
         L->tdsize[1] = dir[t2].size;
+    }
+    if (!(L->anims = bs_anim_find(dir, ndir, L->tdef, L->tdsize, opt, s->name))) {
+        bs_fail(err, errlen, "%s: out of memory", s->name);
+        goto fail;
     }
     lk->doom_palette = 1;
     lk->sky_tex = SCN_TEX_NONE;
@@ -733,5 +754,6 @@ void bs_look_close(bs_wadlook *L)
     nt_free(&L->lumps);
     nt_free(&L->flat_name);
     nt_free(&L->texdefs);
+    bs_anim_free(L->anims);
     free(L);
 }

@@ -6,6 +6,7 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "anims.h"
 #include "bspc_int.h"
 #include "name_table.h"
 
@@ -61,6 +62,8 @@ struct bs_wadlook {
     uint8_t def_palette[768]; /* the flat-shaded palette (bs_palette), for things.txt's colours */
     int have_def_palette;
     const char *wadpath; /* the file, as the look cache knows it */
+    bs_anims *anims;     /* the WAD's animated textures and flats (anims.c) */
+    int anim_busy;       /* storing a sequence's frames */
     /* the things' sprites (sprites.c) */
     uint32_t *image_of; /* [ndir]: 1 + the scn_sprite of lump i, 0 while not stored */
     bs_wl_sprset *sets; /* the sprite sets asked for, in order of first use */
