@@ -903,10 +903,10 @@ static void test_paths(void **state)
     add_box(m, 16, 16, 16, 0, 0, 0, 40);
     attach(&l.s);
     scn_object so[4] = {
-        {m, U(256), U(256), U(8), U(30), SCN_PATH_CIRCLE, U(128), 0, 8000, 0},
-        {m, U(100), U(400), 0, U(350), SCN_PATH_LINE, U(256), -U(300), 4000, U(45)},
-        {m, U(300), U(100), U(2), U(10), SCN_PATH_NONE, 0, 0, 0, -U(3600)},
-        {m, U(200), U(200), 0, 0, SCN_PATH_CIRCLE, U(100.5), 0, 3600000, U(0.25)},
+        {m, U(256), U(256), U(8), U(30), SCN_PATH_CIRCLE, U(128), 0, 8000, 0, SCN_NONE, SCN_NONE},
+        {m, U(100), U(400), 0, U(350), SCN_PATH_LINE, U(256), -U(300), 4000, U(45), SCN_NONE, SCN_NONE},
+        {m, U(300), U(100), U(2), U(10), SCN_PATH_NONE, 0, 0, 0, -U(3600), SCN_NONE, SCN_NONE},
+        {m, U(200), U(200), 0, 0, SCN_PATH_CIRCLE, U(100.5), 0, 3600000, U(0.25), SCN_NONE, SCN_NONE},
     };
     l.s.objects = so;
     l.s.nobjects = 4;
@@ -1121,8 +1121,8 @@ static void test_engine(void **state)
     add_box(m, 24, 24, 24, 0, 0, 0, 40);
     attach(&e->sc);
     scn_object so[2] = {
-        {m, U(128), U(160), 0, 0, SCN_PATH_CIRCLE, U(40), 0, 4000, 0},
-        {m, U(128), U(400), 0, 0, SCN_PATH_NONE, 0, 0, 0, U(90)},
+        {m, U(128), U(160), 0, 0, SCN_PATH_CIRCLE, U(40), 0, 4000, 0, SCN_NONE, SCN_NONE},
+        {m, U(128), U(400), 0, 0, SCN_PATH_NONE, 0, 0, 0, U(90), SCN_NONE, SCN_NONE},
     };
     e->sc.objects = so;
     e->sc.nobjects = 2;
