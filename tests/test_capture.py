@@ -10,7 +10,7 @@ import zlib
 import pytest
 import serial
 
-from conftest import ROOT, program, read_png_indexed, run
+from conftest import ROOT, program, read_png_indexed, render, run
 from linkrig import ARM, FaultyRelay, Firmware, firmware_link, outages
 
 sys.path.insert(0, str(ROOT / "tools"))
@@ -221,3 +221,45 @@ def test_capture_render_reproduces_a_frame(firmware, tmp_path):
     assert "warning" in bad.stderr and "12345678" in bad.stderr
     missing = subprocess.run(tool + ["--render", "99", "--out", str(cap)], capture_output=True, text=True)
     assert missing.returncode == 1 and "frame 99 is not in" in missing.stderr
+
+
+@pytest.fixture(scope="module")
+def firmware_battle():
+    """The Cortex-M3 firmware with the space-battle scene built in: ships moving along their paths."""
+    out = ROOT / "build" / "firmware-test" / "arm-battle"
+    proc = subprocess.run(["make", "-s", "--no-print-directory", "-j2", "firmware",
+                           "SCENE=tests/scenes/battle.scene", f"ARM_OUT={out}"], cwd=ROOT, capture_output=True,
+                          text=True, timeout=1800)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    return out / "firmware.elf"
+
+
+def test_captured_frame_with_moving_things_redraws(firmware_battle, tmp_path):
+    """A frame the firmware sent while its objects were moving is redrawn bit for bit by
+    tools/capture.py --render: the frame link carries the engine's time, and build/render --time puts
+    every object where the firmware had it."""
+    frames = 12
+    fw = Firmware("tcp", f"--frames {frames} --linger 1000", elf=firmware_battle, tmp=tmp_path)
+    try:
+        port = serial.serial_for_url(fw.port, baudrate=115200, timeout=0.2)
+        fw.start()
+        try:
+            summary = capture.capture(port, frames, tmp_path / "cap", timeout=60, log=sys.stderr)
+        finally:
+            port.close()
+        assert fw.wait(timeout=300) == 0, "".join(fw.log)
+    finally:
+        fw.kill()
+    assert summary["frames_captured"] == frames, summary
+    records = [json.loads(line) for line in (tmp_path / "cap" / "frames.jsonl").read_text().splitlines()]
+    moved = []
+    for rec in records:
+        at0 = list(rec["render_args"])
+        at0[at0.index("--time") + 1] = "0"
+        if render(*at0, sanitized=False)["crc32"] != rec["crc32"]:
+            moved.append(rec)  # drawn at time 0, with the ships where they started, it would differ
+    assert moved, "no captured frame shows the objects moved"
+    for rec in moved[-2:]:
+        ok = subprocess.run([sys.executable, str(ROOT / "tools/capture.py"), "--render", str(rec["frame"]), "--out",
+                             str(tmp_path / "cap")], capture_output=True, text=True, cwd=ROOT)
+        assert ok.returncode == 0 and f"frame {rec['frame']}: match" in ok.stderr, ok.stderr
