@@ -3,7 +3,7 @@
 # the whole frame (Doom's weapon left out), the blocks with things and the other blocks.
 # MAP=FILE.wad:MAP picks one map (several, space-separated; `all`: the 43 Freedoom starts of
 # docs/benchmarks.md); the default is the README's two.
-COMPARE_MAPS := freedoom2.wad:MAP01 freedoom1.wad:E1M1
+COMPARE_MAPS := freedoom2.wad:MAP29 freedoom1.wad:E1M1
 MAP ?= $(COMPARE_MAPS)
 
 .PHONY: compare-doom
