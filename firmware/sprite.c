@@ -73,9 +73,11 @@ void spr_opaque(const scene *s, const spr_view *sv, int look, int y, int a, int 
     int32_t w = p->width;
     spr_cols c;
     spr_cols_at(&c, sv, a);
-    for (int x = a; x < b; x++, spr_cols_next(&c)) {
-        if (c.u < 0 || c.u >= w) continue;
-        uint32_t u = (uint32_t)(sv->mirror ? w - 1 - c.u : c.u);
-        if ((col0[u * stride] >> bit) & 1u) bits[x >> 5] |= 1u << (x & 31);
-    }
+    int x = a;
+    for (; x < b && c.u < 0; x++) spr_cols_next(&c); /* left of the image (rounding at its edge) */
+    /* column u's word, walked either way: mirrored, column 0 is the image's last */
+    const uint32_t *col = sv->mirror ? col0 + (uint32_t)(w - 1) * stride : col0;
+    int32_t step = sv->mirror ? -(int32_t)stride : (int32_t)stride;
+    for (; x < b && c.u < w; x++, spr_cols_next(&c))
+        if ((col[c.u * step] >> bit) & 1u) bits[x >> 5] |= 1u << (x & 31);
 }
