@@ -38,8 +38,9 @@ decided with arrays:
   not both ceilings sky) or the lower part (height < B.floor, when B.floor > N.floor) is the
   wall, same id; otherwise the ray goes on into B.
 - Doom's sky rule: between two sky ceilings there is no upper wall; a ray that goes over it
-  (B.ceil < height <= N.ceil) sees sky at once: kind 3 of N (default, `sky_owner="near"`: Doom's
-  visplane owner, and what build/render draws) or of B (`"far"`).
+  (max(B.ceil, N.floor) < height <= N.ceil: where the upper wall would be) sees sky at once:
+  kind 3 of N (default, `sky_owner="near"`: Doom's visplane owner, and what build/render draws)
+  or of B (`"far"`).
 - after a crossing the current sector is the far-side sector (B, or L's front for a one-sided wall
   crossed from behind). Past the last crossing the ray meets the current sector's floor or
   ceiling (yv is never 0), or nothing (kind 0) when there is none.
@@ -1116,7 +1117,7 @@ def cast_view(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="n
         wall_stop = mid | upper | lower                        # no near sector: nan, culled
         # Doom's sky rule: a ray that goes over the missing upper wall between two sky
         # ceilings meets sky at once
-        over_sky = ns & bs & (zc > bc) & (zc <= nc) & ~wall_stop
+        over_sky = ns & bs & (zc > np.maximum(bc, nf)) & (zc <= nc) & ~wall_stop
         sky_id = (KIND_CEIL << 24) | (nsec if sky_owner == "near" else bsec)
         cf, cc = fl[cur][None, :], ce[cur][None, :]
         # a plane is seen from its own side only: the ray goes down through the floor or up
