@@ -9,11 +9,20 @@ within one light step and (u', v') within one texel (the 3 x 3 texels round (u, 
 texture wraps), 27 candidates.
 
 Which pixels are compared (Expect.cat): walls (1), floors (2), ceilings (3) and sky (4) with a
-texture, and sprites (5: WAD things drawn as their sprites, docs/objects.md "Sprites"). Not
+texture, sprites (5: WAD things drawn as their sprites, docs/objects.md "Sprites") and see-through
+middle textures (6, "midtex": docs/textures.md "See-through middle textures"). Not
 compared (0): no surface, objects drawn as their boxes (flat colours), and parts or planes
 without a texture ('-', a name the WAD does not have, or Doom's texture 0, which Doom never draws),
 which keep their flat colour. compare() takes the world's pixels where the renderer's id buffer
-shows no object, and the sprite pixels where it shows the same object as the reference.
+shows no object, and the sprite and middle texture pixels where it shows the same object as the
+reference.
+
+A see-through middle texture's pixel (refrender.cast_view gives its exact column and row): the
+texel of the side's middle texture there, wrapped as the texture wraps, under the light of the
+side's walls (its sector's light, the fake contrast, Doom's scale light at the pixel's depth).
+Its candidates are the 3 x 3 texels round it, a neighbour in a hole standing for the texel
+itself, under the tables within one step. The texture's texels and coverage are composed here
+(Look.mid_texture: compose(..., cover=True) marks the texels some patch's post covers).
 
 A sprite pixel (refrender.cast_view gives its image and texel): the texel of the image at the
 column and row the pixel's centre ray meets (a mirrored image flipped), its light table 0 when the
@@ -37,9 +46,10 @@ import numpy as np
 W, H = 320, 200
 FOCAL = 160.0
 NLIGHTS = 32
-CAT_NONE, CAT_WALL, CAT_FLOOR, CAT_CEIL, CAT_SKY, CAT_SPRITE = 0, 1, 2, 3, 4, 5
+CAT_NONE, CAT_WALL, CAT_FLOOR, CAT_CEIL, CAT_SKY, CAT_SPRITE, CAT_MID = 0, 1, 2, 3, 4, 5, 6
 CAT_NAMES = {CAT_WALL: "wall", CAT_FLOOR: "floor", CAT_CEIL: "ceiling", CAT_SKY: "sky",
-             CAT_SPRITE: "sprite"}
+             CAT_SPRITE: "sprite", CAT_MID: "midtex"}
+OBJECT_CATS = (CAT_SPRITE, CAT_MID)   # compared where the renderer shows the same object
 UNPEG_TOP, UNPEG_BOTTOM = 8, 16      # Doom's linedef flags
 
 
@@ -109,10 +119,13 @@ def read_patch(data):
     return w, h, cols
 
 
-def compose(width, height, patches):
+def compose(width, height, patches, cover=False):
     """Doom's composition: patches [(originx, originy, patch lump)] in order, each post clipped
-    to the texture, later over earlier; texel 0 where none covers."""
+    to the texture, later over earlier; texel 0 where none covers. cover: return (texels,
+    covered) with covered[u, v] True where a post of some patch covers the texel (a texture's
+    holes are where it is False: docs/textures.md "See-through middle textures")."""
     cols = np.zeros((width, height), np.uint8)
+    covered = np.zeros((width, height), bool)
     for ox, oy, lump in patches:
         _, _, pcols = read_patch(lump)
         for c, posts in enumerate(pcols):
@@ -124,7 +137,8 @@ def compose(width, height, patches):
                 a, b = max(0, y0), min(height, y0 + len(px))
                 if a < b:
                     cols[x, a:b] = np.frombuffer(px, np.uint8)[a - y0:b - y0]
-    return cols
+                    covered[x, a:b] = True
+    return (cols, covered) if cover else cols
 
 
 def read_texture_defs(wad):
@@ -186,11 +200,12 @@ class Look:
         s1 = lin["s1"].astype(np.int64)
         self.side_def = np.stack([lin["s0"].astype(np.int64), np.where(s1 == 0xFFFF, -1, s1)], 1)
         self.xoff, self.yoff = sd["xo"].astype(float), sd["yo"].astype(float)
+        self.mid_name = [_name8(n) for n in sd["mid"]]      # each sidedef's middle texture name
         self.sector_light = sec["light"].astype(np.int64)
         self.defs, self.tex0 = read_texture_defs(wad)
         self.sky = sky_name(m.name.rsplit(":", 1)[1])
         # texture numbers: names in order of first use; -1 none
-        self.names, self._num, self._tex = [], {}, {}
+        self.names, self._num, self._tex, self._mid = [], {}, {}, {}
         self.side_tex = np.array([[self.number(_name8(r[k]), False) for k in ("up", "mid", "lo")]
                                   for r in sd], np.int64).reshape(len(sd), 3)
         self.floor_tex = np.array([self.number(_name8(n), True) for n in sec["ff"]], np.int64)
@@ -207,6 +222,16 @@ class Look:
             self._tex[self._num[key]] = image
         return self._num[key]
 
+    def mid_number(self, name):
+        """The number of a see-through middle texture (mid_texture(name) has it) among the
+        names, as (name, "mid"); texture() gives its texels (a Texture) back."""
+        key = (name, "mid")
+        if key not in self._num:
+            self._num[key] = len(self.names)
+            self.names.append(key)
+            self._tex[self._num[key]] = self.mid_texture(name)[0]
+        return self._num[key]
+
     def number(self, name, flat):
         key = (name, flat)
         if key not in self._num:
@@ -215,6 +240,29 @@ class Look:
             if ok:
                 self.names.append(key)
         return self._num[key]
+
+    def mid_texture(self, name):
+        """A wall texture as a see-through middle texture (docs/textures.md): (texels, cover),
+        both Textures (cover's texels 1 where a patch covers the texel, 0 in a hole), when the
+        texture has a hole among its shown columns (the largest power of two not above its
+        width) and rows; None when it has none, or the WAD has no such texture ('-', unknown) or
+        cannot compose it. Doom's texture 0 counts like any other (bspc draws it)."""
+        if name not in self._mid:
+            got = None
+            if name in self.defs:
+                w, h, pats = self.defs[name]
+                lumps = [(ox, oy, self.wad.lump(p) if p else None) for ox, oy, p in pats]
+                try:
+                    if any(lump is None for _, _, lump in lumps) or w <= 0 or h <= 0:
+                        raise ValueError
+                    texels, covered = compose(w, h, lumps, cover=True)
+                    shown = 1 << (w.bit_length() - 1)
+                    if not covered[:shown].all():
+                        got = (Texture(name, texels), Texture(name, covered.astype(np.uint8)))
+                except (ValueError, struct.error, IndexError):
+                    got = None
+            self._mid[name] = got
+        return self._mid[name]
 
     def texture(self, i):
         """Texture number i (a Texture), composed or read on first use; None if it cannot be.
@@ -447,7 +495,8 @@ def expect(view):
     e.colour = np.zeros((H, W), np.uint8)
     e.cand = np.zeros((H, W, 27), np.uint8)
     _sprites(view, lk, e)
-    on = (e.cat > 0) & (e.cat != CAT_SPRITE)
+    _mids(view, lk, e)
+    on = (e.cat > 0) & ~np.isin(e.cat, OBJECT_CATS)
     ui = np.floor(np.where(on, e.u, 0)).astype(np.int64)
     vi = np.floor(np.where(on, e.v, 0)).astype(np.int64)
     du, dv = np.meshgrid([-1, 0, 1], [-1, 0, 1], indexing="ij")
@@ -504,17 +553,49 @@ def _sprites(view, lk, e):
         e.cand[sel] = lk.lights[tabs[None, :, None], near9[:, None, :]].reshape(-1, 27)
 
 
+def _mids(view, lk, e):
+    """The see-through middle texture pixels of a view (refrender.MidDraw; docs/textures.md):
+    cat, tex (the texture's number as (name, "mid")), u, v (the exact column and row), table
+    (the light of the side's walls: its sector's light, the fake contrast, the scale light at
+    the pixel's depth), the colour lights[table][texel] and the candidates: the 3 x 3 texels
+    round it (a neighbour in a hole counts as the texel itself) under the tables within one
+    step."""
+    du, dv = np.meshgrid([-1, 0, 1], [-1, 0, 1], indexing="ij")
+    du, dv = du.ravel(), dv.ravel()
+    for d in getattr(view, "mids", None) or []:
+        if d is None:
+            continue
+        sel = (view.obj == d.obj) & ~np.isnan(view.mid_u)
+        if not sel.any():
+            continue
+        mid = d.mid
+        tex, cover = mid.tex, mid.cover
+        u0 = np.floor(view.mid_u[sel]).astype(np.int64)
+        v0 = np.floor(view.mid_v[sel]).astype(np.int64)
+        table = wall_table(light_start(lk.sector_light[mid.sector], mid.adj), view.obj_t[sel])
+        e.cat[sel] = CAT_MID
+        e.tex[sel] = lk.mid_number(mid.name)
+        e.u[sel], e.v[sel] = view.mid_u[sel], view.mid_v[sel]
+        e.table[sel] = table
+        texel = tex.texel(u0, v0)
+        e.colour[sel] = lk.lights[table, texel]
+        un, vn = u0[:, None] + du[None, :], v0[:, None] + dv[None, :]           # (n, 9)
+        near9 = np.where(cover.texel(un, vn) != 0, tex.texel(un, vn), texel[:, None])
+        tabs = np.clip(table[:, None] + np.array([-1, 0, 1])[None, :], 0, NLIGHTS - 1)  # (n, 3)
+        e.cand[sel] = lk.lights[tabs[:, :, None], near9[:, None, :]].reshape(-1, 27)
+
+
 def compare(e, frame, ids=None):
     """Compare a renderer's frame (200, 320 palette indices) with an Expect: the pixels compared
     are those with a texture in the reference and no object in the renderer's id buffer (ids,
-    optional), and the reference's sprite pixels where the renderer's id buffer shows the same
-    object. Returns (ok (200, 320) bool, compared (200, 320) bool, counts {category name:
-    (acceptable, compared)}, with "all")."""
+    optional), and the reference's sprite and middle texture pixels where the renderer's id
+    buffer shows the same object. Returns (ok (200, 320) bool, compared (200, 320) bool,
+    counts {category name: (acceptable, compared)}, with "all")."""
     frame = np.asarray(frame, np.uint8).reshape(H, W)
     compared = e.cat > 0
     if ids is not None:
         ids = np.asarray(ids).reshape(H, W)
-        compared &= np.where(e.cat == CAT_SPRITE, ids == e.ids, (ids >> 24) != 4)
+        compared &= np.where(np.isin(e.cat, OBJECT_CATS), ids == e.ids, (ids >> 24) != 4)
     ok = e.accept(frame) & compared
     counts = {name: (int(ok[e.cat == c].sum()), int(compared[e.cat == c].sum()))
               for c, name in CAT_NAMES.items()}

@@ -38,8 +38,9 @@ decided with arrays:
   not both ceilings sky) or the lower part (height < B.floor, when B.floor > N.floor) is the
   wall, same id; otherwise the ray goes on into B.
 - Doom's sky rule: between two sky ceilings there is no upper wall; a ray that goes over it
-  (B.ceil < height <= N.ceil) sees sky at once: kind 3 of N (default, `sky_owner="near"`: Doom's
-  visplane owner, and what build/render draws) or of B (`"far"`).
+  (max(B.ceil, N.floor) < height <= N.ceil: where the upper wall would be) sees sky at once:
+  kind 3 of N (default, `sky_owner="near"`: Doom's visplane owner, and what build/render draws)
+  or of B (`"far"`).
 - after a crossing the current sector is the far-side sector (B, or L's front for a one-sided wall
   crossed from behind). Past the last crossing the ray meets the current sector's floor or
   ceiling (yv is never 0), or nothing (kind 0) when there is none.
@@ -118,6 +119,28 @@ list given to cast_view (build/render's JSON) draws its object i as the sprite o
 object i (its thing type) at the position given. The View records each pixel's texel of its
 sprite image for tools/reflook.py.
 
+See-through middle textures (docs/textures.md "See-through middle textures"). In a WAD map with its
+look, each side of a two-sided line whose middle texture has holes is an object (MidSide), after
+the things' objects: in line order, side 0 before side 1, each with a model of its own (one quad)
+after the things' models, as bspc numbers them (tools/bspc/mids.c). The texture and its coverage
+are composed here from TEXTURE1/TEXTURE2, PNAMES and the patches (tools/reflook.py: Look.mid_texture);
+it has holes when a texel of its shown columns (the largest power of two not above its width) and
+rows is covered by no patch's post. Its quad: the whole line, heights [max(max floor, row0 - H),
+min(min ceiling, row0)] with row0 = (lower-unpegged ? max floor + H : min ceiling) + yoff (the
+compiled heights: doors closed), none when empty, none when the line's half-length along x or y
+or the strip's distance from row0 - yoff exceeds 1024 units; the object's origin is the line's
+middle at z = row0 - yoff, yaw 0. The pixel's centre ray (the tie-break sample) meets the quad,
+seen only from its side's front (the right of the line going from the side's left end to its
+right end, the ends and heights inclusive), at forward depth t >= the near plane, point P,
+height h: column u(P) = U . (P - O) + xoff of the side's walls, row floor(z + yoff - h) (z the
+object's z as given), both wrapped as the texture wraps; the object has the pixel where that
+texel is covered and t is nearer than everything else (ties as for sprites); through a hole the
+ray goes on. An object list given to cast_view draws its object i as the scene's object i's
+middle texture when that is one: its quad (the model's vertices) at the position and yaw given,
+its texel column from the quad's left end (the side's origin O, as compiled), its row from the z
+given; the model number given is only checked to exist. The View records each such pixel's exact
+(u, v) (mid_u, mid_v) for tools/reflook.py (light: the side's walls', at depth t).
+
 Eye sector (default eye height = its floor + 41, or 41 in none): even-odd ray crossing over each
 sector's lines (a line with the sector on both sides counts twice and cancels); if several
 sectors claim the point (a map whose sectors overlap), the one facing the point across the
@@ -126,9 +149,10 @@ nearest line crossing the ray to +x wins.
 Colours (a WAD map; tools/reflook.py, docs/textures.md): --raw writes the expected frame (64,000
 palette indices, 0 where not compared: objects drawn as boxes, nothing, no texture), --expect an
 .npz of the per-pixel category, texture, u, v, light table, colour and the 27 acceptable colours,
---colour-png the expected frame in the WAD's palette. The colours are of the world and the
+--colour-png the expected frame in the WAD's palette. The colours are of the world, the
 sprites (a sprite pixel: lights[table][texel], table 0 when its frame is full-bright, else the
-light of walls at depth zc in the light of the sector under its origin; tools/reflook.py).
+light of walls at depth zc in the light of the sector under its origin; tools/reflook.py) and
+the see-through middle textures (the light of the side's walls at the pixel's depth).
 
 usage: tools/refrender.py SCENE --at X,Y[,Z] --angle DEG [--look PX] [--ids OUT.bin] [--png OUT.png]
                           [--raw OUT.raw] [--expect OUT.npz] [--colour-png OUT.png]
@@ -176,6 +200,7 @@ class Map:
         self.objects = list(objects)                   # SceneObject, in file / THINGS order
         self.open_h = self.ceil.copy() if open_h is None else np.asarray(open_h, float)
         self.sprites = [None] * len(self.objects)     # each object's SpriteSet, None: its model
+        self.mids = [None] * len(self.objects)        # each object's MidSide, None: not one
         self.textured = False                          # a WAD map drawn with its look and sprites
 
     @property
@@ -734,7 +759,76 @@ def read_wad(spec, flat=False):
         m.models, m.objects, m.sprites = wad_objects(thing, table,
                                                      lambda x, y: sector_at(m, x, y) is not None,
                                                      sets)
+    m.nthings = len(m.objects)
+    m.mids = [None] * len(m.objects)
+    if m.textured:
+        import reflook
+        for mid in wad_mids(m, reflook.look_of(m)):
+            mid.obj, mid.model = len(m.objects), len(m.models)
+            m.models.append(Model(f"mid{mid.line}.{mid.side}", [(mid.verts, [[0, 1, 2, 3]])]))
+            m.objects.append(SceneObject(mid.model, mid.x, mid.y, mid.top, 0.0))
+            m.sprites.append(None)
+            m.mids.append(mid)
     return m
+
+
+MID_REACH = 1024.0    # a model's coordinate limit (SCN_MODEL_MAX): a mid quad's reach from its origin
+
+
+class MidSide:
+    """A see-through middle texture drawn as an object (docs/textures.md "See-through middle
+    textures"): line (refrender's line number) and side (0 front, 1 back), the sidedef's texture
+    name, tex and cover (reflook.Texture of its texels and of its coverage: 1 covered, 0 a
+    hole), xoff and yoff (the sidedef's offsets), top (the height of the texture's row 0 less
+    yoff: the object's z), zb and zt (the quad's heights), sector (the side's) and adj (the fake
+    contrast), the object's origin (x, y: the line's middle) and its model's four vertices
+    verts (4, 3) relative to (x, y, top): the side's left end (its origin O) and right end as
+    its viewer sees them at zb, then the same at zt. obj and model: its numbers in the scene."""
+
+
+def wad_mids(m, lk):
+    """The MidSides of a textured WAD map, in bspc's order (tools/bspc/mids.c): two-sided lines
+    in line order, side 0 before side 1; each side whose middle texture has holes
+    (lk.mid_texture), pegged as Doom pegs it with the compiled heights (a door closed): row0 =
+    (lower-unpegged ? max floor + H : min ceiling) + yoff, the quad [max(max floor, row0 - H),
+    min(min ceiling, row0)] along the whole line, none when that is empty; a line whose
+    half-length along x or y, or a strip whose distance from row0 - yoff, exceeds 1024 units
+    is left out (a model's coordinate limit). lk: the map's reflook.Look."""
+    import reflook
+    out = []
+    for i in np.nonzero(m.back >= 0)[0]:
+        a, b = int(m.front[i]), int(m.back[i])
+        lo, hi = max(m.floor[a], m.floor[b]), min(m.ceil[a], m.ceil[b])
+        for k in (0, 1):
+            sd = int(lk.side_def[i, k])
+            if sd < 0:
+                continue
+            got = lk.mid_texture(lk.mid_name[sd])
+            if got is None:
+                continue
+            tex, cover = got
+            top = lo + tex.height if lk.flags[i] & reflook.UNPEG_BOTTOM else hi
+            row0 = top + lk.yoff[sd]
+            zt, zb = min(row0, hi), max(row0 - tex.height, lo)
+            if zb >= zt:
+                continue
+            # the side as its viewer sees it, left end first: v1 -> v2 for the front side
+            ax, ay, bx, by = m.x1[i], m.y1[i], m.x2[i], m.y2[i]
+            if k:
+                ax, ay, bx, by = bx, by, ax, ay
+            mx, my = (ax + bx) / 2, (ay + by) / 2
+            if max(abs(ax - mx), abs(ay - my), zt - top, top - zb) > MID_REACH:
+                continue
+            d = MidSide()
+            d.line, d.side, d.name, d.tex, d.cover = int(i), k, lk.mid_name[sd], tex, cover
+            d.xoff, d.yoff, d.top, d.zb, d.zt = float(lk.xoff[sd]), float(lk.yoff[sd]), float(top), zb, zt
+            d.sector = a if k == 0 else b
+            d.adj = -1 if m.y1[i] == m.y2[i] else (1 if m.x1[i] == m.x2[i] else 0)
+            d.x, d.y = float(mx), float(my)
+            d.verts = np.array([(ax - mx, ay - my, zb - top), (bx - mx, by - my, zb - top),
+                                (bx - mx, by - my, zt - top), (ax - mx, ay - my, zt - top)], float)
+            out.append(d)
+    return out
 
 
 def _wad_textured(m):
@@ -743,7 +837,7 @@ def _wad_textured(m):
     is sky). A WAD whose texture lumps cannot be read is not."""
     try:
         import reflook
-        lk = reflook.Look(m)
+        lk = reflook.look_of(m)
     except (ValueError, TypeError, KeyError, IndexError, AttributeError, struct.error):
         return False
     return bool((lk.side_tex >= 0).any() or (lk.floor_tex >= 0).any() or (lk.ceil_tex >= 0).any()
@@ -983,6 +1077,80 @@ def _sprite_hits(draws, best, who, ez, xv, yv):
     return col, row, su, sv
 
 
+def mid_draws(m, states):
+    """[MidDraw or None] per object of states: object i of the list is drawn as the scene's
+    object i's see-through middle texture when that object is one (m.mids), its quad (the
+    model's four vertices) placed at the position and yaw given; None else."""
+    out = []
+    for i, (_, ox, oy, oz, yaw) in enumerate(states):
+        mid = m.mids[i] if i < len(m.mids) else None
+        if mid is None:
+            out.append(None)
+            continue
+        c, s_ = math.cos(math.radians(float(yaw))), math.sin(math.radians(float(yaw)))
+        w = np.empty_like(mid.verts)
+        w[:, 0] = float(ox) + c * mid.verts[:, 0] - s_ * mid.verts[:, 1]
+        w[:, 1] = float(oy) + s_ * mid.verts[:, 0] + c * mid.verts[:, 1]
+        w[:, 2] = float(oz) + mid.verts[:, 2]
+        d = MidDraw()
+        d.obj, d.mid, d.z, d.quad = i, mid, float(oz), w
+        out.append(d)
+    return out
+
+
+class MidDraw:
+    """One see-through middle texture drawn in a view: its object index, its MidSide (mid), the
+    object's z as drawn (row 0 of the texture is at z + mid.yoff) and its quad in world space
+    (4, 3): left end, right end at the bottom, then the right and left ends at the top."""
+
+
+def _mid_hits(draws, best, who, ex, ey, ez, dx, dy, yv):
+    """Draw the see-through middle textures into (best, who) (depth and object per pixel, as
+    _object_hits and _sprite_hits leave them): the pixel's centre ray meets the quad (seen only
+    from its front, the right of its bottom edge left to right; the ends and heights inclusive)
+    at depth t >= the near plane, point P and height h; the texel column is the side's u(P) =
+    U . (P - O) + xoff (O the quad's left end, U the unit vector to its right end), the row
+    z + yoff - h; the object has the pixel where that texel is covered and t is nearer than
+    what the pixel has (an exact tie: the lower object number), else the ray goes on.
+    Returns per pixel the exact (u, v) (nan where no middle texture won)."""
+    su, sv = np.full((H, W), np.nan), np.full((H, W), np.nan)
+    for d in draws:
+        if d is None:
+            continue
+        (axx, ayy, z0), (bxx, byy, _), (_, _, z1), _ = d.quad
+        wx, wy = bxx - axx, byy - ayy
+        ax, ay = axx - ex, ayy - ey                             # A - E
+        if not wx * (-ay) - wy * (-ax) < 0:                     # the eye is not on its front
+            continue
+        denom = dx * wy - dy * wx
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = (ax * wy - ay * wx) / denom
+            s = (ax * dy - ay * dx) / denom
+        cs = np.nonzero((denom != 0) & (s >= 0) & (s <= 1) & (t >= ZNEAR))[0]
+        if not len(cs):
+            continue
+        tc = t[cs]
+        h = ez + yv[:, None] * tc[None, :]                      # (200, n)
+        inside = (h >= z0) & (h <= z1)
+        ln = math.hypot(wx, wy)
+        ux, uy = wx / ln, wy / ln
+        u = (-ax) * ux + (-ay) * uy + tc * (dx[cs] * ux + dy[cs] * uy) + d.mid.xoff
+        v = d.z + d.mid.yoff - h
+        ui = np.floor(u).astype(np.int64)
+        vi = np.floor(np.where(inside, v, 0)).astype(np.int64)
+        covered = d.mid.cover.texel(ui[None, :], vi) != 0
+        sub_best, sub_who = best[:, cs], who[:, cs]
+        nearer = inside & covered & ((tc[None, :] < sub_best) |
+                                     ((tc[None, :] == sub_best) & (d.obj < sub_who)))
+        if not nearer.any():
+            continue
+        best[:, cs] = np.where(nearer, tc[None, :], sub_best)
+        who[:, cs] = np.where(nearer, d.obj, sub_who)
+        su[:, cs] = np.where(nearer, u[None, :], su[:, cs])
+        sv[:, cs] = np.where(nearer, v, sv[:, cs])
+    return su, sv
+
+
 # ---- rendering ----------------------------------------------------------------------------
 
 class View:
@@ -995,7 +1163,9 @@ class View:
     Objects: obj (the object a pixel shows, -1 none) and obj_t (its forward depth, inf);
     sprites[i] the SpriteDraw of object i (None: not drawn as a sprite), and per pixel of a
     sprite spr_col, spr_row (the texel of its image; -1 elsewhere) and spr_u, spr_v (the exact
-    image coordinates, u from the right edge for a mirrored image; nan elsewhere)."""
+    image coordinates, u from the right edge for a mirrored image; nan elsewhere); mids[i] the
+    MidDraw of object i (None: not a see-through middle texture) and per pixel of one mid_u,
+    mid_v (its texture's exact column and row; nan elsewhere)."""
 
 
 def render_ids(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="near",
@@ -1017,7 +1187,8 @@ def cast_view(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="n
     as dicts with those keys or as tuples), drawn with ids 4 << 24 | their position in the
     list; None: the scene's own objects at time 0 (object_states). Object i of the list is drawn
     as the sprite of the scene's object i (its thing type, in THINGS order) when that one has
-    sprites, else as its model. ceilings: {sector: height} (keys may be strings, as in
+    sprites, as its see-through middle texture when it is one (m.mids: the objects after the
+    things'), else as its model. ceilings: {sector: height} (keys may be strings, as in
     build/render's JSON "ceilings"), for doors. flat: a WAD map as bspc --flat compiles it
     (scene_spec a spec, not a Map): no sprites, every thing its box."""
     m = load(scene_spec, flat)
@@ -1116,7 +1287,7 @@ def cast_view(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="n
         wall_stop = mid | upper | lower                        # no near sector: nan, culled
         # Doom's sky rule: a ray that goes over the missing upper wall between two sky
         # ceilings meets sky at once
-        over_sky = ns & bs & (zc > bc) & (zc <= nc) & ~wall_stop
+        over_sky = ns & bs & (zc > np.maximum(bc, nf)) & (zc <= nc) & ~wall_stop
         sky_id = (KIND_CEIL << 24) | (nsec if sky_owner == "near" else bsec)
         cf, cc = fl[cur][None, :], ce[cur][None, :]
         # a plane is seen from its own side only: the ray goes down through the floor or up
@@ -1152,12 +1323,15 @@ def cast_view(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="n
             hit_line[:, px] = np.where(crossing, li[j], -1)
             hit_part[:, px] = np.where(crossing, part, -1)
     draws = sprite_draws(m, states, x, y, fxd, fyd, rx, ry)
-    skip = {i for i in range(len(states)) if i < len(m.sprites) and m.sprites[i] is not None}
+    mids = mid_draws(m, states)
+    skip = {i for i in range(len(states)) if mids[i] is not None or
+            (i < len(m.sprites) and m.sprites[i] is not None)}
     parts = world_parts(m, states, skip)
     obj_t, obj = np.full((H, W), np.inf), np.full((H, W), -1, np.int64)
     if parts:
         obj_t, obj = _object_hits(parts, x, y, z, fxd, fyd, rx, ry, look, dx, dy, yv)
     spr = _sprite_hits(draws, obj_t, obj, z, xv, yv)
+    mid_u, mid_v = _mid_hits(mids, obj_t, obj, x, y, z, dx, dy, yv)
     front = obj_t < world_t
     out[front] = ((KIND_OBJECT << 24) | obj[front]).astype(np.uint32)
     obj[~front] = -1
@@ -1166,12 +1340,15 @@ def cast_view(scene_spec, x, y, z=None, angle=0.0, look=0, fx=True, sky_owner="n
     spr_col, spr_row, spr_u, spr_v = spr
     spr_col[~is_spr], spr_row[~is_spr] = -1, -1
     spr_u[~is_spr], spr_v[~is_spr] = np.nan, np.nan
+    is_mid = np.array([d is not None for d in mids] + [False], bool)[obj]
+    mid_u[~is_mid], mid_v[~is_mid] = np.nan, np.nan
     v = View()
     v.scene, v.x, v.y, v.z, v.angle, v.look = m, x, y, z, float(angle), look
     v.dx, v.dy, v.yv = dx, dy, yv
     v.ids, v.t, v.line, v.part, v.ceil = out, world_t, hit_line, hit_part, ce[:-1]
     v.obj, v.obj_t, v.sprites = obj, obj_t, draws
     v.spr_col, v.spr_row, v.spr_u, v.spr_v = spr_col, spr_row, spr_u, spr_v
+    v.mids, v.mid_u, v.mid_v = mids, mid_u, mid_v
     return v
 
 

@@ -9,9 +9,9 @@ docs/objects.md "Sprites"; --no-objects: the world alone) and its expected colou
 one texel and one light step of the reference's (docs/textures.md; a sprite's texel in its
 image, its light table by the sprites' light rule). Compared: wall, floor, ceiling and sky pixels
 with a texture in the reference where the renderer's id buffer shows no object, and the
-reference's sprite pixels where the renderer's id buffer shows the same object ("sprite" in the
-counts). Prints one JSON object; --diff writes the frame with the failures in red (the pixels not
-compared dimmed). Exit status 0, or 1 on bad input.
+reference's sprite pixels and see-through middle texture pixels where the renderer's id buffer
+shows the same object ("sprite" and "midtex" in the counts). Prints one JSON object; --diff
+writes the frame with the failures in red (the pixels not compared dimmed). Exit status 0, or 1 on bad input.
 
 usage: tools/texcompare.py WAD:MAP --raw FRAME --ids IDS [--at X,Y[,Z]] [--angle DEG] [--look PX]
                            [--door SECTOR=H]... [--no-objects] [--time MS] [--diff OUT.png]
