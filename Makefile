@@ -92,7 +92,7 @@ $(eval $(call variant,$(BUILD)/san,$(SAN)))
 # many batches, and mode direct with room for the faces of one object or so, so
 # that the others are worked out again where needed (tests/test_span_batches.py
 # compares its frames with build/render's).
-$(eval $(call variant,$(BUILD)/tinypools,$(REL) -DSPANS_POOL_EDGES=72u -DSPANS_POOL_SURFACES=6u -DCFG_DIRECT_FACES=3u -DCFG_DIRECT_EDGES=90u \
+$(eval $(call variant,$(BUILD)/tinypools,$(REL) -DSPANS_POOL_EDGES=72u -DSPANS_POOL_SURFACES=6u -DCFG_DIRECT_FACES=1u -DCFG_DIRECT_EDGES=12u \
                                           -DCFG_COLS_PLANES=4u))
 $(BUILD)/tinypools/obj/tools/bspc/wad.o: $(THINGS_H)
 $(BUILD)/tinypools/obj/tools/bspc/wad.o: BASE += -I$(GEN)
