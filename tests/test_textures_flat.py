@@ -61,8 +61,15 @@ def test_same_surfaces_textured_and_flat(view, mode, tmp_path):
     rflat, rflat_ids, rflat_raw = draw(render, view, mode, tmp_path, "rflat", "--flat")
     bflat, bflat_ids, bflat_raw = draw(flat, view, mode, tmp_path, "bflat")
     assert (tex["textured"], rflat["textured"], bflat["textured"]) == (1, 0, 0)
-    assert tex_ids == rflat_ids == bflat_ids, "texturing changed which surface a pixel shows"
-    assert rflat_raw == bflat_raw, "--flat and the flat build draw different colours"
+    assert tex_ids == rflat_ids, "texturing changed which surface a pixel shows"
+    # the flat build has no texture code, so no sprites or see-through middle textures: it draws those
+    # objects as their boxes and quads (docs/objects.md); every other pixel is the same surface
+    import numpy as np
+    t, b = np.frombuffer(tex_ids, "<u4"), np.frombuffer(bflat_ids, "<u4")
+    world = ((t >> 24) != 4) & ((b >> 24) != 4)
+    assert np.array_equal(t[world], b[world]), "the flat build shows other surfaces"
+    if not ((t >> 24) == 4).any():
+        assert rflat_raw == bflat_raw, "--flat and the flat build draw different colours"
     assert tex_raw != rflat_raw, "the textured frame is not textured"
     for out in (tex, rflat, bflat):
         assert out["overdraw"] == 1.0 or mode == "painter"
@@ -82,6 +89,8 @@ def test_texels_do_not_depend_on_the_mode(view, tmp_path):
     ids0, raw0 = frames["direct"]
     for mode in ("spans", "painter"):
         ids, raw = frames[mode]
-        same = ids == ids0
-        assert same.mean() > 0.9  # painter sorts objects inexactly by design; most pixels still compare
+        # objects left out: mode spans draws a sprite thing as its box in flat colour (docs/objects.md)
+        objects = ((ids >> 24) == 4) | ((ids0 >> 24) == 4)
+        same = (ids == ids0) & ~objects
+        assert (same | objects).mean() > 0.9  # painter sorts objects inexactly by design; most pixels compare
         assert np.array_equal(raw[same], raw0[same]), f"{mode}: {(raw[same] != raw0[same]).sum()} pixels differ"

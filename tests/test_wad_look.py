@@ -176,7 +176,10 @@ def test_look_sections_hold_exactly_what_the_map_uses(tmp_path, wad, mapname):
         walls.add(("SKY1" if n < 12 else "SKY2" if n < 21 else "SKY3") if n else f"SKY{mapname[1]}")
     # a frame of an animation brings its whole sequence
     walls, used_flats = with_animations(lumps, walls & set(defs), used_flats & flats)
-    expected = len(walls & set(defs)) + len(used_flats & flats)
+    # and a middle texture with holes on a two-sided line its opacity map (docs/textures.md)
+    off, n = sec[SEC_TEXTURES]
+    masks = {struct.unpack_from("<H", blob, off + 12 * i + 10)[0] for i in range(n)} - {0xFFFF}
+    expected = len(walls & set(defs)) + len(used_flats & flats) + len(masks)
     assert len(texs) == expected, (len(texs), expected)
     look_sky = struct.unpack_from("<I", blob, sec[SEC_LOOK][0])[0]
     assert (look_sky != TEX_NONE) == sky and (not sky or look_sky < len(texs))
