@@ -542,3 +542,33 @@ def test_render_sprite_colours_against_reference(mode, tmp_path):
     assert compared_px >= 0.95 * ref_px, \
         f"only {compared_px} of {ref_px} sprite pixels drawn as the same object"
     assert ok_px >= MIN_TEX * compared_px, f"{ok_px} of {compared_px} sprite pixels acceptable"
+
+
+# ---- build/render on the crafted map --------------------------------------------------------
+
+PWAD_VIEWS = [(380, -100, 0),    # the imp behind the step and beside the pillar
+              (700, 150, 180),   # the barrel (a box: its sprite has 7 of 8 rotations) and the imps beyond
+              (140, -100, 0)]    # along the room, both imps and the soul
+
+
+@pytest.mark.parametrize("mode", EXACT_MODES)
+def test_render_clips_sprites_and_boxes_as_the_reference(pwad, mode, tmp_path):
+    """build/render on the crafted map, compiled by bspc: the imp hidden by the step and the
+    pillar where the reference hides it, and sprites and a box (the barrel) in one frame sorted
+    against each other and the world as the reference sorts them."""
+    spec, _ = pwad
+    bsc = tmp_path / "p.bsc"
+    run([program("bspc"), spec, "-o", bsc])
+    kinds = set()
+    for x, y, angle in PWAD_VIEWS:
+        ids_path = tmp_path / "p.ids"
+        j = json.loads(run([program("render"), bsc, "--at", f"{x},{y}", "--angle", str(angle), "--mode", mode,
+                            "--ids", ids_path]).stdout)
+        ids = np.fromfile(ids_path, "<u4").reshape(200, 320)
+        c = j["camera"]
+        v = refrender.cast_view(spec, c["x"], c["y"], c["z"], c["angle"], c["look"], objects=j["objects"])
+        same = float((ids == v.ids).mean())
+        assert same >= 0.999, f"{x},{y} {angle}: only {same:.4%} of pixels agree"
+        shown = {int(i) & 0xFFFFFF for i in np.unique(ids[(ids >> 24) == 4])}
+        kinds |= {"sprite" if v.sprites[i] is not None else "box" for i in shown}
+    assert kinds == {"sprite", "box"}, kinds
