@@ -10,8 +10,8 @@ static int rotation(int64_t dx, int64_t dy, fx_t yaw_deg)
     /* turn d by 22.5 degrees less the yaw; 2^25 raw bounds |d| (< 2^33) shifted by 8 */
     fx_ang_t a = fx_ang_from_deg(22 * 65536 + 32768) - fx_ang_from_deg(yaw_deg);
     int64_t c = fx_cos(a), sn = fx_sin(a);
-    dx >>= 8;
-    dy >>= 8;
+    dx = fx_asr64(dx, 8);
+    dy = fx_asr64(dy, 8);
     int64_t x = dx * c - dy * sn, y = dx * sn + dy * c;
     int s = 0;
     if (y < 0 || (y == 0 && x < 0)) x = -x, y = -y, s = 4; /* [180, 360) */
@@ -46,7 +46,7 @@ int spr_view_of(const scene *s, const obj_state *o, uint32_t sprset, const view_
     int r = rotation(dx, dy, o->yaw_deg);
     const scn_sprite *p = &s->sprites[set->image[r]];
     /* heights as objd_transform takes them, so the bottom on a floor lies in its plane */
-    int64_t top = (int64_t)o->z + ((int64_t)p->top << 16), bottom = top - ((int64_t)p->height << 16);
+    int64_t top = (int64_t)o->z + (int64_t)p->top * 65536, bottom = top - (int64_t)p->height * 65536;
     if (bottom < o->z) bottom = o->z;
     if (bottom >= top) return 0;
     sv->image = set->image[r];
