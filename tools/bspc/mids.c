@@ -64,9 +64,12 @@ static int add_mid(bs_scene *s, uint32_t i, int k, const char *display, const bs
     int64_t ax = s->vx[va], ay = s->vy[va], bx = s->vx[vb], by = s->vy[vb];
     int64_t mx = (ax + bx) / 2, my = (ay + by) / 2;
     if (ax - mx > MID_REACH || mx - ax > MID_REACH || ay - my > MID_REACH || my - ay > MID_REACH ||
-        zt - top > MID_REACH || top - zb > MID_REACH) {
-        bs_note(opt, "%s: line %u side %d: middle texture spans more than %d units from its middle: not drawn", display,
-                i, k, SCN_MODEL_MAX);
+        zt - top > MID_REACH || top - zb > MID_REACH || top > ((int64_t)SCN_HEIGHT_MAX << 16) ||
+        top < -((int64_t)SCN_HEIGHT_MAX << 16)) {
+        bs_note(opt,
+                "%s: line %u side %d: middle texture spans more than %d units from its middle, or is pegged "
+                "beyond a height of %d: not drawn",
+                display, i, k, SCN_MODEL_MAX, SCN_HEIGHT_MAX);
         return 0;
     }
     if (s->nobjects >= SCN_MAX_OBJECTS)
