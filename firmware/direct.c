@@ -89,11 +89,10 @@ static uint32_t work_bytes(const world_state *w, int own_mask)
     uint32_t n = objl_capacity(w);
     if (n > SCN_MAX_OBJECTS) return 0; /* more than the format allows (an object record holds 16 bits): refuse */
     uint64_t total = align8(sizeof(dr_state)) + (own_mask ? align8(sizeof(cov_mask)) : 0);
-    if (n) /* within another mode's frame the pools are the list's unused room (widen_pools) */
+    if (n)
         total += align8((uint64_t)n * sizeof(dr_obj)) + align8((uint64_t)n * sizeof(uint16_t)) +
-                 (own_mask ? align8((uint64_t)DIRECT_FACE_POOL * sizeof(dr_face)) +
-                                 align8((uint64_t)DIRECT_EDGE_POOL * sizeof(dr_edge))
-                           : 0);
+                 align8((uint64_t)DIRECT_FACE_POOL * sizeof(dr_face)) +
+                 align8((uint64_t)DIRECT_EDGE_POOL * sizeof(dr_edge));
     return total > 0xFFFFFFF0u ? 0 : (uint32_t)total;
 }
 
@@ -735,8 +734,8 @@ static void widen_pools(dr_state *S, uint32_t n, uint8_t *end)
     uint16_t *active = (uint16_t *)(void *)p;
     p += align8((uint64_t)S->nobjs * sizeof(uint16_t));
     uint64_t room = (uint64_t)(end - p), faces = room / (sizeof(dr_face) + 4u * sizeof(dr_edge));
-    if (S->nobjs >= n || faces <= S->face_cap) return; /* no more than the pools it has */
-    if (faces > 65535u) faces = 65535u;                /* their indices are 16 bits */
+    if (S->nobjs >= n || faces <= DIRECT_FACE_POOL) return; /* no more than the fixed pools */
+    if (faces > 65535u) faces = 65535u;                     /* their indices are 16 bits */
     uint64_t edges = (room - align8(faces * sizeof(dr_face))) / sizeof(dr_edge);
     S->active = active;
     S->faces = (dr_face *)(void *)p;
@@ -783,13 +782,12 @@ void direct_render_within(const scene *sc, const world_state *w, const view_xfor
     mem += n ? align8((uint64_t)n * sizeof(dr_obj)) : 0;
     S->active = (uint16_t *)(void *)mem;
     mem += n ? align8((uint64_t)n * sizeof(uint16_t)) : 0;
-    int pools = n && !only; /* within another mode's frame: none of their own (widen_pools) */
     S->faces = (dr_face *)(void *)mem;
-    mem += pools ? align8((uint64_t)DIRECT_FACE_POOL * sizeof(dr_face)) : 0;
+    mem += n ? align8((uint64_t)DIRECT_FACE_POOL * sizeof(dr_face)) : 0;
     S->edges = (dr_edge *)(void *)mem;
-    mem += pools ? align8((uint64_t)DIRECT_EDGE_POOL * sizeof(dr_edge)) : 0;
-    S->face_cap = pools ? DIRECT_FACE_POOL : 0;
-    S->edge_cap = pools ? DIRECT_EDGE_POOL : 0;
+    mem += n ? align8((uint64_t)DIRECT_EDGE_POOL * sizeof(dr_edge)) : 0;
+    S->face_cap = DIRECT_FACE_POOL;
+    S->edge_cap = DIRECT_EDGE_POOL;
     S->cov = only ? only : (cov_mask *)(void *)mem;
     S->sc = sc;
     S->w = w;
