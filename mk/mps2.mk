@@ -57,8 +57,8 @@ FW_MODES ?= columns
 COLS_PLANES ?= 10
 # Mode direct's face pools (firmware/build_config.h): small on the board; objects
 # beyond them are worked out again where needed, never dropped.
-DIRECT_FACES ?= 16
-DIRECT_EDGES ?= 96
+DIRECT_FACES ?= 8
+DIRECT_EDGES ?= 48
 # KNOB_DEFS: a precision knob configuration's flags (mk/report.mk), for make report's Cortex-M3 runs.
 KNOB_DEFS ?=
 FW_DEFS = $(call render_modes_def,$(FW_MODES)) $(flat_def) -DCFG_DIRECT_FACES=$(DIRECT_FACES)u -DCFG_DIRECT_EDGES=$(DIRECT_EDGES)u \
