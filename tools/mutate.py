@@ -206,8 +206,7 @@ def run_test(tree, name, timeout):
             cam = (["--at", view["at"], "--angle", view["angle"]] if view["at"] else [])
             for mode, present in GOLDEN_MODES:
                 painter = mode == "painter"
-                want = (view.get("painter_crc32", view["crc32"]) if painter else view["crc32"],
-                        view["painter_overdraw"] if painter else 1.0)
+                want = (view.get(f"{mode}_crc32", view["crc32"]), view["painter_overdraw"] if painter else 1.0)
                 # a WAD's map is found by build/render in DOOMWADDIR, as tests/test_golden.py passes it
                 scene = view["scene"] if ".wad:" in view["scene"] else str(tree / view["scene"])
                 cmds.append(([str(tree / "build/san/render"), scene, *cam, "--mode", mode, "--present", present],
