@@ -102,8 +102,17 @@ def test_tcp_reader_connecting_late_misses_nothing(firmware, tmp_path):
     proc = subprocess.Popen(["make", "run-firmware", f"PORT=tcp:{port}", "RUN_ARGS=--frames 6"], cwd=ROOT,
                             stdout=subprocess.PIPE, stderr=err, env=sys_env)
     try:
-        time.sleep(2.0)  # QEMU has long started and listens; the firmware must not have run yet
-        with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
+        time.sleep(2.0)  # QEMU starts and listens; the firmware must not run before a reader connects
+        deadline = time.time() + 30
+        while True:  # make may take a moment longer to start QEMU on a busy machine
+            try:
+                s = socket.create_connection(("127.0.0.1", port), timeout=10)
+                break
+            except ConnectionRefusedError:
+                if time.time() > deadline:
+                    raise
+                time.sleep(0.5)
+        with s:
             data = read_all(s, time.time() + 60)
         assert proc.wait(timeout=60) == 0
     finally:
