@@ -248,3 +248,26 @@ def outages(damage, accepted, frames_sent):
                         "frames_lost": lost})
         i = k
     return out
+
+
+def capture_run(elf, frames, tmp_path):
+    """Runs the firmware elf for frames frames over TCP and captures them with tools/capture.py
+    (pyserial) into tmp_path/cap: the frames' records (frames.jsonl), each with its render_args."""
+    import json
+    import sys
+    import serial
+    sys.path.insert(0, str(ROOT / "tools"))
+    import capture
+    fw = Firmware("tcp", f"--frames {frames} --linger 1000", elf=elf, tmp=tmp_path)
+    try:
+        port = serial.serial_for_url(fw.port, baudrate=115200, timeout=0.2)
+        fw.start()
+        try:
+            summary = capture.capture(port, frames, tmp_path / "cap", timeout=60, log=sys.stderr)
+        finally:
+            port.close()
+        assert fw.wait(timeout=300) == 0, "".join(fw.log)
+    finally:
+        fw.kill()
+    assert summary["frames_captured"] == frames, summary
+    return [json.loads(line) for line in (tmp_path / "cap" / "frames.jsonl").read_text().splitlines()]

@@ -319,23 +319,8 @@ def firmware_map01():
 def test_captured_frame_with_an_animated_wall_redraws(firmware_map01, tmp_path):
     """The firmware's frames carry their time: a frame whose animated textures differ from time 0's
     is redrawn bit for bit by tools/capture.py --render (build/render --time)."""
-    import serial
-    import capture
-    from linkrig import Firmware
-    frames = 24
-    fw = Firmware("tcp", f"--frames {frames} --linger 1000", elf=firmware_map01, tmp=tmp_path)
-    try:
-        port = serial.serial_for_url(fw.port, baudrate=115200, timeout=0.2)
-        fw.start()
-        try:
-            summary = capture.capture(port, frames, tmp_path / "cap", timeout=60, log=sys.stderr)
-        finally:
-            port.close()
-        assert fw.wait(timeout=300) == 0, "".join(fw.log)
-    finally:
-        fw.kill()
-    assert summary["frames_captured"] == frames, summary
-    records = [json.loads(line) for line in (tmp_path / "cap" / "frames.jsonl").read_text().splitlines()]
+    from linkrig import capture_run
+    records = capture_run(firmware_map01, 24, tmp_path)
     assert [r["time_ms"] for r in records] == sorted(r["time_ms"] for r in records) and records[-1]["time_ms"] > 0
     # the last frame whose animation shows: drawn at time 0 it would differ
     for rec in reversed(records):

@@ -11,7 +11,7 @@ import pytest
 import serial
 
 from conftest import ROOT, program, read_png_indexed, render, run
-from linkrig import ARM, FaultyRelay, Firmware, firmware_link, outages
+from linkrig import ARM, FaultyRelay, Firmware, capture_run, firmware_link, outages
 
 sys.path.insert(0, str(ROOT / "tools"))
 import capture  # noqa: E402
@@ -238,20 +238,7 @@ def test_captured_frame_with_moving_things_redraws(firmware_battle, tmp_path):
     """A frame the firmware sent while its objects were moving is redrawn bit for bit by
     tools/capture.py --render: the frame link carries the engine's time, and build/render --time puts
     every object where the firmware had it."""
-    frames = 12
-    fw = Firmware("tcp", f"--frames {frames} --linger 1000", elf=firmware_battle, tmp=tmp_path)
-    try:
-        port = serial.serial_for_url(fw.port, baudrate=115200, timeout=0.2)
-        fw.start()
-        try:
-            summary = capture.capture(port, frames, tmp_path / "cap", timeout=60, log=sys.stderr)
-        finally:
-            port.close()
-        assert fw.wait(timeout=300) == 0, "".join(fw.log)
-    finally:
-        fw.kill()
-    assert summary["frames_captured"] == frames, summary
-    records = [json.loads(line) for line in (tmp_path / "cap" / "frames.jsonl").read_text().splitlines()]
+    records = capture_run(firmware_battle, 12, tmp_path)
     moved = []
     for rec in records:
         at0 = list(rec["render_args"])
