@@ -7,6 +7,7 @@
  * sequence's phase: frame k (number base + k) then shows frame
  * (T / speed + phase + k) mod n, whatever index the scene gives the frames. */
 #include "anims.h"
+#include "wad_bytes.h"
 
 #include <ctype.h>
 #include <stdlib.h>
@@ -31,18 +32,6 @@ struct bs_anims {
     bs_anim_seq seq[DOOM_ANIMS];
     uint32_t nseq;
 };
-
-static uint32_t rd32(const uint8_t *p)
-{
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
-}
-
-static void name8(char out[9], const uint8_t *p)
-{
-    int i;
-    for (i = 0; i < 8 && p[i]; i++) out[i] = (char)toupper(p[i]);
-    out[i] = 0;
-}
 
 /* The wall textures by Doom's number: TEXTURE1's entries, then TEXTURE2's
  * numbered after TEXTURE1's declared count, up to the first entry whose

@@ -2,19 +2,7 @@
 #include "patch.h"
 
 #include "bspc_int.h"
-
-static uint16_t rd16(const uint8_t *p)
-{
-    return (uint16_t)(p[0] | (p[1] << 8));
-}
-static int16_t rds16(const uint8_t *p)
-{
-    return (int16_t)rd16(p);
-}
-static uint32_t rd32(const uint8_t *p)
-{
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
-}
+#include "wad_bytes.h"
 
 int bs_patch_info_read(const uint8_t *p, uint32_t size, const char *wad, const char *what, bs_patch_info *info,
                        char *err, size_t errlen)

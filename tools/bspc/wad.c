@@ -20,22 +20,10 @@
 
 #include "anims.h"
 #include "bspc_int.h"
+#include "wad_bytes.h"
 #include "things_txt.h" /* bs_things_txt[], bs_things_txt_len: tools/bspc/things.txt */
 
 typedef bs_wadlump lump;
-
-static uint16_t rd16(const uint8_t *p)
-{
-    return (uint16_t)(p[0] | (p[1] << 8));
-}
-static int16_t rds16(const uint8_t *p)
-{
-    return (int16_t)rd16(p);
-}
-static uint32_t rd32(const uint8_t *p)
-{
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
-}
 
 static const char *map_lumps[] = {"THINGS",  "LINEDEFS", "SIDEDEFS", "VERTEXES", "SEGS",    "SSECTORS", "NODES",
                                   "SECTORS", "REJECT",   "BLOCKMAP", "BEHAVIOR", "SCRIPTS", NULL};
@@ -52,14 +40,6 @@ static int read_at(FILE *f, uint32_t pos, uint32_t n, uint8_t *buf)
 {
     if (fseek(f, (long)pos, SEEK_SET) != 0) return -1;
     return fread(buf, 1, n, f) == n ? 0 : -1;
-}
-
-/* texture/flat name field: 8 bytes, NUL padded, upper case */
-static void name8(char out[9], const uint8_t *p)
-{
-    int i;
-    for (i = 0; i < 8 && p[i]; i++) out[i] = (char)toupper(p[i]);
-    out[i] = 0;
 }
 
 /* ---- things (docs/objects.md) ---- */

@@ -16,31 +16,12 @@
 
 #include "anims.h"
 #include "bspc_int.h"
+#include "wad_bytes.h"
 #include "look_cache.h"
 #include "patch.h"
 #include "wad_look_int.h"
 
 enum { BAD_NONE, BAD_COUNT, BAD_ENTRY };
-
-static uint16_t rd16(const uint8_t *p)
-{
-    return (uint16_t)(p[0] | (p[1] << 8));
-}
-static int16_t rds16(const uint8_t *p)
-{
-    return (int16_t)rd16(p);
-}
-static uint32_t rd32(const uint8_t *p)
-{
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
-}
-
-static void name8(char out[9], const uint8_t *p)
-{
-    int i;
-    for (i = 0; i < 8 && p[i]; i++) out[i] = (char)toupper(p[i]);
-    out[i] = 0;
-}
 
 /* the last lump of that name in [from, to), or ndir */
 static uint32_t find_lump(const bs_wadlook *L, const char *name, uint32_t from, uint32_t to)
