@@ -193,7 +193,7 @@ def test_scrolling_wall_moves_one_texel_a_tic(map01, tmp_path):
         assert (moved[wall] != still[wall]).mean() > 0.3, k
         if k < 8:  # nothing else has changed yet
             assert (moved[~wall] == still[~wall]).all()
-        e = texcompare.reference("freedoom2.wad:MAP01", at, angle, 0, time_ms=t)
+        e = texcompare.reference("freedoom2.wad:MAP01", at, angle, 0, objects=[], time_ms=t)
         assert e.accept(moved)[wall].mean() > 0.99
 
 

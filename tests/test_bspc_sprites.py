@@ -13,7 +13,7 @@ SCN_NONE = 0xFFFFFFFF
 SEC = {name: i for i, name in enumerate(
     ["VERTICES", "SECTORS", "LINES", "SEGS", "NODES", "LEAVES", "PVERTS", "PALETTE", "MODELS", "MVERTS", "FACES",
      "FINDEX", "OBJECTS", "NEEDS", "LOOK", "LIGHTS", "TEXTURES", "TEXELS", "SIDES", "PLANES", "SPRITES", "SPRMASK",
-     "SPRSETS"])}
+     "SPRSETS", "ANIMS"])}
 BRIGHT = 1
 
 
@@ -25,7 +25,7 @@ class Blob:
     def __init__(self, data):
         self.data = data
         magic, version, header_bytes, total, crc, flags = struct.unpack_from("<IHHIII", data, 0)
-        assert (data[:4], version, header_bytes, total) == (b"BSCN", 5, 44 + 8 * len(SEC), len(data))
+        assert (data[:4], version, header_bytes, total) == (b"BSCN", 6, 44 + 8 * len(SEC), len(data))
         self.sec = [struct.unpack_from("<II", data, 44 + 8 * i) for i in range(len(SEC))]
         self._images = {}
 
