@@ -28,7 +28,7 @@ BOARD_STACK_BYTES ?= 4096
 BOARD_BASE_SRC := hal/mps2/startup.c hal/mps2/uart.c hal/mps2/semihost.c hal/mps2/log.c hal/mps2/tick.c \
                   hal/bare/format.c hal/bare/libc.c firmware/crc32.c
 BOARD_APP_SRC  := $(BOARD_BASE_SRC) hal/board/main.c hal/board/board_args.c \
-                  hal/serial/fl_framing.c hal/serial/fl_codec.c hal/serial/fl_decoder.c
+                  hal/serial/fl_framing.c hal/serial/fl_codec.c hal/serial/fl_copy.c hal/serial/fl_decoder.c
 BOARD_BOOT_SRC := $(BOARD_BASE_SRC) hal/board/boot.c firmware/dfu/dfu_device.c firmware/dfu/dfu_proto.c
 BOARD_CFLAGS = $(ARM_CFLAGS) -Ihal/board
 # $(1): ROM origin, $(2): ROM bytes

@@ -20,6 +20,7 @@ void fl_dec_init(fl_decoder *d, uint8_t *frame, uint8_t *work, fl_event_fn on_ev
     d->ev_ctx = ev_ctx;
     fl_writer_init(&d->back, back_put, back_ctx);
     d->send_acks = 1;
+    d->want_crc = 1;
     d->window = 4;
 }
 
@@ -103,7 +104,7 @@ static void frame_msg(fl_decoder *d, const fl_msg *m)
     const uint8_t *pic = m->payload + pre;
     uint32_t n = m->len - pre;
     int raw = method == FL_METHOD_RAW || method == FL_METHOD_RAW_HASH;
-    if ((flags & ~1u) || method > FL_METHOD_RAW_HASH || (raw && (!key || n != FL_FRAME_BYTES))) {
+    if ((flags & ~1u) || method > FL_METHOD_COPY || (raw && (!key || n != FL_FRAME_BYTES))) {
         bad(d, FL_R_PAYLOAD);
         return;
     }
@@ -119,13 +120,16 @@ static void frame_msg(fl_decoder *d, const fl_msg *m)
         why = FL_R_NO_BASE;
     } else if (raw) {
         for (uint32_t i = 0; i < FL_FRAME_BYTES; i++) d->recon[i] = pic[i];
+    } else if (method == FL_METHOD_COPY) {
+        if (fl_copy_decode(&d->copy, pic, n, key ? 0 : d->frame, d->recon)) why = FL_R_DECODE;
     } else if (fl_decode_picture(&d->coder, pic, n, key ? 0 : d->frame, d->recon)) {
         why = FL_R_DECODE;
     }
     if (why == FL_R_NONE) {
         /* end to end: the frame check always, the pixel CRC-32 when it was sent */
-        uint32_t crc = crc_update(0, d->recon, FL_FRAME_BYTES);
-        uint32_t got = method == FL_METHOD_RAW_HASH ? fl_pixel_hash(d->recon) : fl_frame_check(d->recon);
+        uint32_t got = method == FL_METHOD_RAW_HASH || method == FL_METHOD_COPY ? fl_pixel_hash(d->recon)
+                                                                                : fl_frame_check(d->recon);
+        uint32_t crc = !info.no_crc || d->want_crc ? crc_update(0, d->recon, FL_FRAME_BYTES) : 0u;
         if (got != check || (!info.no_crc && crc != info.crc))
             why = FL_R_FRAME_CRC;
         else

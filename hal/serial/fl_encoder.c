@@ -42,7 +42,7 @@ void fl_enc_hello(fl_encoder *e)
     h[5] = 8;
     fl_put16(h + 6, e->key_interval > 0xFFFF ? 0xFFFF : e->key_interval);
     h[8] = e->window;
-    h[9] = (1u << FL_METHOD_RAW) | (1u << FL_METHOD_EDGE) | (1u << FL_METHOD_RAW_HASH);
+    h[9] = (1u << FL_METHOD_EDGE) | (1u << FL_METHOD_COPY); /* the methods this encoder sends */
     fl_put32(h + FL_HELLO_CAPS, e->scene_crc);
     h[FL_HELLO_CAPS + 4] = e->scene_len;
     for (uint32_t i = 0; i < e->scene_len; i++) h[FL_HELLO_MIN + i] = (uint8_t)e->scene_name[i];
@@ -74,10 +74,16 @@ static void window_push(fl_encoder *e, uint32_t frame_no)
  * frames measured at 0.7 to 3 bits a transition flat-shaded, 9 to 13
  * textured), only when the last frame went raw or filled a quarter of the
  * buffer: a frame that overflows anyway is sent raw after the attempt. */
-static int predict_raw(const fl_encoder *e, const uint8_t *pixels, const uint8_t *base, uint32_t cap)
+/* Whether a picture is one for the COPY coding (textured) rather than the EDGE
+ * coding (flat-shaded): its transitions, sampled, say the edge coding would
+ * pass FL_EDGE_BYTES_MAX or the scratch buffer. A frame after a small edge-coded
+ * one is taken for flat without the sample. */
+#define FL_EDGE_BYTES_MAX 4096u
+static int predict_copy(const fl_encoder *e, const uint8_t *pixels, const uint8_t *base, uint32_t cap)
 {
-    if (e->sent_any && e->last_coded && e->last_coded < cap / 4) return 0;
-    return fl_estimate_transitions(pixels, base) / 8u * 6u > cap;
+    if (e->sent_any && e->last_coded && e->last_coded < cap / 4 && e->last_coded < FL_EDGE_BYTES_MAX / 4) return 0;
+    uint32_t est = fl_estimate_transitions(pixels, base) / 8u * 6u;
+    return est > cap || est > FL_EDGE_BYTES_MAX;
 }
 
 int fl_enc_frame(fl_encoder *e, uint32_t frame_no, const uint8_t *pixels, const uint8_t *base, uint32_t base_no,
@@ -92,36 +98,32 @@ int fl_enc_frame(fl_encoder *e, uint32_t frame_no, const uint8_t *pixels, const 
     if (e->scratch && e->scratch_bytes > pre) {
         uint32_t cap = e->scratch_bytes - pre;
         if (cap > FL_PAYLOAD_MAX - pre) cap = FL_PAYLOAD_MAX - pre;
-        if (!predict_raw(e, pixels, key ? 0 : base, cap))
+        if (!predict_copy(e, pixels, key ? 0 : base, cap))
             coded = fl_code_picture(&e->coder, pixels, key ? 0 : base, e->scratch + pre, cap, &check);
-        else
-            e->coder.hashes_valid = 0; /* the row hashes were not made for these pixels */
     }
     e->last_coded = coded;
-    if (coded == 0) { /* did not fit: a raw keyframe, checked by the pixel hash */
-        key = 1;
-        check = fl_pixel_hash(pixels);
-    }
     uint8_t head[FL_FRAME_PRE + 5];
     fl_info_pack(head, info);
     head[FL_INFO_BYTES] = info->no_crc ? 0u : 1u;
-    fl_put32(head + FL_INFO_BYTES + 1, check);
-    if (coded) {
-        uint32_t k = FL_FRAME_PRE;
-        if (!key) {
-            fl_put32(head + k, base_no);
-            k += 4;
-        }
+    uint32_t k = FL_FRAME_PRE;
+    if (!key) {
+        fl_put32(head + k, base_no);
+        k += 4;
+    }
+    if (coded) { /* flat-shaded: the edge coding, from the scratch buffer */
+        fl_put32(head + FL_INFO_BYTES + 1, check);
         head[k] = FL_METHOD_EDGE;
         fl_writer_begin(&e->w, key ? FL_MSG_KEYFRAME : FL_MSG_DELTA, frame_no, pre + coded);
         fl_writer_bytes(&e->w, head, pre);
         fl_writer_bytes(&e->w, e->scratch + pre, coded);
-    } else {
-        head[FL_FRAME_PRE] = FL_METHOD_RAW_HASH;
-        fl_writer_begin(&e->w, FL_MSG_KEYFRAME, frame_no, FL_FRAME_PRE + 1 + FL_FRAME_BYTES);
-        fl_writer_bytes(&e->w, head, FL_FRAME_PRE + 1);
-        fl_writer_direct(&e->w, pixels, FL_FRAME_BYTES); /* outside the message CRC */
-        e->raw_fallbacks++;
+    } else { /* textured: the copy coding, streamed, checked by the pixel hash */
+        fl_put32(head + FL_INFO_BYTES + 1, fl_pixel_hash(pixels));
+        head[k] = FL_METHOD_COPY;
+        fl_writer_begin(&e->w, key ? FL_MSG_KEYFRAME : FL_MSG_DELTA, frame_no, FL_LEN_STREAMED);
+        fl_writer_bytes(&e->w, head, pre);
+        fl_copy_encode(&e->copy, pixels, key ? 0 : base, e->match_hash, &e->w);
+        e->coder.hashes_valid = 0; /* the copy model took the edge coder's memory */
+        e->copy_frames++;
     }
     fl_writer_end(&e->w);
     e->bytes = e->w.bytes;

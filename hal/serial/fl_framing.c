@@ -216,11 +216,21 @@ int fl_reader_byte(fl_reader *r, uint8_t b)
     return 0;
 }
 
+/* A streamed COPY frame: its length field, type and method byte say so. */
+static int is_streamed(const uint8_t *buf, uint32_t len)
+{
+    uint32_t plen = (uint32_t)buf[6] | (uint32_t)buf[7] << 8 | (uint32_t)buf[8] << 16;
+    if (plen != FL_LEN_STREAMED || (buf[1] != FL_MSG_KEYFRAME && buf[1] != FL_MSG_DELTA)) return 0;
+    uint32_t pre = FL_HEADER_BYTES + FL_FRAME_PRE + (buf[1] == FL_MSG_DELTA ? 4u : 0u) + 1u;
+    return len > pre + FL_CRC_BYTES && buf[pre - 1] == FL_METHOD_COPY;
+}
+
 uint32_t fl_msg_crc_bytes(const uint8_t *buf, uint32_t len)
 {
     uint32_t pre = FL_HEADER_BYTES + FL_FRAME_PRE + 1;
     if (len == pre + FL_FRAME_BYTES + FL_CRC_BYTES && buf[1] == FL_MSG_KEYFRAME && buf[pre - 1] == FL_METHOD_RAW_HASH)
         return pre;
+    if (len >= FL_HEADER_BYTES && is_streamed(buf, len)) return pre + (buf[1] == FL_MSG_DELTA ? 4u : 0u);
     return len - FL_CRC_BYTES;
 }
 
@@ -230,7 +240,8 @@ fl_reason fl_msg_check(const uint8_t *buf, uint32_t len, fl_msg *m)
     if (crc_update(0, buf, fl_msg_crc_bytes(buf, len)) != fl_get32(buf + len - FL_CRC_BYTES)) return FL_R_CRC;
     if (buf[0] != FL_VERSION) return FL_R_VERSION;
     uint32_t plen = (uint32_t)buf[6] | (uint32_t)buf[7] << 8 | (uint32_t)buf[8] << 16;
-    if (plen != len - FL_HEADER_BYTES - FL_CRC_BYTES) return FL_R_LENGTH;
+    if (plen == FL_LEN_STREAMED && is_streamed(buf, len)) plen = len - FL_HEADER_BYTES - FL_CRC_BYTES;
+    if (plen != len - FL_HEADER_BYTES - FL_CRC_BYTES || plen > FL_PAYLOAD_MAX) return FL_R_LENGTH;
     m->type = buf[1];
     m->frame_no = fl_get32(buf + 2);
     m->payload = buf + FL_HEADER_BYTES;

@@ -24,7 +24,9 @@
 
 #include <stdint.h>
 
-#define FL_VERSION 3 /* 2: method RAW_HASH (its message CRC leaves the pixels to the frame check); 3: the time */
+#define FL_VERSION                                                                                                     \
+    4 /* 2: method RAW_HASH (its message CRC leaves the pixels to the frame check); 3: the time;
+                       * 4: method COPY, streamed (length FL_LEN_STREAMED) */
 #define FL_W 320
 #define FL_H 200
 #define FL_FRAME_BYTES (FL_W * FL_H)
@@ -32,9 +34,10 @@
 
 #define FL_HEADER_BYTES 9 /* version, type, frame u32, payload length u24 */
 #define FL_CRC_BYTES 4
-#define FL_INFO_BYTES 30      /* fl_frame_info on the wire (without no_crc) */
-#define FL_FRAME_PRE 35       /* info, flags, frame check: the start of every frame payload */
-#define FL_PAYLOAD_MAX 65536u /* largest payload a receiver accepts */
+#define FL_INFO_BYTES 30          /* fl_frame_info on the wire (without no_crc) */
+#define FL_FRAME_PRE 35           /* info, flags, frame check: the start of every frame payload */
+#define FL_PAYLOAD_MAX 65536u     /* largest payload a receiver accepts */
+#define FL_LEN_STREAMED 0xFFFFFFu /* length field of a COPY frame: the payload runs to the CRC */
 #define FL_MSG_MAX (FL_HEADER_BYTES + FL_PAYLOAD_MAX + FL_CRC_BYTES)
 #define FL_WINDOW_MAX 32     /* largest flow-control window */
 #define FL_SCENE_NAME_MAX 63 /* longest scene name a HELLO carries */
@@ -53,7 +56,7 @@ enum {
 /* RAW_HASH: the 64,000 pixel bytes of a keyframe as they are; the frame check is
  * fl_pixel_hash (not fl_frame_check), and the message CRC covers the header and the
  * payload before the pixels only: the hash protects them, at a fraction of a CRC's cost. */
-enum { FL_METHOD_RAW = 0, FL_METHOD_EDGE = 1, FL_METHOD_RAW_HASH = 2 };
+enum { FL_METHOD_RAW = 0, FL_METHOD_EDGE = 1, FL_METHOD_RAW_HASH = 2, FL_METHOD_COPY = 3 };
 
 /* What the receiver knows about a frame besides its pixels. */
 typedef struct {
@@ -127,6 +130,35 @@ typedef struct {
     uint32_t row_hash[FL_H];
 } fl_coder;
 
+/* ---- the COPY coding's model (both ends; fl_copy.c) ------------------------- */
+
+/* adaptive bit probabilities, by what they decide (offsets into p) */
+#define FL_CP_IS_COPY 0    /* 2: after a literal, after a copy */
+#define FL_CP_IS_REP0 2    /* 2: the same */
+#define FL_CP_IS_REP 4     /* one of the other three recent offsets */
+#define FL_CP_IS_NEAR 5    /* a neighbour's offset */
+#define FL_CP_IN_BASE 6    /* a new offset into the base frame */
+#define FL_CP_REP_TREE 8   /* 4: which recent offset */
+#define FL_CP_NEAR_TREE 12 /* 4: which neighbour */
+#define FL_CP_DY 16        /* 16: a new offset's rows, bit length */
+#define FL_CP_DX 32        /* 16: its columns, bit length */
+#define FL_CP_DY_HI 48     /* 64: the two bits below the top one, per length */
+#define FL_CP_DX_HI 112    /* 64 */
+#define FL_CP_LEN 176      /* 64: a copy's length, bit length (rep0 copies, the others) */
+#define FL_CP_LEN_HI 240   /* 64 */
+#define FL_CP_LIT 304      /* 8 x 256: a literal against the pixel above, by that pixel */
+#define FL_CP_LIT_SHIFT 5  /* literal contexts: the pixel above's top 3 bits */
+#define FL_CP_LIT_CTX(up) (((uint32_t)(up) >> FL_CP_LIT_SHIFT) * 256u)
+#define FL_CP_PROBS (FL_CP_LIT + (256u >> FL_CP_LIT_SHIFT) * 256u)
+#define FL_CP_SLACK 256u   /* a coded picture is at most 64,000 + this + a few bytes */
+#define FL_CP_HASH_BITS 16 /* the encoder's optional match finder: 2^16 positions */
+#define FL_CP_HASH (1u << FL_CP_HASH_BITS)
+
+typedef struct {
+    uint16_t p[FL_CP_PROBS];
+    int32_t rep[4]; /* the recent offsets, most recent first */
+} fl_copy_model;
+
 /* ---- encoder (the sender: runs on the target) ----------------------------- */
 
 typedef struct {
@@ -157,13 +189,18 @@ typedef struct {
 
     /* counters */
     uint32_t frames, keyframes, deltas, raw_fallbacks, bytes;
+    uint32_t copy_frames; /* frames whose picture went with method COPY */
     uint32_t acks, keyreqs, palette_reqs, timeouts, rx_bad;
 
     /* receiving acks and keyframe requests */
     fl_reader rx;
     uint8_t rx_buf[64];
 
-    fl_coder coder;
+    int32_t *match_hash; /* FL_CP_HASH entries for the COPY coder's match finder, or NULL */
+    union {              /* one picture coder at a time */
+        fl_coder coder;
+        fl_copy_model copy;
+    };
 } fl_encoder;
 
 /* Start a sender. put receives every encoded byte. scratch holds one coded frame
@@ -281,8 +318,12 @@ typedef struct {
     fl_hello hello;
     uint8_t palette[FL_PALETTE_BYTES];
     fl_counters count;
+    uint8_t want_crc; /* default 1: every frame shown gets its pixel CRC-32 (info.crc), sent or not */
 
-    fl_coder coder;
+    union { /* one picture coder at a time */
+        fl_coder coder;
+        fl_copy_model copy;
+    };
 } fl_decoder;
 
 /* Start a receiver. frame: 64,000 bytes, written only with frames that passed
@@ -339,5 +380,17 @@ uint32_t fl_estimate_transitions(const uint8_t *pixels, const uint8_t *base);
 /* Decode a method-EDGE picture of n bytes into out (64,000), with base for a
  * delta (NULL: keyframe). Returns 0, or -1 if the data is inconsistent. */
 int fl_decode_picture(fl_coder *c, const uint8_t *in, uint32_t n, const uint8_t *base, uint8_t *out);
+
+/* Code a picture (method COPY) straight into the message w has begun, as
+ * bytes the message CRC does not cover (fl_writer_direct); base: the previous
+ * frame for a delta, or NULL. hash: FL_CP_HASH entries of work memory for the
+ * match finder, or NULL (fewer, shorter copies). Returns the bytes written, at
+ * most FL_FRAME_BYTES + FL_CP_SLACK + 16. */
+uint32_t fl_copy_encode(fl_copy_model *m, const uint8_t *pixels, const uint8_t *base, int32_t *hash, fl_writer *w);
+
+/* Decode a method-COPY picture of n bytes into out (64,000), with base for a
+ * delta (NULL: keyframe). Returns 0, or -1 if the data is inconsistent: a copy
+ * from outside the picture, a length past its end, bytes left over or missing. */
+int fl_copy_decode(fl_copy_model *m, const uint8_t *in, uint32_t n, const uint8_t *base, uint8_t *out);
 
 #endif
