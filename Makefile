@@ -83,6 +83,9 @@ $(1)/test_planar: $(call objs,$(1)/obj,tests/unit/test_planar.c $(HAL_SRC))
 # test_copybuf too (a linear target with no system-memory buffer of its own)
 $(1)/test_copybuf: $(call objs,$(1)/obj,tests/unit/test_copybuf.c $(HAL_SRC))
 	$$(CC) $(2) $$^ -o $$@ -lcmocka
+# test_copycoding includes fl_copy.c (to write streams token by token): the rest of the link beside it
+$(1)/test_copycoding: $(call objs,$(1)/obj,tests/unit/test_copycoding.c firmware/crc32.c $(filter-out hal/serial/fl_copy.c,$(sort $(LINK_SRC))))
+	$$(CC) $(2) $$^ -o $$@ -lcmocka
 $(1)/test_%: $(call objs,$(1)/obj,tests/unit/test_%.c) $(call objs,$(1)/obj,$(BSPC_LIB) $(FW_SRC) $(HAL_SRC) $(NULL_SRC) $(sort $(LINK_SRC) $(UNIT_EXTRA)))
 	$$(CC) $(2) $$^ -o $$@ -lcmocka -lm
 endef

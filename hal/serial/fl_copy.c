@@ -7,8 +7,8 @@
  * texel taller than a pixel, or any offset) or the base frame (the frame shown
  * before: a turn shifts most of it sideways, distant walls barely change). Four
  * recent offsets are kept, so a shift that holds across a wall costs a few
- * bits per run. A literal is one palette index, coded against the pixel above,
- * because a texture's neighbouring texels sit on the same colour ramp.
+ * bits per run. A literal is one palette index in the context of the pixel to
+ * its left's colour ramp (the top three bits of its index).
  *
  * Both ends reset the models with every picture: a picture decodes from its
  * own bytes and its base alone. The encoder streams its bytes (LZMA's carry
@@ -20,11 +20,41 @@
 
 #define PROB_BITS 11
 #define PROB_ONE (1u << PROB_BITS)
-#define MOVE_BITS 4
+#define MOVE_BITS 4 /* not less: a probability then stays >= 15/2048, so one byte renormalises */
 #define TOP (1u << 24)
+
+/* The model's bit probabilities, by what they decide. A token's kind (literal,
+ * rep0, another recent offset, a neighbour, a new offset) is the context of the
+ * next token's first decisions. */
+enum {
+    K_LIT,
+    K_REP0,
+    K_REP,
+    K_NEAR,
+    K_NEW,
+    K_N,
+    P_IS_COPY = 0,                      /* [kind] */
+    P_IS_REP0 = P_IS_COPY + K_N,        /* [kind] */
+    P_IS_REP = P_IS_REP0 + K_N,         /* [kind] */
+    P_IS_NEAR = P_IS_REP + K_N,         /* [kind] */
+    P_IN_BASE = P_IS_NEAR + K_N,        /* [kind] */
+    P_REP_TREE = P_IN_BASE + K_N,       /* [kind][4]: which other recent offset */
+    P_NEAR_TREE = P_REP_TREE + 4 * K_N, /* [kind][4]: which neighbour */
+    P_DY = P_NEAR_TREE + 4 * K_N,       /* [16]: a new offset's rows, bit length */
+    P_DX = P_DY + 16,                   /* [16]: its columns */
+    P_DY_HI = P_DX + 16,                /* [64]: the two bits below the top one, per length */
+    P_DX_HI = P_DY_HI + 64,
+    P_LEN = P_DX_HI + 64,      /* [copy kind 1..4][32]: a copy's length, bit length */
+    P_LEN_HI = P_LEN + 32 * 4, /* [copy kind][64] */
+    P_LIT = P_LEN_HI + 64 * 4, /* [8][256]: a literal, by the top bits of the pixel left of it (its colour ramp) */
+    P_END = P_LIT + 8 * 256
+};
+_Static_assert(P_END <= FL_CP_PROBS, "the model fits fl_copy_model");
+#define LIT_CTX(left) (P_LIT + ((uint32_t)(left) >> 5) * 256u)
 
 /* offsets: src = pos - off in the virtual line [base (64,000) | this frame] */
 #define OFF_BASE ((int32_t)FL_FRAME_BYTES)
+#define NEAR_N 4
 static const int32_t near_off[4] = {1, FL_W, FL_W - 1, FL_W + 1};
 
 /* ---- the model ----------------------------------------------------------- */
@@ -180,6 +210,39 @@ static uint32_t match_len(const uint8_t *px, const uint8_t *base, uint32_t pos, 
     return n;
 }
 
+/* The encoder's choice: the copy that saves the most bits against literals,
+ * by rough costs in bits (a literal about 6; a copy its kind and its length). */
+#define LIT_BITS 6
+typedef struct {
+    uint32_t kind, i, len;
+    int32_t off, gain;
+} cand;
+
+static inline uint32_t len_bits(uint32_t len)
+{
+    uint32_t n = 0;
+    while ((len >> n) > 1u) n++;
+    return 2u * n + 1u;
+}
+
+static void consider(cand *b, uint32_t kind, uint32_t i, int32_t off, uint32_t len)
+{
+    static const uint8_t kind_bits[K_N] = {0, 3, 7, 10, 30}; /* measured on textured walks */
+    int32_t gain = (int32_t)(len * LIT_BITS) - (int32_t)(kind_bits[kind] + len_bits(len));
+    if (len && gain > b->gain) {
+        b->kind = kind;
+        b->i = i;
+        b->len = len;
+        b->off = off;
+        b->gain = gain;
+    }
+}
+
+static inline int is_rep(const fl_copy_model *m, int32_t off)
+{
+    return off == m->rep[0] || off == m->rep[1] || off == m->rep[2] || off == m->rep[3];
+}
+
 static inline uint32_t hash4(const uint8_t *p)
 {
     uint32_t v = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
@@ -188,9 +251,33 @@ static inline uint32_t hash4(const uint8_t *p)
 
 static void lit_encode(rc_enc *r, fl_copy_model *m, const uint8_t *px, uint32_t pos)
 {
-    uint8_t up = pos >= FL_W ? px[pos - FL_W] : 0;
-    enc_tree(r, m->p + FL_CP_LIT + FL_CP_LIT_CTX(up), (uint8_t)(px[pos] - up), 8);
+    enc_tree(r, m->p + LIT_CTX(pos ? px[pos - 1] : 0), px[pos], 8);
 }
+
+#ifdef FL_CP_STATS
+double cp_bits[8];
+long cp_cnt[8], cp_len[8];
+static double rc_pos(const rc_enc *r)
+{
+    double lg = 0;
+    uint32_t x = r->range;
+    while (x > 1) {
+        x >>= 1;
+        lg += 1;
+    }
+    return 8.0 * (r->out + r->pending) + 32 - lg;
+}
+#define STAT_BEGIN double stat_t0 = rc_pos(&r)
+#define STAT_END(k, l)                                                                                                 \
+    do {                                                                                                               \
+        cp_bits[k] += rc_pos(&r) - stat_t0;                                                                            \
+        cp_cnt[k]++;                                                                                                   \
+        cp_len[k] += (l);                                                                                              \
+    } while (0)
+#else
+#define STAT_BEGIN
+#define STAT_END(k, l)
+#endif
 
 uint32_t fl_copy_encode(fl_copy_model *m, const uint8_t *px, const uint8_t *base, int32_t *hash, fl_writer *w)
 {
@@ -209,101 +296,82 @@ uint32_t fl_copy_encode(fl_copy_model *m, const uint8_t *px, const uint8_t *base
     while (pos < FL_FRAME_BYTES) {
         uint32_t left = FL_FRAME_BYTES - pos;
         if (r.out > pos + FL_CP_SLACK) { /* worse than raw: escape, the rest plain */
-            enc_bit(&r, m->p + FL_CP_IS_COPY + state, 1);
-            enc_bit(&r, m->p + FL_CP_IS_REP0 + state, 0);
-            enc_bit(&r, m->p + FL_CP_IS_REP, 0);
-            enc_bit(&r, m->p + FL_CP_IS_NEAR, 0);
-            enc_bit(&r, m->p + FL_CP_IN_BASE, 0);
-            enc_gamma(&r, m->p + FL_CP_DY, 4, m->p + FL_CP_DY_HI, 1); /* dy 0 */
-            enc_gamma(&r, m->p + FL_CP_DX, 4, m->p + FL_CP_DX_HI, 1); /* dx 0: offset 0 */
+            enc_bit(&r, m->p + P_IS_COPY + state, 1);
+            enc_bit(&r, m->p + P_IS_REP0 + state, 0);
+            enc_bit(&r, m->p + P_IS_REP + state, 0);
+            enc_bit(&r, m->p + P_IS_NEAR + state, 0);
+            enc_bit(&r, m->p + P_IN_BASE + state, 0);
+            enc_gamma(&r, m->p + P_DY, 4, m->p + P_DY_HI, 1); /* dy 0 */
+            enc_gamma(&r, m->p + P_DX, 4, m->p + P_DX_HI, 1); /* dx 0: offset 0 */
             enc_flush(&r);
             fl_writer_direct(w, px + pos, left);
             return r.out + left;
         }
         /* candidates: the recent offsets, the neighbours, a hashed position */
-        uint32_t best_len = 0, best_kind = 0, best_i = 0;
-        int32_t best_off = 0;
+        cand best = {0, 0, 0, 0, 0};
         for (uint32_t i = 0; i < 4; i++) {
             int32_t off = m->rep[i];
-            if (!copy_ok(pos, off, 1, delta)) continue;
-            uint32_t l = match_len(px, base, pos, off, left);
-            uint32_t need = i == 0 ? 1u : 2u;
-            if (l >= need && l > best_len) {
-                best_len = l;
-                best_kind = 1;
-                best_i = i;
-                best_off = off;
-            }
+            if (copy_ok(pos, off, 1, delta))
+                consider(&best, i == 0 ? K_REP0 : K_REP, i, off, match_len(px, base, pos, off, left));
         }
-        for (uint32_t i = 0; i < 4; i++) {
+        for (uint32_t i = 0; i < NEAR_N; i++) {
             int32_t off = near_off[i];
-            if (off == m->rep[0] || off == m->rep[1] || off == m->rep[2] || off == m->rep[3]) continue;
-            if (!copy_ok(pos, off, 1, delta)) continue;
-            uint32_t l = match_len(px, base, pos, off, left);
-            if (l >= 2 && l > best_len + 1) {
-                best_len = l;
-                best_kind = 2;
-                best_i = i;
-                best_off = off;
-            }
+            if (!is_rep(m, off) && copy_ok(pos, off, 1, delta))
+                consider(&best, K_NEAR, i, off, match_len(px, base, pos, off, left));
         }
         if (hash && left >= 4) {
             int32_t q = hash[hash4(px + pos)];
-            if (q != INT32_MIN) {
-                int32_t off = (int32_t)pos - q;
-                if (copy_ok(pos, off, 1, delta) && off != m->rep[0] && off != m->rep[1] && off != m->rep[2] &&
-                    off != m->rep[3]) {
-                    uint32_t l = match_len(px, base, pos, off, left);
-                    if (l >= 6 && l > best_len + 4) {
-                        best_len = l;
-                        best_kind = 3;
-                        best_off = off;
-                    }
-                }
-            }
+            int32_t off = q == INT32_MIN ? 0 : (int32_t)pos - q;
+            if (copy_ok(pos, off, 1, delta) && !is_rep(m, off))
+                consider(&best, K_NEW, 0, off, match_len(px, base, pos, off, left));
         }
+        uint32_t best_len = best.len, best_i = best.i;
+        int32_t best_off = best.off;
+        uint32_t best_kind = best.kind == K_REP0 || best.kind == K_REP ? 1u : best.kind == K_NEAR ? 2u : 3u;
+        STAT_BEGIN;
         if (best_len == 0) {
-            enc_bit(&r, m->p + FL_CP_IS_COPY + state, 0);
+            enc_bit(&r, m->p + P_IS_COPY + state, 0);
             lit_encode(&r, m, px, pos);
+            STAT_END(0, 1);
             if (hash && left >= 4) hash[hash4(px + pos)] = (int32_t)pos;
             pos++;
-            state = 0;
+            state = K_LIT;
             continue;
         }
-        enc_bit(&r, m->p + FL_CP_IS_COPY + state, 1);
-        enc_bit(&r, m->p + FL_CP_IS_REP0 + state, best_kind == 1 && best_i == 0);
-        if (best_kind == 1 && best_i == 0) {
-            /* rep0 */
-        } else {
-            enc_bit(&r, m->p + FL_CP_IS_REP, best_kind == 1);
-            if (best_kind == 1) {
-                enc_tree(&r, m->p + FL_CP_REP_TREE, best_i - 1, 2); /* 0..2: rep1..rep3 */
+        uint32_t kind = best_kind == 1 ? (best_i == 0 ? K_REP0 : K_REP) : best_kind == 2 ? K_NEAR : K_NEW;
+        enc_bit(&r, m->p + P_IS_COPY + state, 1);
+        enc_bit(&r, m->p + P_IS_REP0 + state, kind == K_REP0);
+        if (kind != K_REP0) {
+            enc_bit(&r, m->p + P_IS_REP + state, kind == K_REP);
+            if (kind == K_REP) {
+                enc_tree(&r, m->p + P_REP_TREE + 4 * state, best_i - 1, 2); /* 0..2: rep1..rep3 */
                 rep_use(m, best_i);
             } else {
-                enc_bit(&r, m->p + FL_CP_IS_NEAR, best_kind == 2);
-                if (best_kind == 2) {
-                    enc_tree(&r, m->p + FL_CP_NEAR_TREE, best_i, 2);
+                enc_bit(&r, m->p + P_IS_NEAR + state, kind == K_NEAR);
+                if (kind == K_NEAR) {
+                    enc_tree(&r, m->p + P_NEAR_TREE + 4 * state, best_i, 2);
                 } else {
                     /* a new offset: where, as rows and columns */
                     int32_t q = (int32_t)pos - best_off, in_base = q < 0;
                     int32_t d = in_base ? q + OFF_BASE - (int32_t)pos : best_off; /* base: motion; else back */
-                    enc_bit(&r, m->p + FL_CP_IN_BASE, (uint32_t)in_base);
+                    enc_bit(&r, m->p + P_IN_BASE + state, (uint32_t)in_base);
                     /* d = dy * 320 + dx with dx in -160..159 */
                     int32_t dy = (d + 160 + 320 * 400) / 320 - 400, dx = d - dy * 320;
                     uint32_t zy = in_base ? (dy < 0 ? (uint32_t)(-2 * dy) - 1u : (uint32_t)(2 * dy)) : (uint32_t)dy;
                     uint32_t zx = dx < 0 ? (uint32_t)(-2 * dx) - 1u : (uint32_t)(2 * dx);
-                    enc_gamma(&r, m->p + FL_CP_DY, 4, m->p + FL_CP_DY_HI, zy + 1u);
-                    enc_gamma(&r, m->p + FL_CP_DX, 4, m->p + FL_CP_DX_HI, zx + 1u);
+                    enc_gamma(&r, m->p + P_DY, 4, m->p + P_DY_HI, zy + 1u);
+                    enc_gamma(&r, m->p + P_DX, 4, m->p + P_DX_HI, zx + 1u);
                 }
                 rep_push(m, best_off);
             }
         }
-        enc_gamma(&r, m->p + FL_CP_LEN + (best_kind == 1 && best_i == 0 ? 0u : 32u), 5, m->p + FL_CP_LEN_HI, best_len);
+        enc_gamma(&r, m->p + P_LEN + 32 * (kind - 1), 5, m->p + P_LEN_HI + 64 * (kind - 1), best_len);
+        STAT_END(best_kind == 1 ? 1 + (best_i > 0) : best_kind + 1, best_len);
         if (hash)
             for (uint32_t i = 0; i < best_len && pos + i + 4 <= FL_FRAME_BYTES; i++)
                 hash[hash4(px + pos + i)] = (int32_t)(pos + i);
         pos += best_len;
-        state = 1;
+        state = kind;
     }
     enc_flush(&r);
     return r.out;
@@ -390,32 +458,35 @@ int fl_copy_decode(fl_copy_model *m, const uint8_t *in, uint32_t n, const uint8_
     for (int i = 0; i < 4; i++) r.code = r.code << 8 | next_byte(&r);
     int delta = base != 0;
     model_reset(m, delta);
-    uint32_t pos = 0, state = 0;
+    uint32_t pos = 0, state = K_LIT;
     while (pos < FL_FRAME_BYTES) {
         if (r.over) return -1;
-        if (!dec_bit(&r, m->p + FL_CP_IS_COPY + state)) {
-            uint8_t up = pos >= FL_W ? out[pos - FL_W] : 0;
-            out[pos] = (uint8_t)(up + dec_tree(&r, m->p + FL_CP_LIT + FL_CP_LIT_CTX(up), 8));
+        if (!dec_bit(&r, m->p + P_IS_COPY + state)) {
+            out[pos] = (uint8_t)dec_tree(&r, m->p + LIT_CTX(pos ? out[pos - 1] : 0), 8);
             pos++;
-            state = 0;
+            state = K_LIT;
             continue;
         }
         int32_t off;
-        uint32_t rep0 = dec_bit(&r, m->p + FL_CP_IS_REP0 + state);
-        if (rep0) {
+        uint32_t kind;
+        if (dec_bit(&r, m->p + P_IS_REP0 + state)) {
+            kind = K_REP0;
             off = m->rep[0];
-        } else if (dec_bit(&r, m->p + FL_CP_IS_REP)) {
-            uint32_t i = dec_tree(&r, m->p + FL_CP_REP_TREE, 2) + 1u;
+        } else if (dec_bit(&r, m->p + P_IS_REP + state)) {
+            kind = K_REP;
+            uint32_t i = dec_tree(&r, m->p + P_REP_TREE + 4 * state, 2) + 1u;
             if (i > 3) return -1;
             rep_use(m, i);
             off = m->rep[0];
         } else {
-            if (dec_bit(&r, m->p + FL_CP_IS_NEAR)) {
-                off = near_off[dec_tree(&r, m->p + FL_CP_NEAR_TREE, 2)];
+            if (dec_bit(&r, m->p + P_IS_NEAR + state)) {
+                kind = K_NEAR;
+                off = near_off[dec_tree(&r, m->p + P_NEAR_TREE + 4 * state, 2)];
             } else {
-                uint32_t in_base = dec_bit(&r, m->p + FL_CP_IN_BASE);
-                uint32_t zy = dec_gamma(&r, m->p + FL_CP_DY, 4, m->p + FL_CP_DY_HI);
-                uint32_t zx = dec_gamma(&r, m->p + FL_CP_DX, 4, m->p + FL_CP_DX_HI);
+                kind = K_NEW;
+                uint32_t in_base = dec_bit(&r, m->p + P_IN_BASE + state);
+                uint32_t zy = dec_gamma(&r, m->p + P_DY, 4, m->p + P_DY_HI);
+                uint32_t zx = dec_gamma(&r, m->p + P_DX, 4, m->p + P_DX_HI);
                 if (!zy-- || !zx-- || zy > 2u * FL_H || zx > FL_W) return -1;
                 int32_t dy = in_base ? ((zy & 1u) ? -(int32_t)(zy + 1u) / 2 : (int32_t)(zy / 2u)) : (int32_t)zy;
                 int32_t dx = (zx & 1u) ? -(int32_t)(zx + 1u) / 2 : (int32_t)(zx / 2u);
@@ -431,7 +502,7 @@ int fl_copy_decode(fl_copy_model *m, const uint8_t *in, uint32_t n, const uint8_
             }
             rep_push(m, off);
         }
-        uint32_t len = dec_gamma(&r, m->p + FL_CP_LEN + (rep0 ? 0u : 32u), 5, m->p + FL_CP_LEN_HI);
+        uint32_t len = dec_gamma(&r, m->p + P_LEN + 32 * (kind - 1), 5, m->p + P_LEN_HI + 64 * (kind - 1));
         if (!copy_ok(pos, off, len, delta)) return -1;
         int32_t q = (int32_t)pos - off;
         uint8_t *d = out + pos;
@@ -446,7 +517,7 @@ int fl_copy_decode(fl_copy_model *m, const uint8_t *in, uint32_t n, const uint8_
         }
         const uint8_t *s = out + q;
         for (uint32_t i = 0; i < len; i++) d[i] = s[i];
-        state = 1;
+        state = kind;
     }
     /* every byte read, none past the end (the encoder's flush leaves none over) */
     return r.over || r.p != r.end ? -1 : 0;

@@ -132,24 +132,7 @@ typedef struct {
 
 /* ---- the COPY coding's model (both ends; fl_copy.c) ------------------------- */
 
-/* adaptive bit probabilities, by what they decide (offsets into p) */
-#define FL_CP_IS_COPY 0    /* 2: after a literal, after a copy */
-#define FL_CP_IS_REP0 2    /* 2: the same */
-#define FL_CP_IS_REP 4     /* one of the other three recent offsets */
-#define FL_CP_IS_NEAR 5    /* a neighbour's offset */
-#define FL_CP_IN_BASE 6    /* a new offset into the base frame */
-#define FL_CP_REP_TREE 8   /* 4: which recent offset */
-#define FL_CP_NEAR_TREE 12 /* 4: which neighbour */
-#define FL_CP_DY 16        /* 16: a new offset's rows, bit length */
-#define FL_CP_DX 32        /* 16: its columns, bit length */
-#define FL_CP_DY_HI 48     /* 64: the two bits below the top one, per length */
-#define FL_CP_DX_HI 112    /* 64 */
-#define FL_CP_LEN 176      /* 64: a copy's length, bit length (rep0 copies, the others) */
-#define FL_CP_LEN_HI 240   /* 64 */
-#define FL_CP_LIT 304      /* 8 x 256: a literal against the pixel above, by that pixel */
-#define FL_CP_LIT_SHIFT 5  /* literal contexts: the pixel above's top 3 bits */
-#define FL_CP_LIT_CTX(up) (((uint32_t)(up) >> FL_CP_LIT_SHIFT) * 256u)
-#define FL_CP_PROBS (FL_CP_LIT + (256u >> FL_CP_LIT_SHIFT) * 256u)
+#define FL_CP_PROBS 3072   /* adaptive bit probabilities (their layout: fl_copy.c) */
 #define FL_CP_SLACK 256u   /* a coded picture is at most 64,000 + this + a few bytes */
 #define FL_CP_HASH_BITS 16 /* the encoder's optional match finder: 2^16 positions */
 #define FL_CP_HASH (1u << FL_CP_HASH_BITS)
