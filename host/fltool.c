@@ -16,11 +16,14 @@
  *       not at their compiled height, as build/render's JSON has them.
  *   fltool encode FRAMES.raw --out STREAM [--info FRAMES.jsonl] [--palette P.bin]
  *                 [--key-interval N] [--scratch BYTES] [--sizes] [--scene NAME [--scene-crc HEX]]
+ *                 [--no-match-finder]
  *       Encodes the frames with the C encoder (hello, palette, then one frame
  *       message each: keyframe or delta against the previous frame) into a byte
  *       stream file; its hello names the scene NAME, blob CRC-32 HEX (default:
  *       none). --sizes prints one JSON line per frame (bytes on the wire,
- *       keyframe or not).
+ *       keyframe or not). Textured frames go with the COPY coding and its match
+ *       finder, as build/emu and build/render send them; --no-match-finder
+ *       codes them as the firmware does, without one.
  *   fltool decode STREAM [--chunk N] [--frames-out FILE]
  *       Feeds the stream to the C decoder (in chunks of N bytes, default 4096)
  *       and prints one JSON line per event and a final line with the counters.
@@ -47,7 +50,7 @@ static int usage_to(FILE *f, int rc)
 {
     fputs("usage: fltool walk SCENE [--frames N] [--dt MS] [--out DIR] [--flat] [--keys STEPS]\n"
           "       fltool encode FRAMES.raw --out STREAM [--info FRAMES.jsonl] [--palette P.bin]\n"
-          "                     [--key-interval N] [--scratch BYTES] [--sizes]\n"
+          "                     [--key-interval N] [--scratch BYTES] [--sizes] [--no-match-finder]\n"
           "       fltool decode STREAM [--chunk N] [--frames-out FILE]\n"
           "       fltool bench FRAMES.raw [--key-interval N] [--repeat R] [--crc]\n"
           "       fltool digest FRAMES.raw\n"
@@ -325,12 +328,15 @@ static void parse_info(const char *line, fl_frame_info *fi)
     if (t) fi->time_ms = (uint32_t)strtoul(t + 8, NULL, 10);
 }
 
+/* the COPY coder's match finder (the firmware goes without: fltool digest) */
+static int32_t match_hash[FL_CP_HASH];
+
 static int cmd_encode(int argc, char **argv, int bench)
 {
     const char *in = NULL, *out = NULL, *infof = NULL, *palf = NULL, *scene_name = NULL;
     unsigned long scene_crc = 0;
     long key_interval = 64, scratch_bytes = 16384, repeat = 1, limit = -1;
-    int sizes = 0, with_crc = 0, no_crc = 0;
+    int sizes = 0, with_crc = 0, no_crc = 0, match_finder = 1;
     for (int i = 0; i < argc; i++) {
         if (!strcmp(argv[i], "--out") && i + 1 < argc)
             out = argv[++i];
@@ -352,6 +358,8 @@ static int cmd_encode(int argc, char **argv, int bench)
             with_crc = 1;
         else if (!strcmp(argv[i], "--no-crc"))
             no_crc = 1;
+        else if (!strcmp(argv[i], "--no-match-finder"))
+            match_finder = 0;
         else if (!strcmp(argv[i], "--scene") && i + 1 < argc)
             scene_name = argv[++i];
         else if (!strcmp(argv[i], "--scene-crc") && i + 1 < argc)
@@ -411,6 +419,7 @@ static int cmd_encode(int argc, char **argv, int bench)
         else
             fl_enc_init(&enc, put_file, fo, scratch, (uint32_t)scratch_bytes);
         enc.key_interval = (uint32_t)key_interval;
+        enc.match_hash = match_finder ? match_hash : NULL;
         fl_enc_scene(&enc, scene_name, (uint32_t)scene_crc);
         fl_enc_hello(&enc);
         fl_enc_palette(&enc, pal);

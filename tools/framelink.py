@@ -23,7 +23,9 @@ model's initial probabilities from streams, docs/frame-link.md "Model").
 import struct
 import zlib
 
-VERSION = 3
+from framelink_copy import CopyError, decode_copy
+
+VERSION = 4
 W, H = 320, 200
 FRAME_BYTES = W * H
 PALETTE_BYTES = 768
@@ -35,7 +37,8 @@ PAYLOAD_MAX = 65536
 MSG_MAX = HEADER_BYTES + PAYLOAD_MAX + CRC_BYTES
 
 MSG_HELLO, MSG_PALETTE, MSG_KEYFRAME, MSG_DELTA, MSG_ACK, MSG_KEYREQ = 1, 2, 3, 4, 5, 6
-METHOD_RAW, METHOD_EDGE, METHOD_RAW_HASH = 0, 1, 2
+METHOD_RAW, METHOD_EDGE, METHOD_RAW_HASH, METHOD_COPY = 0, 1, 2, 3
+LEN_STREAMED = 0xFFFFFF  # the length field of a COPY frame: the payload runs to the CRC
 HELLO_CAPS = 10          # the capabilities: all a HELLO held before scene names
 HELLO_MIN = HELLO_CAPS + 5  # then the scene's blob CRC (u32), its name's length (u8), the name
 SCENE_NAME_MAX = 63
@@ -478,12 +481,23 @@ class _Reader:
             self.broken = R_LONG
 
 
+def _streamed(buf):
+    """A streamed COPY frame: its length field, type and method byte say so."""
+    if (buf[6] | buf[7] << 8 | buf[8] << 16) != LEN_STREAMED or buf[1] not in (MSG_KEYFRAME, MSG_DELTA):
+        return False
+    pre = HEADER_BYTES + FRAME_PRE + (4 if buf[1] == MSG_DELTA else 0) + 1
+    return len(buf) > pre + CRC_BYTES and buf[pre - 1] == METHOD_COPY
+
+
 def crc_bytes(buf):
     """How many leading bytes of a message (CRC included) its CRC covers: all but the CRC, or
-    for a RAW_HASH keyframe the header and the payload up to its method byte (fl_msg_crc_bytes)."""
+    for a RAW_HASH keyframe and a COPY frame the header and the payload up to its method byte
+    (fl_msg_crc_bytes)."""
     pre = HEADER_BYTES + FRAME_PRE + 1
     if len(buf) == pre + FRAME_BYTES + CRC_BYTES and buf[1] == MSG_KEYFRAME and buf[pre - 1] == METHOD_RAW_HASH:
         return pre
+    if _streamed(buf):
+        return pre + (4 if buf[1] == MSG_DELTA else 0)
     return len(buf) - CRC_BYTES
 
 
@@ -497,7 +511,9 @@ def check_message(buf):
     if buf[0] != VERSION:
         return R_VERSION, None
     plen = buf[6] | buf[7] << 8 | buf[8] << 16
-    if plen != n - HEADER_BYTES - CRC_BYTES:
+    if plen == LEN_STREAMED and _streamed(buf):
+        plen = n - HEADER_BYTES - CRC_BYTES
+    if plen != n - HEADER_BYTES - CRC_BYTES or plen > PAYLOAD_MAX:
         return R_LENGTH, None
     return None, (buf[1], struct.unpack_from("<I", buf, 2)[0], bytes(buf[HEADER_BYTES:n - CRC_BYTES]))
 
@@ -609,7 +625,7 @@ class Decoder:
         base_no = 0 if key else struct.unpack_from("<I", pl, FRAME_PRE)[0]
         pic = pl[pre:]
         raw = method in (METHOD_RAW, METHOD_RAW_HASH)
-        if flags & ~1 or method > METHOD_RAW_HASH or (raw and (not key or len(pic) != FRAME_BYTES)):
+        if flags & ~1 or method > METHOD_COPY or (raw and (not key or len(pic) != FRAME_BYTES)):
             return self._bad(R_PAYLOAD)
         self._ok()
         if self.have_seen and _gt(frame_no, self.seen_no):
@@ -625,6 +641,12 @@ class Decoder:
         elif raw:
             recon = pic
             got = pixel_hash(recon) if method == METHOD_RAW_HASH else frame_check(recon)
+        elif method == METHOD_COPY:
+            try:
+                recon = decode_copy(pic, None if key else self.frame)
+                got = pixel_hash(recon)
+            except CopyError:
+                why = R_DECODE
         else:
             try:
                 recon, got = decode_picture(pic, None if key else self.frame, self.stats)

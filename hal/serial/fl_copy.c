@@ -281,9 +281,13 @@ static double rc_pos(const rc_enc *r)
 
 uint32_t fl_copy_encode(fl_copy_model *m, const uint8_t *px, const uint8_t *base, int32_t *hash, fl_writer *w)
 {
-    rc_enc r = {0};
+    rc_enc r; /* no initialiser: freestanding targets have no memset */
+    r.low = 0;
     r.range = 0xFFFFFFFFu;
     r.pending = 1;
+    r.cache = 0;
+    r.out = 0;
+    r.n = 0;
     r.w = w;
     int delta = base != 0;
     model_reset(m, delta);
