@@ -26,9 +26,9 @@ or any file of raw 64,000-byte frames given with --raw), it reports:
     with each frame's camera, --repeat 3 minus --repeat 1, halved), for the ratio;
   * textured against flat: the walk draws a WAD map textured (the tables above are of those
     frames); the same walk again with --flat (the same cameras), and for each the bytes per frame
-    with the firmware's scratch buffer (hal/mps2/stream_fl.c: a coded frame larger than it is sent
-    raw) and with one large enough for any frame, and the frames per second that 115,200 baud,
-    1 Mbaud and 4 Mbaud (8N1) and USB full speed carry.
+    as the host sends them (the COPY coding with its match finder) and as the firmware does
+    (without one), against zlib -9 of each frame alone (issue 27's goal: at most 0.6 x), and the
+    frames per second that 115,200 baud, 1 Mbaud and 4 Mbaud (8N1) and USB full speed carry.
 
 Usage: bench_link.py [--raw FRAMES.raw] [--frames 200] [--out build/bench-link.md] [--no-m3]
                      [--m3-every K] [--jobs 2]
@@ -54,7 +54,6 @@ BUILD = ROOT / "build"
 FRAME = 64000
 BAUD_BYTES = 115200 // 10
 FIRMWARE_SCRATCH = 8192     # hal/mps2/stream_fl.c's SCRATCH_BYTES
-LARGE_SCRATCH = 70000       # more than a raw frame message: no frame falls back to raw
 # (name, payload bytes per second): a UART at 8N1 carries baud / 10 bytes; USB full speed (12 Mbit/s)
 # at most 19 bulk packets of 64 bytes per 1 ms frame, its ceiling for a CDC serial port
 LINKS = [("115,200 baud", 115200 // 10), ("1 Mbaud", 1_000_000 // 10), ("4 Mbaud", 4_000_000 // 10),
@@ -75,11 +74,13 @@ def callgrind(args):
     return int(m.group(1))
 
 
-def link_sizes(fltool, raw, info, palette, key_interval, tmp, scratch=None):
+def link_sizes(fltool, raw, info, palette, key_interval, tmp, scratch=None, match_finder=True):
     stream = tmp / f"stream_k{key_interval}.bin"
     args = [fltool, "encode", raw, "--out", stream, "--key-interval", key_interval, "--sizes"]
     if scratch:
         args += ["--scratch", scratch]
+    if not match_finder:
+        args += ["--no-match-finder"]
     if info:
         args += ["--info", info]
     if palette:
@@ -120,7 +121,7 @@ def m3_counts(frames_raw, n, fltool):
     return enc, crc
 
 
-MODE_NAMES = {0: "spans", 1: "painter", 2: "direct"}  # firmware/render.c's mode_names, by number
+MODE_NAMES = {0: "spans", 1: "painter", 2: "direct", 3: "columns"}  # firmware/render.c: mode_names, by number
 
 
 def firmware_elf(scene):
@@ -197,32 +198,48 @@ def render_cost(render, scene, lines, sample):
     return costs
 
 
+SENDERS = [("host (build/emu, build/render: COPY with its match finder)", True),
+           ("firmware (hal/mps2/stream_fl.c: COPY without one)", False)]
+
+
 def textured_rows(fltool, walks, tmp):
-    """Per walk (name, DIR of fltool walk) and scratch size: (walk, scratch, mean bytes per frame,
-    max, frames sent raw) with a keyframe every 64 frames."""
+    """Per walk (name, DIR of fltool walk) and sender: (walk, sender, mean bytes per frame, max,
+    zlib -9 of each frame alone) with a keyframe every 64 frames and the firmware's scratch."""
     rows = []
     for name, d in walks:
-        for scratch in (FIRMWARE_SCRATCH, LARGE_SCRATCH):
-            sizes, _ = link_sizes(fltool, d / "frames.raw", d / "frames.jsonl", d / "palette.bin", 64, tmp, scratch)
+        raw = (d / "frames.raw").read_bytes()
+        alone = statistics.mean(len(zlib.compress(raw[k:k + FRAME], 9)) for k in range(0, len(raw), FRAME))
+        for who, mf in SENDERS:
+            sizes, _ = link_sizes(fltool, d / "frames.raw", d / "frames.jsonl", d / "palette.bin", 64, tmp,
+                                  FIRMWARE_SCRATCH, mf)
             b = [s["bytes"] for s in sizes]
-            rows.append((name, scratch, statistics.mean(b), max(b), sum(1 for x in b if x >= FRAME)))
+            rows.append((name, who, statistics.mean(b), max(b), alone))
     return rows
 
 
 def textured_table(rows, n, scene):
     out = [f"## Textured and flat frames: {n} frames of the fly-through of {scene}\n",
            "The same walk (the same cameras) drawn textured (fltool walk's default for a WAD map) and with --flat. "
-           f"Keyframe every 64 frames. Scratch: the buffer a coded frame message is built in; a frame whose coding "
-           f"does not fit is sent raw (64,000 bytes and the message around them). {FIRMWARE_SCRATCH:,} bytes is the "
-           f"firmware's (hal/mps2/stream_fl.c), {LARGE_SCRATCH:,} holds any frame. Frames per second: the link's "
+           f"Keyframe every 64 frames, the firmware's {FIRMWARE_SCRATCH:,}-byte scratch (flat frames are "
+           "edge-coded in it; textured frames go with the COPY coding, streamed). Frames per second: the link's "
            "bytes per second over the mean bytes per frame (8N1 UARTs carry baud / 10 bytes per second; USB full "
            "speed at most 19 bulk packets of 64 bytes per millisecond, 1,216,000 bytes per second).\n",
-           "| frames | scratch | mean bytes/frame | max | sent raw | " +
+           "| frames | sender | mean bytes/frame | max | / zlib -9 alone | " +
            " | ".join(f"fps at {name}" for name, _ in LINKS) + " |",
-           "|---|---:|---:|---:|---:|" + "---:|" * len(LINKS)]
-    for name, scratch, mean, mx, raw in rows:
-        out.append(f"| {name} | {scratch:,} | **{mean:,.0f}** | {fmt(mx)} | {raw} of {n} | " +
+           "|---|---|---:|---:|---:|" + "---:|" * len(LINKS)]
+    for name, who, mean, mx, alone in rows:
+        out.append(f"| {name} | {who} | **{mean:,.0f}** | {fmt(mx)} | {mean / alone:.2f} | " +
                    " | ".join(f"{bps / mean:.1f}" for _, bps in LINKS) + " |")
+    tex = [r for r in rows if "flat" not in r[0]]
+    flat = [r for r in rows if "flat" in r[0]]
+    out.append("")
+    for name, who, mean, _, alone in tex:
+        out.append(f"- Goal (issue 27): textured frames at most 0.6 x zlib -9 of each frame alone "
+                   f"({0.6 * alone:,.0f} bytes): {who.split(' (')[0]} {mean:,.0f}, {mean / alone:.2f} x zlib: "
+                   f"{'met' if mean <= 0.6 * alone else 'missed'}.")
+    for name, who, mean, _, _ in flat:
+        out.append(f"- Goal (issue 27): flat frames at most 265 bytes: {who.split(' (')[0]} {mean:,.0f}: "
+                   f"{'met' if mean <= 265 else 'missed'}.")
     return out
 
 

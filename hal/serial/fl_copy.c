@@ -313,14 +313,15 @@ uint32_t fl_copy_encode(fl_copy_model *m, const uint8_t *px, const uint8_t *base
         }
         /* candidates: the recent offsets, the neighbours, a hashed position */
         cand best = {0, 0, 0, 0, 0};
+        uint8_t here = px[pos];
         for (uint32_t i = 0; i < 4; i++) {
             int32_t off = m->rep[i];
-            if (copy_ok(pos, off, 1, delta))
+            if (copy_ok(pos, off, 1, delta) && vpix(px, base, (int32_t)pos - off) == here)
                 consider(&best, i == 0 ? K_REP0 : K_REP, i, off, match_len(px, base, pos, off, left));
         }
         for (uint32_t i = 0; i < NEAR_N; i++) {
             int32_t off = near_off[i];
-            if (!is_rep(m, off) && copy_ok(pos, off, 1, delta))
+            if (copy_ok(pos, off, 1, delta) && vpix(px, base, (int32_t)pos - off) == here && !is_rep(m, off))
                 consider(&best, K_NEAR, i, off, match_len(px, base, pos, off, left));
         }
         if (hash && left >= 4) {
@@ -389,14 +390,16 @@ typedef struct {
     uint32_t over; /* bytes read past the end */
 } rc_dec;
 
-static inline uint8_t next_byte(rc_dec *r)
+#define HOT static inline __attribute__((always_inline))
+
+HOT uint8_t next_byte(rc_dec *r)
 {
     if (r->p < r->end) return *r->p++;
     r->over++;
     return 0;
 }
 
-static inline uint32_t dec_bit(rc_dec *r, uint16_t *p)
+HOT uint32_t dec_bit(rc_dec *r, uint16_t *p)
 {
     uint32_t bound = (r->range >> PROB_BITS) * *p, bit;
     if (r->code < bound) {
@@ -416,7 +419,7 @@ static inline uint32_t dec_bit(rc_dec *r, uint16_t *p)
     return bit;
 }
 
-static uint32_t dec_direct(rc_dec *r, uint32_t nbits)
+HOT uint32_t dec_direct(rc_dec *r, uint32_t nbits)
 {
     uint32_t v = 0;
     while (nbits--) {
@@ -432,7 +435,7 @@ static uint32_t dec_direct(rc_dec *r, uint32_t nbits)
     return v;
 }
 
-static uint32_t dec_tree(rc_dec *r, uint16_t *p, uint32_t nbits)
+HOT uint32_t dec_tree(rc_dec *r, uint16_t *p, uint32_t nbits)
 {
     uint32_t m = 1;
     for (uint32_t i = 0; i < nbits; i++) m = m * 2 + dec_bit(r, p + m);
