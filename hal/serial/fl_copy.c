@@ -254,30 +254,6 @@ static void lit_encode(rc_enc *r, fl_copy_model *m, const uint8_t *px, uint32_t 
     enc_tree(r, m->p + LIT_CTX(pos ? px[pos - 1] : 0), px[pos], 8);
 }
 
-#ifdef FL_CP_STATS
-double cp_bits[8];
-long cp_cnt[8], cp_len[8];
-static double rc_pos(const rc_enc *r)
-{
-    double lg = 0;
-    uint32_t x = r->range;
-    while (x > 1) {
-        x >>= 1;
-        lg += 1;
-    }
-    return 8.0 * (r->out + r->pending) + 32 - lg;
-}
-#define STAT_BEGIN double stat_t0 = rc_pos(&r)
-#define STAT_END(k, l)                                                                                                 \
-    do {                                                                                                               \
-        cp_bits[k] += rc_pos(&r) - stat_t0;                                                                            \
-        cp_cnt[k]++;                                                                                                   \
-        cp_len[k] += (l);                                                                                              \
-    } while (0)
-#else
-#define STAT_BEGIN
-#define STAT_END(k, l)
-#endif
 
 uint32_t fl_copy_encode(fl_copy_model *m, const uint8_t *px, const uint8_t *base, int32_t *hash, fl_writer *w)
 {
@@ -333,11 +309,9 @@ uint32_t fl_copy_encode(fl_copy_model *m, const uint8_t *px, const uint8_t *base
         uint32_t best_len = best.len, best_i = best.i;
         int32_t best_off = best.off;
         uint32_t best_kind = best.kind == K_REP0 || best.kind == K_REP ? 1u : best.kind == K_NEAR ? 2u : 3u;
-        STAT_BEGIN;
         if (best_len == 0) {
             enc_bit(&r, m->p + P_IS_COPY + state, 0);
             lit_encode(&r, m, px, pos);
-            STAT_END(0, 1);
             if (hash && left >= 4) hash[hash4(px + pos)] = (int32_t)pos;
             pos++;
             state = K_LIT;
@@ -371,7 +345,6 @@ uint32_t fl_copy_encode(fl_copy_model *m, const uint8_t *px, const uint8_t *base
             }
         }
         enc_gamma(&r, m->p + P_LEN + 32 * (kind - 1), 5, m->p + P_LEN_HI + 64 * (kind - 1), best_len);
-        STAT_END(best_kind == 1 ? 1 + (best_i > 0) : best_kind + 1, best_len);
         if (hash)
             for (uint32_t i = 0; i < best_len && pos + i + 4 <= FL_FRAME_BYTES; i++)
                 hash[hash4(px + pos + i)] = (int32_t)(pos + i);
