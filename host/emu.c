@@ -1,12 +1,15 @@
 /* emu.c - build/emu: the host-emulated run. The firmware engine on the SDL target:
  * a window scaled up, keyboard input, counters on demand. Without a display it
  * says so and renders a short scripted fly-through to PNG files instead. With
- * --link it also sends every frame over the frame link to a display board. */
+ * --link it also sends its frames over the frame link to a display board,
+ * never waiting for it: a frame the link is not ready for is skipped
+ * (link_send.h), and the game's clock stays real time. */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 
 #include "engine.h"
 #include "fxtext.h"
@@ -43,10 +46,13 @@ static const char usage[] =
     "                to PNG files\n"
     "  --out DIR     where the headless fly-through goes (default build/flythrough;\n"
     "                with --link, PNG files only when --out is given)\n"
-    "  --link PORT   also send every frame over the frame link (docs/frame-link.md) to\n"
+    "  --link PORT   also send the frames over the frame link (docs/frame-link.md) to\n"
     "                a display board: PORT as build/display takes it, a tty or pty\n"
-    "                (set raw at --baud) or socket://HOST:PORT. The counters gain the\n"
-    "                link's bytes, frames, keyframes, deltas and acks\n"
+    "                (set raw at --baud) or socket://HOST:PORT. The game never waits\n"
+    "                for the board: a frame drawn while the link is behind is not\n"
+    "                sent (skipped). Headless, the fly-through then runs in real time.\n"
+    "                The counters gain the link's bytes, frames, keyframes, deltas,\n"
+    "                skipped frames and acks\n"
     "  --baud B      serial speed for a tty PORT (default 115200)\n"
     "  -h, --help    this text\n";
 
@@ -65,16 +71,18 @@ static void print_counters(const engine *e)
     printf(" bus_cycles=%llu", (unsigned long long)hal_perf_tsc());
     if (linked) {
         const fl_encoder *en = &linked->enc;
-        printf(" link_bytes=%u link_frames=%u link_keyframes=%u link_deltas=%u link_acks=%u link_timeouts=%u",
+        printf(" link_bytes=%u link_frames=%u link_keyframes=%u link_deltas=%u link_skipped=%u link_acks=%u "
+               "link_timeouts=%u",
                (unsigned)en->bytes, (unsigned)en->frames, (unsigned)en->keyframes, (unsigned)en->deltas,
-               (unsigned)en->acks, (unsigned)en->timeouts);
+               (unsigned)linked->skipped, (unsigned)en->acks, (unsigned)en->timeouts);
     }
     printf("\n");
     fflush(stdout);
 }
 
-/* One frame: drawn and presented (eng_step), then sent when linked.
- * 0, or -1 after a message when the link stopped. */
+/* One frame: drawn and presented (eng_step), then sent when linked (or
+ * skipped: link_frame never waits). 0, or -1 after a message when the link
+ * stopped. */
 static int step(engine *e, uint32_t input, uint32_t dt_ms)
 {
     eng_step(e, input, dt_ms);
@@ -158,6 +166,25 @@ static int run_window(engine *e, long frames, const char *shots)
     return 0;
 }
 
+static uint64_t mono_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (uint64_t)t.tv_sec * 1000u + (uint64_t)t.tv_nsec / 1000000u;
+}
+
+/* Linked, the fly-through keeps to its game clock (a frame every FLY_STEP_MS
+ * from start): the board shows it at its speed, as the window would, and a
+ * board that keeps up with the game is sent every frame. */
+static void wait_for_frame_time(uint64_t start, long i)
+{
+    uint64_t due = start + (uint64_t)i * FLY_STEP_MS, now = mono_ms();
+    if (now >= due) return;
+    struct timespec d = {(time_t)((due - now) / 1000u), (long)((due - now) % 1000u) * 1000000L};
+    while (nanosleep(&d, &d) != 0 && errno == EINTR) {
+    }
+}
+
 /* frames of a turn on the spot; to PNG files in dir unless dir is NULL */
 static int run_headless(engine *e, const char *dir, long frames)
 {
@@ -166,7 +193,9 @@ static int run_headless(engine *e, const char *dir, long frames)
         return 1;
     }
     char path[4096];
+    uint64_t start = mono_ms();
     for (long i = 0; i < frames; i++) {
+        if (linked) wait_for_frame_time(start, i);
         hal_perf_reset();
         if (step(e, i == 0 ? 0 : HAL_KEY_TURN_LEFT, i == 0 ? 1 : FLY_STEP_MS) != 0) return 1;
         if (!dir) continue;

@@ -37,8 +37,8 @@ static int receiver_gone(int err)
     return err == EPIPE || err == ECONNRESET || err == EIO || err == ENOTCONN || err == ENXIO;
 }
 
-/* Take what the receiver sent, without waiting, into pending (the encoder is
- * fed between frames, never in the middle of one). EOF: it closed its end. */
+/* Take what the receiver sent, without waiting, into pending. EOF: it closed
+ * its end. */
 static void read_back(link_sender *l)
 {
     while (!l->closed && l->npending < sizeof l->pending) {
@@ -55,26 +55,32 @@ static void read_back(link_sender *l)
     }
 }
 
+/* Everything the receiver has sent so far, to the encoder. */
 static void feed_back(link_sender *l)
 {
     fl_encoder *e = &l->enc;
     uint32_t before = e->acks + e->keyreqs + e->palette_reqs;
-    read_back(l);
-    if (l->npending) fl_enc_receive(e, l->pending, l->npending);
-    l->npending = 0;
+    for (;;) {
+        read_back(l);
+        int full = l->npending == sizeof l->pending;
+        if (l->npending) fl_enc_receive(e, l->pending, l->npending);
+        l->npending = 0;
+        if (!full || l->closed) break;
+    }
     if (e->acks + e->keyreqs + e->palette_reqs != before) l->heard = 1;
 }
 
-/* The encoder's output: written out whole, waiting on the port (and reading
- * what comes back meanwhile) while the receiver's buffers are full. */
-static void put(void *ctx, const uint8_t *p, uint32_t n)
+/* Write the queue out as far as the port takes it. With wait_ms, wait on the
+ * port (reading what comes back meanwhile) up to that long for it to take the
+ * rest. A port that takes nothing for LINK_STALL_MS stops the link. */
+static void drain(link_sender *l, uint32_t wait_ms)
 {
-    link_sender *l = ctx;
-    while (n > 0 && !l->failed) {
-        ssize_t w = write(l->fd, p, n);
+    uint32_t t0 = now_ms();
+    while (l->out_at < l->out_len && !l->failed) {
+        ssize_t w = write(l->fd, l->out + l->out_at, l->out_len - l->out_at);
         if (w > 0) {
-            p += w;
-            n -= (uint32_t)w;
+            l->out_at += (uint32_t)w;
+            l->out_moved_ms = now_ms();
             continue;
         }
         if (w < 0 && errno == EINTR) continue;
@@ -86,18 +92,47 @@ static void put(void *ctx, const uint8_t *p, uint32_t n)
             stop(l, "cannot write: %s", strerror(errno));
             return;
         }
-        struct pollfd pf = {l->fd, (short)(POLLOUT | (l->npending < sizeof l->pending ? POLLIN : 0)), 0};
-        int r = poll(&pf, 1, LINK_STALL_MS);
-        if (r < 0 && errno == EINTR) continue;
-        if (r == 0) {
+        uint32_t now = now_ms(), idle = now - l->out_moved_ms, spent = now - t0;
+        if (idle >= LINK_STALL_MS) {
             stop(l, "the receiver took no bytes for %d s", LINK_STALL_MS / 1000);
             return;
         }
-        if (pf.revents & POLLIN) read_back(l);
-        if ((pf.revents & (POLLERR | POLLHUP | POLLNVAL)) && !(pf.revents & POLLOUT)) {
+        if (spent >= wait_ms) return;
+        uint32_t left = wait_ms - spent;
+        if (left > LINK_STALL_MS - idle) left = LINK_STALL_MS - idle;
+        struct pollfd pf = {l->fd, (short)(POLLOUT | (l->npending < sizeof l->pending ? POLLIN : 0)), 0};
+        int r = poll(&pf, 1, (int)left);
+        if (r < 0 && errno != EINTR) {
+            stop(l, "cannot wait on it: %s", strerror(errno));
+            return;
+        }
+        if (r > 0 && (pf.revents & POLLIN)) read_back(l);
+        if (r > 0 && (pf.revents & (POLLERR | POLLHUP | POLLNVAL)) && !(pf.revents & POLLOUT)) {
             stop(l, "the receiver went away");
             return;
         }
+    }
+    if (l->out_at == l->out_len) l->out_at = l->out_len = 0;
+}
+
+/* The encoder's output: into the queue, written out by drain. A queue that
+ * cannot take it (never expected: LINK_OUT_BYTES holds two frame messages) is
+ * first written out, waiting on the port. */
+static void put(void *ctx, const uint8_t *p, uint32_t n)
+{
+    link_sender *l = ctx;
+    while (n > 0 && !l->failed) {
+        if (l->out_len == 0) l->out_moved_ms = now_ms(); /* the stall clock starts with the bytes */
+        uint32_t room = (uint32_t)sizeof l->out - l->out_len;
+        if (room == 0) {
+            drain(l, LINK_STALL_MS);
+            continue;
+        }
+        uint32_t k = n < room ? n : room;
+        memcpy(l->out + l->out_len, p, k);
+        l->out_len += k;
+        p += k;
+        n -= k;
     }
 }
 
@@ -129,32 +164,15 @@ int link_hello(link_sender *l, const char *scene, const uint8_t *blob, size_t bl
     if (l->failed) return -1;
     fl_enc_scene(&l->enc, scene, crc_update(0, blob, blob_len));
     fl_enc_hello(&l->enc);
+    drain(l, 0);
     return l->failed ? -1 : 0;
 }
 
-/* Flow control once the receiver has answered (as the firmware's AUTO): a
- * full window is waited out on the port, at most the encoder's ack timeout. */
-static void wait_window(link_sender *l)
+/* Code the frame into the queue (its palette first when new or changed): a
+ * delta against prev, the last frame sent, or a keyframe (fl_enc_frame). */
+static void send_frame(link_sender *l, uint32_t frame_no, const uint8_t *pixels, const uint8_t *palette,
+                       const fl_frame_info *info)
 {
-    feed_back(l);
-    if (!l->heard) return;
-    while (!l->failed && !l->closed && !fl_enc_may_send(&l->enc, now_ms())) {
-        struct pollfd pf = {l->fd, POLLIN, 0};
-        int r = poll(&pf, 1, (int)l->enc.ack_timeout_ms);
-        if (r < 0 && errno != EINTR) {
-            stop(l, "cannot wait for acks: %s", strerror(errno));
-            return;
-        }
-        feed_back(l);
-    }
-}
-
-int link_frame(link_sender *l, uint32_t frame_no, const uint8_t *pixels, const uint8_t *palette,
-               const fl_frame_info *info)
-{
-    wait_window(l);
-    if (l->closed) stop(l, "the receiver closed the link");
-    if (l->failed) return -1;
     if (!l->palette_sent || memcmp(l->palette, palette, sizeof l->palette)) {
         memcpy(l->palette, palette, sizeof l->palette); /* the encoder keeps the pointer for requests */
         fl_enc_palette(&l->enc, l->palette);
@@ -163,16 +181,76 @@ int link_frame(link_sender *l, uint32_t frame_no, const uint8_t *pixels, const u
     fl_frame_info fi = *info;
     fi.crc = crc_update(0, pixels, FL_FRAME_BYTES);
     fi.no_crc = 0;
-    int delta = l->have_prev && l->prev_no == frame_no - 1u;
-    fl_enc_frame(&l->enc, frame_no, pixels, delta ? l->prev : NULL, frame_no - 1u, &fi);
+    fl_enc_frame(&l->enc, frame_no, pixels, l->have_prev ? l->prev : NULL, l->prev_no, &fi);
     memcpy(l->prev, pixels, sizeof l->prev);
     l->have_prev = 1;
     l->prev_no = frame_no;
+}
+
+/* May a frame go now? Not while the last message is being written, nor, once
+ * the receiver has answered (as the firmware's AUTO), while its window is full
+ * (fl_enc_may_send gives a full window up after the ack timeout). */
+static int may_send(link_sender *l)
+{
+    return l->out_len == 0 && (!l->heard || fl_enc_may_send(&l->enc, now_ms()));
+}
+
+int link_frame(link_sender *l, uint32_t frame_no, const uint8_t *pixels, const uint8_t *palette,
+               const fl_frame_info *info)
+{
+    if (l->failed) return -1;
+    drain(l, 0);
+    feed_back(l);
+    if (l->closed) stop(l, "the receiver closed the link");
+    if (l->failed) return -1;
+    if (!may_send(l)) { /* the link is behind: this frame stays here */
+        memcpy(l->held, pixels, sizeof l->held);
+        memcpy(l->held_palette, palette, sizeof l->held_palette);
+        l->held_info = *info;
+        l->held_no = frame_no;
+        l->have_held = 1;
+        l->skipped++;
+        return 0;
+    }
+    l->have_held = 0;
+    send_frame(l, frame_no, pixels, palette, info);
+    drain(l, 0);
     return l->failed ? -1 : 0;
+}
+
+/* The whole queue written out, however long the port takes, unless it takes
+ * nothing for LINK_STALL_MS. */
+static void drain_all(link_sender *l)
+{
+    while (l->out_len && !l->failed) drain(l, LINK_STALL_MS);
 }
 
 int link_finish(link_sender *l)
 {
+    drain_all(l);
+    feed_back(l);
+    if (l->have_held) { /* the last frame drawn was skipped: it goes once there is room */
+        uint32_t t0 = now_ms();
+        int room = 0;
+        while (!l->failed && !l->closed && !(room = may_send(l)) && now_ms() - t0 < LINK_STALL_MS) {
+            if (l->out_len) {
+                drain(l, l->enc.ack_timeout_ms);
+            } else {
+                struct pollfd pf = {l->fd, POLLIN, 0};
+                if (poll(&pf, 1, (int)l->enc.ack_timeout_ms) < 0 && errno != EINTR) {
+                    stop(l, "cannot wait for acks: %s", strerror(errno));
+                    break;
+                }
+            }
+            feed_back(l);
+        }
+        if (room && !l->failed && !l->closed) {
+            send_frame(l, l->held_no, l->held, l->held_palette, &l->held_info);
+            l->have_held = 0;
+            l->skipped--;
+            drain_all(l);
+        }
+    }
     uint32_t t0 = now_ms();
     feed_back(l);
     while (!l->failed && !l->closed && l->enc.in_count > 0) {
@@ -194,10 +272,11 @@ void link_print_summary(const link_sender *l, FILE *f)
 {
     const fl_encoder *e = &l->enc;
     fprintf(f,
-            "link %s: %u frames (%u keyframes, %u deltas, %u raw), %u bytes; %u acks, %u keyframe requests, "
-            "%u timeouts, %u bad messages received\n",
+            "link %s: %u frames (%u keyframes, %u deltas, %u raw), %u skipped, %u bytes; %u acks, %u keyframe "
+            "requests, %u timeouts, %u bad messages received\n",
             l->port, (unsigned)e->frames, (unsigned)e->keyframes, (unsigned)e->deltas, (unsigned)e->raw_fallbacks,
-            (unsigned)e->bytes, (unsigned)e->acks, (unsigned)e->keyreqs, (unsigned)e->timeouts, (unsigned)e->rx_bad);
+            (unsigned)l->skipped, (unsigned)e->bytes, (unsigned)e->acks, (unsigned)e->keyreqs, (unsigned)e->timeouts,
+            (unsigned)e->rx_bad);
 }
 
 void link_print_json(const link_sender *l, FILE *f)
@@ -209,15 +288,18 @@ void link_print_json(const link_sender *l, FILE *f)
         if ((unsigned char)*p >= 0x20) fputc(*p, f);
     }
     fprintf(f,
-            "\", \"bytes\": %u, \"frames\": %u, \"keyframes\": %u, \"deltas\": %u, \"raw\": %u, \"acks\": %u, "
-            "\"keyreqs\": %u, \"palette_reqs\": %u, \"timeouts\": %u, \"rx_bad\": %u, \"error\": %s}",
+            "\", \"bytes\": %u, \"frames\": %u, \"keyframes\": %u, \"deltas\": %u, \"raw\": %u, \"skipped\": %u, "
+            "\"acks\": %u, \"keyreqs\": %u, \"palette_reqs\": %u, \"timeouts\": %u, \"rx_bad\": %u, \"error\": %s}",
             (unsigned)e->bytes, (unsigned)e->frames, (unsigned)e->keyframes, (unsigned)e->deltas,
-            (unsigned)e->raw_fallbacks, (unsigned)e->acks, (unsigned)e->keyreqs, (unsigned)e->palette_reqs,
-            (unsigned)e->timeouts, (unsigned)e->rx_bad, l->failed ? "true" : "false");
+            (unsigned)e->raw_fallbacks, (unsigned)l->skipped, (unsigned)e->acks, (unsigned)e->keyreqs,
+            (unsigned)e->palette_reqs, (unsigned)e->timeouts, (unsigned)e->rx_bad, l->failed ? "true" : "false");
 }
 
 void link_close(link_sender *l)
 {
+    /* what the receiver said last, read: a socket closed with bytes unread is
+     * reset, and its reset can cost the receiver the bytes it has not read yet */
+    if (l->fd > 0 && !l->closed) read_back(l);
     if (l->fd > 0) close(l->fd);
     l->fd = -1;
 }
