@@ -64,6 +64,7 @@ typedef struct {
     fl_frame_info held_info;
     fl_encoder enc;
     _Alignas(4) uint8_t scratch[LINK_SCRATCH_BYTES];
+    int32_t match_hash[FL_CP_HASH]; /* the COPY coder's match finder */
 } link_sender;
 
 /* Open PORT (port.h) for sending. Returns 0, or -1 with a message in err: PORT
