@@ -117,7 +117,7 @@ def test_emu_link_into_the_board(built, tmp_path, scene):
     """build/emu --headless --link: every frame shown by the board, the last one bit-identical to
     build/render's frame for the camera the link carried."""
     board_elf = ARM / "display-board.elf"  # its symbols; the flash image boots it
-    board = Board(built[1], f"--frames {FRAMES}", tmp=tmp_path)
+    board = Board(built[1], f"--frames {FRAMES} --log-frames", tmp=tmp_path)
     relay = None
     try:
         relay = Relay(board.tcp_port)
