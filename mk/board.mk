@@ -8,7 +8,7 @@
 #                                       application and the valid mark as a DFU download
 #                                       leaves them (build/board_image)
 #          build/arm/display-board.dfu  the application bytes with a DFU suffix 1209:0001
-#   make run-board [BOARD_PORT=tcp:N] [BOARD_ARGS="--frames N"]
+#   make run-board [BOARD_PORT=tcp:N] [BOARD_ARGS="--log-frames --frames N"]
 #       boots display-board.bin in qemu-system-arm (-kernel loads a raw image at 0 on M-profile) with UART0 a TCP server on port N
 #       (default 5555), waiting for the sender to connect
 #   make bench-board   the decoder's instructions per frame on the Cortex-M3
@@ -25,12 +25,15 @@ BOARD_OBJ   := $(BOARD_OUT)/board-obj
 # (hal/mps2/mps2.ld's .display), one link message, the decoder (hal/board/README.md).
 BOARD_RAM_BYTES   ?= 221184
 BOARD_STACK_BYTES ?= 4096
+# UART0's receive ring (hal/mps2/uart.c): a power of two; the main loop is woken
+# at each message's first byte and delimiter and at every half ring.
+BOARD_RX_RING     ?= 2048
 BOARD_BASE_SRC := hal/mps2/startup.c hal/mps2/uart.c hal/mps2/semihost.c hal/mps2/log.c hal/mps2/tick.c \
                   hal/bare/format.c hal/bare/libc.c firmware/crc32.c
 BOARD_APP_SRC  := $(BOARD_BASE_SRC) hal/board/main.c hal/board/board_args.c \
                   hal/serial/fl_framing.c hal/serial/fl_codec.c hal/serial/fl_copy.c hal/serial/fl_decoder.c
 BOARD_BOOT_SRC := $(BOARD_BASE_SRC) hal/board/boot.c firmware/dfu/dfu_device.c firmware/dfu/dfu_proto.c
-BOARD_CFLAGS = $(ARM_CFLAGS) -Ihal/board
+BOARD_CFLAGS = $(ARM_CFLAGS) -Ihal/board -DUART_RX_RING=$(BOARD_RX_RING) -DUART_RX_SPANS=1
 # $(1): ROM origin, $(2): ROM bytes
 board_ld = -T hal/mps2/mps2.ld -Wl,--gc-sections -Wl,--defsym=MPS2_ROM_ORIGIN=$(1) -Wl,--defsym=MPS2_ROM_BYTES=$(2) \
            -Wl,--defsym=MPS2_RAM_BYTES=$(BOARD_RAM_BYTES) -Wl,--defsym=MPS2_STACK_BYTES=$(BOARD_STACK_BYTES)
@@ -64,7 +67,7 @@ $(BOARD_OUT)/display-board.elf: $(patsubst %.c,$(BOARD_OBJ)/%.o,$(BOARD_APP_SRC)
 	@$(call board_nofloat,$@)
 	@$(ARMSIZE) $@ | sed 's/^/board: /'
 	@need=$$(($$($(ARMNM) $@ | awk '$$3=="__ram_need"{print "0x"$$1}'))); \
-	echo "board: RAM $$need of $(BOARD_RAM_BYTES) bytes: stack $(BOARD_STACK_BYTES), pages + palette + display start 128772, the rest .data/.bss (the link message, the decoder)"
+	echo "board: RAM $$need of $(BOARD_RAM_BYTES) bytes: stack $(BOARD_STACK_BYTES), pages + palette + display start 128772, the rest .data/.bss (the link message, the decoder, the $(BOARD_RX_RING)-byte receive ring)"
 
 $(BOARD_OUT)/board-boot.elf: $(patsubst %.c,$(BOARD_OBJ)/%.o,$(BOARD_BOOT_SRC)) hal/mps2/mps2.ld
 	$(ARMCC) $(BOARD_CFLAGS) $(call board_ld,0x00000000,0x00010000) $(filter %.o,$^) -lgcc -o $@
@@ -88,7 +91,7 @@ $(BUILD)/board_image: $(patsubst %.c,$(BUILD)/obj/%.o,$(BOARD_IMAGE_SRC))
 	$(CC) $(REL) $^ -o $@
 
 BOARD_PORT ?= tcp:5555
-BOARD_ARGS ?=
+BOARD_ARGS ?= --log-frames
 run-board: display-board
 	@echo "board: UART0 (the frame link) on $(BOARD_PORT), waiting for the sender; log below"
 	$(QEMU_ARM) -M mps2-an385 -nographic -monitor none -semihosting-config enable=on,target=native \

@@ -119,7 +119,7 @@ def test_emu_link_into_the_board(built, tmp_path, scene):
     emu never waits for the board: a frame drawn while the board is behind (textured frames, at the
     fly-through's 12 a second) is skipped, and the last one is sent at the end (host/link_send.h)."""
     board_elf = ARM / "display-board.elf"  # its symbols; the flash image boots it
-    board = Board(built[1], "", tmp=tmp_path)  # no --frames: how many come depends on the board's pace
+    board = Board(built[1], "--log-frames", tmp=tmp_path)  # no --frames: how many come depends on the board's pace
     relay = None
     try:
         relay = Relay(board.tcp_port)

@@ -4,8 +4,10 @@ link over TCP from a second QEMU and shows the frames; the page it shows, read o
 memory over QMP, is bit-identical to build/render's frame for the camera the link carried. A
 damaged application or an erased valid mark is refused by the bootloader, which never jumps.
 """
+import random
 import re
 import shutil
+import socket
 import struct
 import subprocess
 import sys
@@ -13,7 +15,7 @@ import zlib
 
 import pytest
 
-from conftest import BUILD, ROOT, program, run
+from conftest import BUILD, ROOT, freedoom, program, run
 
 sys.path.insert(0, str(ROOT / "tools"))
 from boardrig import ARM, Board, Sender, frames_of  # noqa: E402
@@ -50,12 +52,12 @@ def host_frame(scene, f, tmp_path):
     return raw.read_bytes()
 
 
-def stream_into_board(image, fw_elf, tmp_path, frames=FRAMES):
-    """Boot image as the board, stream frames in from the rendering firmware, stop the board over QMP.
-    Returns (board log, the frames it logged, the display-start register, the page it shows, the
-    sender's output)."""
+def stream_into_board(image, fw_elf, tmp_path, frames=FRAMES, log_frames=True):
+    """Boot image as the board (with --log-frames unless log_frames is false), stream frames in from
+    the rendering firmware, stop the board over QMP. Returns (board log, the frames it logged, the
+    display-start register, the page it shows, the sender's output)."""
     board_elf = ARM / "display-board.elf"
-    board = Board(image, f"--frames {frames}", tmp=tmp_path)
+    board = Board(image, f"--frames {frames}" + (" --log-frames" if log_frames else ""), tmp=tmp_path)
     snd = None
     try:
         snd = Sender(fw_elf, board.tcp_port, f"--frames {frames} --acks on", tmp=tmp_path)
@@ -88,6 +90,65 @@ def test_rendering_firmware_streams_into_the_board(built, tmp_path):
     assert zlib.crc32(page) == last["crc32"]
     assert page == host_frame(ARM / "scene.bsc", last, tmp_path)
     assert len(set(page)) > 3
+
+
+def test_board_without_log_frames(built, tmp_path):
+    """Without --log-frames the board logs no line per frame, only its summary, and still shows every
+    frame (the last one on the page it flipped to)."""
+    fw_elf, image = built
+    frames = 4
+    text, logged, start, page, sent = stream_into_board(image, fw_elf, tmp_path, frames=frames, log_frames=False)
+    assert logged == [] and "board: frame " not in text, text
+    assert f"board: done: {frames} frames shown, 0 dropped, 0 missed, 0 bad messages" in text, text
+    assert "so far" not in text  # a line of counters only every 1000 frames
+    assert start == (frames % 2)  # page 1 shows frame 0, page 0 frame 1, ...
+    assert len(set(page)) > 3
+
+
+def test_board_takes_a_damaged_stream(built, tmp_path):
+    """A stream straight into the board's UART over TCP, with runs of empty segments (more delimiters
+    than the receive ring notes: the board finds them by a scan), a damaged message and textured
+    frames larger than its receive ring: every frame is shown, and the CRC-32 the board logs for each
+    (the sender sent none) is that of the frame encoded."""
+    fltool = program("fltool", sanitized=False)
+    walk = tmp_path / "walk"
+    walk.mkdir()
+    frames = 6
+    run([fltool, "walk", f"{freedoom('freedoom2.wad')}:MAP01", "--frames", frames, "--out", walk])
+    run([fltool, "encode", walk / "frames.raw", "--info", walk / "frames.jsonl", "--palette", walk / "palette.bin",
+         "--no-crc", "--out", tmp_path / "stream.bin"])
+    msgs = [m + b"\0" for m in (tmp_path / "stream.bin").read_bytes().split(b"\0")[:-1]]
+    assert len(msgs) == 2 + frames and max(len(m) for m in msgs) > 8192  # hello, palette, frames
+    rng = random.Random(27)
+    garbage = bytes(rng.randrange(1, 256) for _ in range(3000)) + b"\0"
+    data = (msgs[0] + b"\0" * 100 + msgs[1] + garbage + b"".join(msgs[2:5]) + b"\0" * 40 +
+            b"".join(m + b"\0" * 3 for m in msgs[5:]))
+    raw = (walk / "frames.raw").read_bytes()
+    board = Board(built[1], f"--frames {frames} --log-frames", tmp=tmp_path)
+    try:
+        with socket.create_connection(("127.0.0.1", board.tcp_port)) as s:
+            s.sendall(data)
+            board.wait_for(r"board: done:[^\n]*\n", 120)
+        start, page = board.shown_page(ARM / "display-board.elf", tmp_path)
+        text = board.text
+    finally:
+        board.kill()
+        board.wait()
+    shown = frames_of(text)
+    assert [f["frame"] for f in shown] == list(range(frames)), text
+    assert [f["crc32"] for f in shown] == [zlib.crc32(raw[k * 64000:(k + 1) * 64000]) for k in range(frames)]
+    assert f"board: done: {frames} frames shown, 0 dropped, 0 missed, 1 bad messages, 1 resyncs" in text, text
+    empty = 100 + 40 + 3 * (frames - 3)  # delimiters of empty segments: the board does not feed them to the decoder
+    assert f"{len(data) - empty} bytes, 0 UART overruns" in text, text
+    assert start == shown[-1]["page"] and page == raw[-64000:]
+
+
+def test_board_options(built, tmp_path):
+    """A bad option is refused with status 5 and says what the board takes."""
+    _, image = built
+    board = Board(image, "--log-frame", listen=False, tmp=tmp_path)
+    assert board.wait(30) == 5, board.text
+    assert "unknown option '--log-frame' (the board takes --frames N and --log-frames)" in board.text
 
 
 def test_flash_image_layout(built):

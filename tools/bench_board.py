@@ -6,8 +6,10 @@ streams its MAP01 camera path over TCP into the display board booted from build/
 textured and with --flat, with the board's QEMU running the instruction-counting plugin
 (build/insn_count.so). The board marks each link message from its first byte to the end of its
 handling (fw_mark_frame_begin/end in hal/board/main.c): receiving the bytes (the UART interrupt
-and ring), COBS, the message CRC, rebuilding the frame into the hidden page, the frame check and
-pixel CRC-32, the flip and the ack. The board's log names the message (seg) of each frame shown.
+and ring), COBS, the message CRC, rebuilding the frame into the hidden page, the frame check (and
+the pixel CRC-32 when the sender sent one), the flip and the ack. The board runs with --log-frames:
+its line per frame names the message (seg) of each frame shown; the CRC-32 of the page that line
+gives is computed after the end mark, outside the count.
 
 Frames per second assume one instruction per cycle at the AN385's 25 MHz: an upper bound; a
 real core spends extra cycles on branches, loads and wait states.
@@ -34,8 +36,10 @@ HZ = 25_000_000
 
 # Where the instructions inside the marks go, by the object file the code comes from (the
 # link map), from the plugin's profile=.
-PARTS = [("UART receive (interrupt, ring) and the main loop", ("hal/mps2/uart.o", "hal/board/main.o")),
-         ("decoder (hal/serial: COBS, message check, picture decoding, frame check)", ("hal/serial/",)),
+RECEIVE = "UART receive (interrupt, ring) and the main loop"
+PARTS = [(RECEIVE, ("hal/mps2/uart.o", "hal/board/main.o")),
+         ("picture decoder of method COPY (hal/serial/fl_copy.c)", ("hal/serial/fl_copy.o",)),
+         ("rest of the decoder (hal/serial: COBS, message check, EDGE pictures, frame check)", ("hal/serial/",)),
          ("CRC-32 (message CRC, pixel CRC-32; firmware/crc32.c)", ("firmware/crc32.o",))]
 OTHER = "other"
 
@@ -77,13 +81,22 @@ def profile_parts(map_file, profile):
     return parts
 
 
+def irq_entries(elf, profile):
+    """Runs of the UART receive interrupt's first instruction inside the marks."""
+    addr = symbol(elf, "uart0_rx_irq") & ~1
+    for line in Path(profile).read_text().splitlines():
+        if not line.startswith("#") and int(line.split()[0], 0) == addr:
+            return int(line.split()[1])
+    return 0
+
+
 def run_case(fw_elf, frames, flat, tmp):
     board_elf = ARM / "display-board.elf"
     counts = tmp / f"board-insns{'-flat' if flat else ''}.txt"
     profile = tmp / f"board-profile{'-flat' if flat else ''}.txt"
     plugin = (f"{BUILD / 'insn_count.so'},begin={symbol(board_elf, 'fw_mark_frame_begin'):#x},"
               f"end={symbol(board_elf, 'fw_mark_frame_end'):#x},out={counts},profile={profile}")
-    board = Board(ARM / "display-board.bin", f"--frames {frames}", tmp=tmp, plugin=plugin)
+    board = Board(ARM / "display-board.bin", f"--frames {frames} --log-frames", tmp=tmp, plugin=plugin)
     snd = None
     try:
         snd = Sender(fw_elf, board.tcp_port, f"--frames {frames} --acks on" + (" --flat" if flat else ""), tmp=tmp)
@@ -105,7 +118,11 @@ def run_case(fw_elf, frames, flat, tmp):
     delta = [per_seg[f["seg"]] for f in shown if not f["key"]]
     every = key + delta
     summary = board.text[board.text.index("board: done:"):].splitlines()[0]
-    return dict(parts=profile_parts(ARM / "display-board.map", profile), segs=len(per_seg), sent=[l for l in sent.splitlines() if "link:" in l][0], frames=frames, median=statistics.median(every), max=max(every),
+    received = int(re.search(r"(\d+) bytes, \d+ UART overruns", summary).group(1))
+    return dict(received=received, irqs=irq_entries(board_elf, profile),
+                parts=profile_parts(ARM / "display-board.map", profile), segs=len(per_seg),
+                sent=[l for l in sent.splitlines() if "link:" in l][0], frames=frames,
+                median=statistics.median(every), max=max(every),
                 key_median=statistics.median(key) if key else 0, delta_median=statistics.median(delta) if delta else 0,
                 keys=len(key), summary=summary)
 
@@ -145,6 +162,10 @@ def main():
             total = sum(r["parts"].values())
             cells.append(f"{r['parts'][label] / r['frames']:,.0f} ({100 * r['parts'][label] / total:.0f}%)")
         lines.append(f"| {label} | " + " | ".join(cells) + " |")
+    lines += ["", "Receiving: " + "; ".join(
+        f"{'flat' if f else 'textured'}: {r['received']:,} bytes, {r['irqs']:,} of their receive interrupts inside "
+        f"the marks, {r['parts'][RECEIVE] / max(r['irqs'], 1):.1f} instructions of the UART receive part per byte "
+        f"there" for f, r in results) + "."]
     text = "\n".join(lines) + "\n"
     print(text)
     Path(a.out).write_text(text)

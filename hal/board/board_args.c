@@ -54,6 +54,7 @@ int board_args_parse(board_args *a, const char *cmdline, char *err, uint32_t err
 {
     char w[32];
     a->frames = 0;
+    a->log_frames = 0;
     const char *s = cmdline;
     next_word(&s, w, sizeof w); /* the program (QEMU: the -kernel file) */
     while (next_word(&s, w, sizeof w)) {
@@ -65,8 +66,10 @@ int board_args_parse(board_args *a, const char *cmdline, char *err, uint32_t err
                 return -1;
             }
             a->frames = (uint32_t)n;
+        } else if (streq(w, "--log-frames")) {
+            a->log_frames = 1;
         } else {
-            say(err, err_size, "unknown option '", w, "' (the board takes --frames N)");
+            say(err, err_size, "unknown option '", w, "' (the board takes --frames N and --log-frames)");
             return -1;
         }
     }
