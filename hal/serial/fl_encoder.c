@@ -193,9 +193,13 @@ int fl_enc_may_send(fl_encoder *e, uint32_t now_ms)
         e->stall_since_ms = now_ms;
         return 0;
     }
-    if (now_ms - e->stall_since_ms >= e->ack_timeout_ms) { /* the acks were lost: start afresh */
+    if (now_ms - e->stall_since_ms >= e->ack_timeout_ms) {
+        /* the oldest frame's ack was lost (or the receiver is slow): give that one
+         * frame up, not the window, so that a slow receiver is sent one frame
+         * more per timeout, not a window more, and its backlog stays bounded */
         e->timeouts++;
-        e->in_count = 0;
+        e->in_head = (uint8_t)((e->in_head + 1) % FL_WINDOW_MAX);
+        e->in_count--;
         e->stalled = 0;
         return 1;
     }
