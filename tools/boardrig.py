@@ -27,7 +27,7 @@ BASE = [QEMU, "-M", "mps2-an385", "-nographic", "-monitor", "none",
         "-semihosting-config", "enable=on,target=native"]
 
 FRAME_RE = re.compile(r"board: frame (\d+) crc32 0x([0-9a-f]{8}) shown page (\d) camera (-?\d+) (-?\d+) (-?\d+) "
-                      r"(-?\d+) look (-?\d+) mode (\d+) present (\d+) key (\d) seg (\d+)")
+                      r"(-?\d+) look (-?\d+) mode (\d+) present (\d+) key (\d) seg (\d+) time (\d+)")
 
 
 def free_port():
@@ -40,10 +40,10 @@ def frames_of(text):
     """The board's frame lines as dicts (camera raw 16.16)."""
     out = []
     for m in FRAME_RE.finditer(text):
-        f, crc, page, x, y, z, a, look, mode, present, key, seg = m.groups()
+        f, crc, page, x, y, z, a, look, mode, present, key, seg, t = m.groups()
         out.append(dict(frame=int(f), crc32=int(crc, 16), page=int(page), x=int(x), y=int(y), z=int(z),
                         angle=int(a), look=int(look), mode=int(mode), present=int(present), key=int(key),
-                        seg=int(seg)))
+                        seg=int(seg), time_ms=int(t)))
     return out
 
 

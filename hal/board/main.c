@@ -91,10 +91,10 @@ static void log_frame(const fl_event *ev, uint32_t seg)
     /* the sender's CRC-32, which the decoder checked the page against, or the page's own */
     uint32_t crc = in->no_crc ? crc_update(0, dec.frame, FL_FRAME_BYTES) : in->crc;
     log_printf("board: frame %u crc32 0x%08x shown page %u camera %d %d %d %d look %d mode %u present %u key %u "
-               "seg %u\n",
+               "seg %u time %u\n",
                (unsigned)ev->frame_no, (unsigned)crc, (unsigned)mps2_display_start, (int)in->x, (int)in->y, (int)in->z,
                (int)in->angle, (int)in->look, (unsigned)in->mode, (unsigned)in->present, (unsigned)ev->keyframe,
-               (unsigned)seg);
+               (unsigned)seg, (unsigned)in->time_ms);
 }
 
 static void log_counters(const char *what)
