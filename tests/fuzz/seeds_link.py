@@ -346,6 +346,8 @@ def main():
     # no acks, a full window given up after the timeout, a skipped frame number
     seeds["rt-no-back-channel"] = round_trip(16 | 1 << 5, 0x7FFFFFFF, 4096, 0,
                                              [(0, scene, None), (3 << 3, [SCROLL_UP], None)])
+    # window 2, no acks: the timeout gives up the oldest frame in flight, one stays
+    seeds["rt-no-back-channel-window-2"] = round_trip(16 | 2 << 5, 5, 0, 0, [(0, scene, None), (0, [SCROLL_UP], None)])
     seeds["rt-hello-no-crc"] = round_trip(8, 3, 0, 0, [(0x20, scene, None), (0x80 | 0x20, [WALL], None)])
 
     # COPY: textured pictures (a keyframe and deltas, sent as they come), random bytes
