@@ -14,17 +14,26 @@
  *                   [len u16][payload: len bytes]
  *                 ctl & 7 is the type (7: the payload is a whole message body, header
  *                 included, to which only CRC and COBS are added); the harness frames
- *                 it with fl_writer (right header, CRC-32, COBS), so arbitrary payloads
- *                 reach the message handling and fl_decode_picture. 0x10 "fix up" a
- *                 frame message: method, flags, the base number of the frame shown,
- *                 and the frame check and pixel CRC-32 of what its picture decodes to,
- *                 after which the decoder must show it; 0x20 pad the payload to a raw
- *                 keyframe's size by repeating it; 0x40 with fix-up: no pixel CRC-32.
- *   2 round trip  [start frame number u32][scratch u16][key interval u8] then frames
+ *                 it with fl_writer (right header, CRC-32, COBS; a frame payload whose
+ *                 method byte is COPY streamed, length field 0xFFFFFF, and its CRC, as a
+ *                 RAW_HASH keyframe's, over the header and payload up to the method
+ *                 byte), so arbitrary payloads reach the message handling and the picture
+ *                 decoders (fl_decode_picture, fl_copy_decode). 0x10 "fix up" a frame
+ *                 message: method (COPY if the method byte & 3 is 3; a padded raw-size
+ *                 keyframe RAW_HASH if it is 2, else RAW; else edge), flags, the base
+ *                 number of the frame shown, and the frame check and pixel CRC-32 of what
+ *                 its picture decodes to (the harness's own call of the picture decoder),
+ *                 after which the decoder must show that picture; 0x20 pad the payload
+ *                 by repeating it: to a raw keyframe's size, or for a COPY picture with
+ *                 as many bytes as the pixels its decoding stops at leave (the plain tail
+ *                 of the escape); 0x40 with fix-up: no pixel CRC-32.
+ *   2 round trip  [start frame number u32][scratch u16][key interval u8, | 16: the COPY
+ *                 coder's match finder] then frames
  *                   [ctl u8][ctl & 7 drawing commands of 6 bytes]
  *                   [damage: u16 position from the end, u8 xor if ctl & 0x40]
- *                 up to MAX_RT frames drawn from commands, sent by fl_enc (keyframes,
- *                 deltas, raw fallback), the receiver's acks and keyframe requests fed
+ *                 up to MAX_RT frames drawn from commands (flat shapes, scrolling,
+ *                 textures, noise), sent by fl_enc (keyframes and deltas, edge-coded or
+ *                 COPY, the escape of noise), the receiver's acks and keyframe requests fed
  *                 back to the sender; ctl picks the base (the true previous frame, none,
  *                 a wrong one), a skipped frame number, no pixel CRC-32, line damage and
  *                 a HELLO; the first byte / 3 holds the global knobs: HELLO and palette
@@ -33,10 +42,14 @@
  * Checked on every event (abort() on failure):
  *   - a frame shown matches the frame check and, when sent, the pixel CRC-32 that its
  *     message promised (both computed here as docs/frame-link.md defines them, apart
- *     from fl_codec.c and firmware/crc32.c); its message is intact; a delta is shown
- *     only on the frame it names as base; the event's info is the message's; a raw
- *     keyframe shows its bytes; in the round trip, the frame shown is bit-exact the
- *     frame sent with its number;
+ *     from fl_codec.c and firmware/crc32.c; the pixel hash for RAW_HASH and COPY); its
+ *     message is intact (its CRC over the span section 2 says); a delta is shown only
+ *     on the frame it names as base; the event's info is the message's; a raw
+ *     keyframe shows its bytes, a fixed-up frame what the harness decoded; in the round
+ *     trip, the frame shown is bit-exact the frame sent with its number;
+ *   - a frame is dropped for a reason its message allows (no base: a delta off the
+ *     frame shown; decode: a coded picture, edge or COPY, keyframe or delta on the
+ *     frame shown; frame check: not a raw keyframe that passes its checks);
  *   - the frame buffer changes only when a frame is shown (compared with a shadow copy
  *     on every drop, at the end, and on the first few other events);
  *   - frames the harness knows to be good (fixed up with this file's frame check, or
@@ -47,6 +60,9 @@
  *     palettes, keyframe and palette requests, acks), shown + dropped + missed spans
  *     the frame numbers of a session numbered upwards, bytes fed, good + bad =
  *     non-empty segments;
+ *   - the round trip's encoder sends edge-coded pictures with their length and COPY
+ *     ones streamed, never a raw fallback, and counts as COPY frames the COPY messages
+ *     that arrive (all of them when nothing was damaged);
  *   - every message sent back is intact (decoded by this file's own COBS reader) and
  *     says what happened: an ack per frame message, a keyframe request exactly when
  *     section 6 says (the first drop, and again after window + 1 more), palette
@@ -159,7 +175,9 @@ typedef struct {
     /* the message being fed (framed, round trip) */
     int expect;
     fl_reason expect_reason;
-    int keyreq_since_frame; /* a keyframe request went back since the last frame was sent */
+    const uint8_t *expect_px; /* EXPECT_SHOW after a fix-up: the picture the frame must be */
+    uint32_t copy_msgs;       /* intact frame messages of method COPY (shown or dropped) */
+    int keyreq_since_frame;   /* a keyframe request went back since the last frame was sent */
     uint32_t spot_checks;
 
     /* what docs/frame-link.md, section 6, says the receiver does next */
@@ -179,11 +197,13 @@ typedef struct {
     uint8_t *sent_px[MAX_RT];
 } harness;
 
-static uint8_t *g_frame, *g_work, *g_shadow, *g_pic, *g_payload, *g_line;
+static uint8_t *g_frame, *g_work, *g_shadow, *g_pic, *g_pic2, *g_payload, *g_line;
 static uint8_t *g_page_a[2], *g_page_u[2], *g_wrong, *g_sent[MAX_RT];
 static fl_decoder *g_dec;
 static fl_encoder *g_enc;
 static fl_coder *g_coder;
+static fl_copy_model *g_copy;
+static int32_t *g_match; /* the COPY coder's match finder (FL_CP_HASH entries) */
 static uint32_t g_line_len;
 
 static void setup_once(void)
@@ -194,6 +214,7 @@ static void setup_once(void)
     g_work = fuzz_alloc(FL_DEC_WORK_BYTES);
     g_shadow = fuzz_alloc(FL_FRAME_BYTES);
     g_pic = fuzz_alloc(FL_FRAME_BYTES);
+    g_pic2 = fuzz_alloc(FL_FRAME_BYTES);
     g_payload = fuzz_alloc(FL_PAYLOAD_MAX + 64);
     g_line = fuzz_alloc(LINE_BYTES);
     for (int i = 0; i < 2; i++) {
@@ -205,6 +226,8 @@ static void setup_once(void)
     g_dec = fuzz_alloc(sizeof *g_dec);
     g_enc = fuzz_alloc(sizeof *g_enc);
     g_coder = fuzz_alloc(sizeof *g_coder);
+    g_copy = fuzz_alloc(sizeof *g_copy);
+    g_match = fuzz_alloc(FL_CP_HASH * sizeof *g_match);
 }
 
 UNTRACED static int frame_unchanged(const harness *h)
@@ -268,6 +291,7 @@ typedef struct {
     uint32_t plen;
     uint32_t pre; /* info, flags, check, [base], method */
     uint8_t flags, method;
+    int streamed; /* length field 0xFFFFFF: the payload runs to the CRC */
     uint32_t check, crc, base_no;
 } frame_msg;
 
@@ -286,30 +310,44 @@ static uint32_t ref_pixel_hash(const uint8_t *px)
     return h ^ (h >> 16);
 }
 
-/* The check a frame message carries, of these pixels. */
+/* The check a frame message carries, of these pixels: the pixel hash for the methods
+ * whose pictures the message CRC leaves out (RAW_HASH, COPY), else the frame check. */
 static uint32_t ref_check_of(uint8_t method, const uint8_t *px)
 {
-    return method == FL_METHOD_RAW_HASH ? ref_pixel_hash(px) : ref_frame_check(px);
+    return method == FL_METHOD_RAW_HASH || method == FL_METHOD_COPY ? ref_pixel_hash(px) : ref_frame_check(px);
 }
 
+static int is_raw_method(uint8_t method)
+{
+    return method == FL_METHOD_RAW || method == FL_METHOD_RAW_HASH;
+}
+
+/* The message's layout, as docs/frame-link.md, section 2, has it (apart from
+ * fl_framing.c): a KEYFRAME or DELTA whose length field is 0xFFFFFF, with at least one
+ * picture byte and method COPY, is streamed (its payload runs to the CRC); its CRC, and
+ * that of a RAW_HASH keyframe of exactly 64,000 pixel bytes, covers the header and the
+ * payload up to the method byte; any other message's covers all but the CRC. */
 static void current_frame_msg(const harness *h, frame_msg *m)
 {
     const uint8_t *b = h->d->rx.buf;
     uint32_t len = h->d->rx.len;
     REQUIRE(len >= FL_HEADER_BYTES + FL_CRC_BYTES);
-    uint32_t raw_pre = FL_HEADER_BYTES + FL_FRAME_PRE + 1; /* a RAW_HASH keyframe's CRC stops at its method */
-    int raw_hash = len == raw_pre + FL_FRAME_BYTES + FL_CRC_BYTES && b[1] == FL_MSG_KEYFRAME &&
-                   b[raw_pre - 1] == FL_METHOD_RAW_HASH;
-    REQUIRE(ref_crc(b, raw_hash ? raw_pre : len - FL_CRC_BYTES) == fl_get32(b + len - FL_CRC_BYTES));
-    REQUIRE(b[0] == FL_VERSION);
-    uint32_t plen = (uint32_t)b[6] | (uint32_t)b[7] << 8 | (uint32_t)b[8] << 16;
-    REQUIRE(plen == len - FL_HEADER_BYTES - FL_CRC_BYTES);
     m->type = b[1];
     REQUIRE(m->type == FL_MSG_KEYFRAME || m->type == FL_MSG_DELTA);
+    m->pre = FL_FRAME_PRE + (m->type == FL_MSG_DELTA ? 4u : 0u) + 1u;
+    uint32_t field = (uint32_t)b[6] | (uint32_t)b[7] << 8 | (uint32_t)b[8] << 16;
+    uint32_t mpre = FL_HEADER_BYTES + m->pre; /* header, info, flags, check, [base], method */
+    uint8_t mb = len >= mpre ? b[mpre - 1] : 0xFFu;
+    m->streamed = field == 0xFFFFFFu && len > mpre + FL_CRC_BYTES && mb == FL_METHOD_COPY;
+    int raw_hash = m->type == FL_MSG_KEYFRAME && len == mpre + FL_FRAME_BYTES + FL_CRC_BYTES &&
+                   mb == FL_METHOD_RAW_HASH;
+    REQUIRE(ref_crc(b, raw_hash || m->streamed ? mpre : len - FL_CRC_BYTES) == fl_get32(b + len - FL_CRC_BYTES));
+    REQUIRE(b[0] == FL_VERSION);
+    uint32_t plen = m->streamed ? len - FL_HEADER_BYTES - FL_CRC_BYTES : field;
+    REQUIRE(plen == len - FL_HEADER_BYTES - FL_CRC_BYTES && plen <= FL_PAYLOAD_MAX);
     m->frame_no = fl_get32(b + 2);
     m->pl = b + FL_HEADER_BYTES;
     m->plen = plen;
-    m->pre = FL_FRAME_PRE + (m->type == FL_MSG_DELTA ? 4u : 0u) + 1u;
     REQUIRE(plen >= m->pre);
     m->flags = m->pl[FL_INFO_BYTES];
     REQUIRE((m->flags & ~1u) == 0);
@@ -317,8 +355,10 @@ static void current_frame_msg(const harness *h, frame_msg *m)
     m->crc = fl_get32(m->pl + 22);
     m->base_no = m->type == FL_MSG_DELTA ? fl_get32(m->pl + FL_FRAME_PRE) : 0;
     m->method = m->pl[m->pre - 1];
-    REQUIRE(m->method <= FL_METHOD_RAW_HASH);
-    if (m->method != FL_METHOD_EDGE) REQUIRE(m->type == FL_MSG_KEYFRAME && plen == m->pre + FL_FRAME_BYTES);
+    REQUIRE(m->method <= FL_METHOD_COPY);
+    if (is_raw_method(m->method)) REQUIRE(m->type == FL_MSG_KEYFRAME && plen == m->pre + FL_FRAME_BYTES);
+    /* round trip: the encoder sends edge-coded pictures with their length, COPY streamed */
+    if (h->sent_n) REQUIRE(m->method == FL_METHOD_COPY ? m->streamed : m->method == FL_METHOD_EDGE && !m->streamed);
 }
 
 /* The ack of a frame message goes back before its event. */
@@ -340,8 +380,10 @@ static void on_frame(harness *h, const fl_event *ev)
     uint32_t crc = ref_crc(h->frame, FL_FRAME_BYTES);
     REQUIRE(ref_check_of(m.method, h->frame) == m.check);
     if (m.flags & 1u) REQUIRE(crc == m.crc);
-    if (m.method != FL_METHOD_EDGE) REQUIRE(memcmp(h->frame, m.pl + m.pre, FL_FRAME_BYTES) == 0);
+    if (is_raw_method(m.method)) REQUIRE(memcmp(h->frame, m.pl + m.pre, FL_FRAME_BYTES) == 0);
     if (m.type == FL_MSG_DELTA) REQUIRE(h->have_shown && m.base_no == h->shown_no);
+    /* fixed up: what the harness's own call of the picture decoder made of it */
+    if (h->expect == EXPECT_SHOW && h->expect_px) REQUIRE(memcmp(h->frame, h->expect_px, FL_FRAME_BYTES) == 0);
 
     /* what the event says */
     fl_frame_info want;
@@ -361,6 +403,8 @@ static void on_frame(harness *h, const fl_event *ev)
     }
     REQUIRE(h->expect != EXPECT_DROP);
     h->expect = EXPECT_ANY;
+    h->expect_px = NULL;
+    h->copy_msgs += m.method == FL_METHOD_COPY;
 
     memcpy(h->shadow, h->frame, FL_FRAME_BYTES);
     h->have_shown = 1;
@@ -380,10 +424,13 @@ static void on_drop(harness *h, const fl_event *ev)
     int on_base = h->have_shown && m.base_no == h->shown_no;
     switch (ev->reason) {
     case FL_R_NO_BASE: REQUIRE(m.type == FL_MSG_DELTA && !on_base); break;
-    case FL_R_DECODE: REQUIRE(m.method == FL_METHOD_EDGE && (m.type == FL_MSG_KEYFRAME || on_base)); break;
+    case FL_R_DECODE:
+        /* coded pictures only (edge, COPY), keyframes or deltas on the frame shown */
+        REQUIRE((m.method == FL_METHOD_EDGE || m.method == FL_METHOD_COPY) && (m.type == FL_MSG_KEYFRAME || on_base));
+        break;
     case FL_R_FRAME_CRC:
         REQUIRE(m.type == FL_MSG_KEYFRAME || on_base);
-        if (m.method != FL_METHOD_EDGE) {
+        if (is_raw_method(m.method)) {
             /* a raw keyframe is its own reconstruction: dropped only if it fails a check */
             const uint8_t *px = m.pl + m.pre;
             REQUIRE(ref_check_of(m.method, px) != m.check || ((m.flags & 1u) && ref_crc(px, FL_FRAME_BYTES) != m.crc));
@@ -394,6 +441,8 @@ static void on_drop(harness *h, const fl_event *ev)
     REQUIRE(h->expect != EXPECT_SHOW);
     if (h->expect == EXPECT_DROP) REQUIRE(ev->reason == h->expect_reason);
     h->expect = EXPECT_ANY;
+    h->expect_px = NULL;
+    h->copy_msgs += m.method == FL_METHOD_COPY;
     session_frame(h, m.frame_no);
     check_ack(h, m.frame_no, 1);
     /* ask for a keyframe once; again after more than window + 1 further drops */
@@ -610,15 +659,67 @@ static void line_put(void *ctx, const uint8_t *p, uint32_t n)
     g_line_len += n;
 }
 
+static uint32_t frame_pre(uint32_t type)
+{
+    return FL_FRAME_PRE + (type == FL_MSG_DELTA ? 4u : 0u) + 1u; /* info, flags, check, [base], method */
+}
+
+/* A picture decoder run by the harness, on an exact-size copy of the picture bytes (ASan
+ * catches a read past them; in the receiver they are followed by more of its work
+ * memory). Returns what the decoder returns. */
+static int harness_decode(uint8_t method, const uint8_t *pic, uint32_t n, const uint8_t *base, uint8_t *out)
+{
+    uint8_t *in = fuzz_copy_exact(pic, n);
+    int r = method == FL_METHOD_COPY ? fl_copy_decode(g_copy, in, n, base, out)
+                                     : fl_decode_picture(g_coder, in, n, base, out);
+    free(in);
+    return r;
+}
+
+/* The pixel a COPY picture's decoding stops at (64,000: it reached the end), found
+ * from two decodings into outputs that start out different: the pixels before it are
+ * decoded alike, the one it stops at is not written. At the escape, the decoder wants
+ * exactly the picture's remaining pixels after the coded bytes. */
+static uint32_t copy_stop(const uint8_t *pic, uint32_t n, const uint8_t *base)
+{
+    memset(g_pic, 0x00, FL_FRAME_BYTES);
+    memset(g_pic2, 0xFF, FL_FRAME_BYTES);
+    harness_decode(FL_METHOD_COPY, pic, n, base, g_pic);
+    harness_decode(FL_METHOD_COPY, pic, n, base, g_pic2);
+    uint32_t i = 0;
+    while (i < FL_FRAME_BYTES && g_pic[i] == g_pic2[i]) i++;
+    return i;
+}
+
+/* The pad of a COPY frame message: the picture bytes given are taken for a coding that
+ * ends in the escape, and are followed by as many plain pixels as it leaves (repeating
+ * them), so that arbitrary coded prefixes reach the escape's plain tail. Returns the
+ * payload's new length. */
+static uint32_t copy_pad(const harness *h, uint32_t type, uint8_t *pl, uint32_t n)
+{
+    uint32_t pre = frame_pre(type);
+    if (type == FL_MSG_DELTA && !h->have_shown) return n; /* no base to decode against */
+    uint32_t tail = FL_FRAME_BYTES - copy_stop(pl + pre, n - pre, type == FL_MSG_DELTA ? h->shadow : NULL);
+    if (n + tail > FL_PAYLOAD_MAX) return n;
+    for (uint32_t i = 0; i < tail; i++) pl[n + i] = n > pre ? pl[pre + i % (n - pre)] : 0u;
+    return n + tail;
+}
+
 /* Make a frame message's payload pass: method, flags, base, and the check and CRC of
- * what the picture decodes to. Sets what the decoder must then do. */
+ * what the picture decodes to. Sets what the decoder must then do. The method: COPY if
+ * the payload's method byte & 3 is 3; a keyframe padded to a raw keyframe's size goes
+ * RAW_HASH if it is 2, else RAW; anything else edge-coded. */
 static void fix_up(harness *h, uint8_t type, uint8_t *pl, uint32_t n, int pad, int no_crc)
 {
-    uint32_t pre = FL_FRAME_PRE + (type == FL_MSG_DELTA ? 4u : 0u) + 1u;
+    uint32_t pre = frame_pre(type);
     if (n < pre) return;
-    int raw = pad && type == FL_MSG_KEYFRAME && n == pre + FL_FRAME_BYTES;
+    uint8_t mb = pl[pre - 1] & 3u;
+    int raw = pad && type == FL_MSG_KEYFRAME && n == pre + FL_FRAME_BYTES && mb != FL_METHOD_COPY;
+    uint8_t method = mb == FL_METHOD_COPY ? FL_METHOD_COPY
+                     : raw                ? (mb == FL_METHOD_RAW_HASH ? FL_METHOD_RAW_HASH : FL_METHOD_RAW)
+                                          : FL_METHOD_EDGE;
     pl[FL_INFO_BYTES] = no_crc ? 0u : 1u;
-    pl[pre - 1] = raw ? FL_METHOD_RAW : FL_METHOD_EDGE;
+    pl[pre - 1] = method;
     if (type == FL_MSG_DELTA && h->have_shown) fl_put32(pl + FL_FRAME_PRE, h->shown_no);
     const uint8_t *px = pl + pre;
     if (type == FL_MSG_DELTA && !h->have_shown) {
@@ -627,16 +728,38 @@ static void fix_up(harness *h, uint8_t type, uint8_t *pl, uint32_t n, int pad, i
         return;
     }
     if (!raw) {
-        if (fl_decode_picture(g_coder, pl + pre, n - pre, type == FL_MSG_DELTA ? h->shadow : NULL, g_pic)) {
+        if (harness_decode(method, pl + pre, n - pre, type == FL_MSG_DELTA ? h->shadow : NULL, g_pic)) {
             h->expect = EXPECT_DROP;
             h->expect_reason = FL_R_DECODE;
             return;
         }
         px = g_pic;
     }
-    fl_put32(pl + FL_INFO_BYTES + 1, ref_frame_check(px));
+    fl_put32(pl + FL_INFO_BYTES + 1, ref_check_of(method, px));
     fl_put32(pl + 22, ref_crc(px, FL_FRAME_BYTES));
     h->expect = EXPECT_SHOW;
+    h->expect_px = px;
+}
+
+/* A frame message as a sender writes it (docs/frame-link.md, section 2): a COPY
+ * picture streamed (length field 0xFFFFFF), a RAW_HASH keyframe's pixels and a COPY
+ * picture outside the message CRC (fl_writer_direct, from an exact-size copy). */
+static void write_frame_msg(fl_writer *w, uint8_t type, uint32_t frame_no, const uint8_t *pl, uint32_t n)
+{
+    uint32_t pre = frame_pre(type);
+    uint8_t mb = n >= pre ? pl[pre - 1] : 0xFFu;
+    int streamed = n > pre && mb == FL_METHOD_COPY;
+    int raw_hash = type == FL_MSG_KEYFRAME && n == pre + FL_FRAME_BYTES && mb == FL_METHOD_RAW_HASH;
+    if (!streamed && !raw_hash) {
+        fl_writer_message(w, type, frame_no, pl, n);
+        return;
+    }
+    fl_writer_begin(w, type, frame_no, streamed ? FL_LEN_STREAMED : n);
+    fl_writer_bytes(w, pl, pre);
+    uint8_t *pic = fuzz_copy_exact(pl + pre, n - pre);
+    fl_writer_direct(w, pic, n - pre);
+    free(pic);
+    fl_writer_end(w);
 }
 
 static void run_framed(cursor *c)
@@ -672,7 +795,17 @@ static void run_framed(cursor *c)
         if (costly && rebuilt >= MAX_REBUILT) continue;
         rebuilt += (uint32_t)costly;
         int pad = (ctl & 0x20u) && pads < MAX_PADS;
-        if (pad) {
+        int frame_type = type == FL_MSG_KEYFRAME || type == FL_MSG_DELTA;
+        /* a COPY picture (the method byte that fix-up or the writer takes for COPY) */
+        int copy = frame_type && n >= frame_pre(type) &&
+                   ((ctl & 0x10u) ? (g_payload[frame_pre(type) - 1] & 3u) == FL_METHOD_COPY
+                                  : g_payload[frame_pre(type) - 1] == FL_METHOD_COPY);
+        h.expect = EXPECT_ANY;
+        h.expect_px = NULL;
+        if (pad && copy) {
+            n = copy_pad(&h, type, g_payload, n); /* the escape's plain tail */
+            pads++;
+        } else if (pad) {
             /* a raw keyframe's size (a delta's: one no receiver takes); for a whole body,
              * the largest message, or one byte more */
             uint32_t want = type == 7u ? FL_MSG_MAX - FL_CRC_BYTES + (n & 1u)
@@ -681,9 +814,7 @@ static void run_framed(cursor *c)
             n = want;
             pads++;
         }
-        h.expect = EXPECT_ANY;
-        if ((ctl & 0x10u) && (type == FL_MSG_KEYFRAME || type == FL_MSG_DELTA))
-            fix_up(&h, (uint8_t)type, g_payload, n, pad, ctl & 0x40u);
+        if ((ctl & 0x10u) && frame_type) fix_up(&h, (uint8_t)type, g_payload, n, pad, ctl & 0x40u);
         frame_msgs += (uint32_t)is_frame;
 
         g_line_len = 0;
@@ -691,6 +822,8 @@ static void run_framed(cursor *c)
         if (type == 7u) {
             fl_writer_bytes(&w, g_payload, n);
             fl_writer_end(&w);
+        } else if (frame_type) {
+            write_frame_msg(&w, (uint8_t)type, frame_no, g_payload, n);
         } else {
             fl_writer_message(&w, (uint8_t)type, frame_no, g_payload, n);
         }
@@ -698,6 +831,7 @@ static void run_framed(cursor *c)
         if (dxor) {
             g_line[dpos % g_line_len] ^= (uint8_t)dxor;
             h.expect = EXPECT_ANY;
+            h.expect_px = NULL;
         }
         feed(&h, g_line, g_line_len);
         fed += g_line_len;
@@ -716,13 +850,23 @@ static void clip_box(int *x0, int *y0, int *x1, int *y1)
     if (*y1 > FL_H) *y1 = FL_H;
 }
 
-/* One drawing command: flat-shaded shapes, noise, scrolling (edges that move). */
+/* A texel of a 16 x 16 texture: a ramp of 16 colours from col, chosen by a hash of the
+ * texel and col (as textures are: the same texel wherever the texture repeats). */
+UNTRACED static inline uint8_t texel(uint32_t u, uint32_t v, uint8_t col)
+{
+    uint32_t t = ((u & 15u) | (v & 15u) << 4 | (uint32_t)col << 8) * 0x9E3779B1u;
+    return (uint8_t)(col + ((t ^ t >> 15) >> 12 & 15u));
+}
+
+/* One drawing command: flat-shaded shapes, noise, scrolling (edges that move), and
+ * textured and noisy pictures (which the encoder sends with the COPY coding). */
 UNTRACED static void draw(uint8_t *px, const uint8_t *op, uint32_t *rng)
 {
     int a = op[1], b = op[2], cc = op[3], dd = op[4];
     uint8_t col = op[5];
     int x0 = a * FL_W / 256, y0 = b * FL_H / 256;
-    switch (op[0] & 7u) {
+    uint32_t kind = op[0] & 15u;
+    switch (kind > 9u ? kind & 7u : kind) {
     case 0: { /* rectangle */
         int x1 = x0 + cc + 1, y1 = y0 + dd + 1;
         clip_box(&x0, &y0, &x1, &y1);
@@ -776,6 +920,27 @@ UNTRACED static void draw(uint8_t *px, const uint8_t *op, uint32_t *rng)
             for (int x = x0; x < FL_W; x += 1 + cc % 16) px[y * FL_W + x] = (uint8_t)(col + (x & 1));
         break;
     case 6: /* the whole frame */ memset(px, col, FL_FRAME_BYTES); break;
+    case 8: { /* a textured wall from (x0, y0) to the right edge, dd * 200 / 256 + 1 rows: a
+               * texture of texels 1 + (cc & 7) wide, 1 + (cc >> 3 & 7) high, whose width
+               * grows by one pixel every 64 columns if cc & 64 (a wall seen at an angle) */
+        int sx = 1 + (cc & 7), sy = 1 + (cc >> 3 & 7), y1 = y0 + dd * FL_H / 256 + 1;
+        if (y1 > FL_H) y1 = FL_H;
+        for (int y = y0; y < y1; y++)
+            for (int x = x0; x < FL_W; x++) {
+                int w = sx + ((cc & 64) ? (x - x0) / 64 : 0);
+                px[y * FL_W + x] = texel((uint32_t)((x - x0) / w), (uint32_t)((y - y0) / sy), col);
+            }
+        break;
+    }
+    case 9: { /* noise from a few colours over (cc + 1) * 320 / 256 by (dd + 1) * 200 / 256
+               * pixels (all of them: 255, 255): random bytes (col 255) make the COPY
+               * coding give up (its escape) */
+        int x1 = x0 + (cc + 1) * FL_W / 256, y1 = y0 + (dd + 1) * FL_H / 256;
+        clip_box(&x0, &y0, &x1, &y1);
+        for (int y = y0; y < y1; y++)
+            for (int x = x0; x < x1; x++) px[y * FL_W + x] = (uint8_t)(xorshift(rng) >> 7 & col);
+        break;
+    }
     default: { /* a diamond */
         int r = cc / 2;
         for (int y = y0 - r; y <= y0 + r; y++) {
@@ -797,7 +962,7 @@ static void run_round_trip(cursor *c, uint32_t knobs)
     uint32_t window = (knobs >> 5) & 3u; /* 0: the default */
     harness h;
     harness_init(&h, send_acks);
-    uint32_t no = u32_or0(c), scratch_bytes = u16_or0(c) % 16384u, key_interval = u8_or0(c) % 16u;
+    uint32_t no = u32_or0(c), scratch_bytes = u16_or0(c) % 16384u, kb = u8_or0(c), key_interval = kb % 16u;
     if (scratch_bytes == 0) scratch_bytes = 8192;
     uint8_t *scratch = fuzz_alloc(scratch_bytes);
     uint8_t palette[FL_PALETTE_BYTES];
@@ -806,6 +971,7 @@ static void run_round_trip(cursor *c, uint32_t knobs)
     fl_encoder *e = g_enc;
     fl_enc_init(e, line_put, NULL, scratch, scratch_bytes);
     e->key_interval = key_interval;
+    if (kb & 16u) e->match_hash = g_match; /* the COPY coder's match finder (hosts) */
     if (window) e->window = (uint8_t)window;
     h.back_to = connected ? e : NULL;
 
@@ -814,7 +980,7 @@ static void run_round_trip(cursor *c, uint32_t knobs)
     memset(page[1], 0, FL_FRAME_BYTES);
 
     uint32_t fed = 0, rng = no | 1u, prev_no = 0, sent = 0, keys = 0;
-    int prev_tail_damaged = 0;
+    int prev_tail_damaged = 0, damaged = 0;
     g_line_len = 0;
     if (hello0) fl_enc_hello(e);
     if (palette0) fl_enc_palette(e, palette);
@@ -882,20 +1048,21 @@ static void run_round_trip(cursor *c, uint32_t knobs)
             g_line[dpos] ^= (uint8_t)dxor;
         }
         prev_tail_damaged = dxor && dpos == g_line_len - 1u;
+        damaged |= dxor != 0;
         feed(&h, g_line, g_line_len);
         fed += g_line_len;
         REQUIRE(h.expect == EXPECT_ANY);
         if (connected && h.keyreq_since_frame) REQUIRE(e->force_key); /* heard: the next is a keyframe */
         g_line_len = 0;
-        /* flow control: an intact frame's ack empties the window; a full window is
-         * given up after the timeout */
-        uint32_t now = i * 20u, timeouts = e->timeouts;
+        /* flow control: an intact frame's ack empties the window; a full window's
+         * oldest frame is given up after the timeout, and one more frame may go */
+        uint32_t now = i * 20u, timeouts = e->timeouts, in_flight = e->in_count;
         if (!fl_enc_may_send(e, now)) {
             REQUIRE(!(connected && send_acks && intact));
             REQUIRE(e->in_count >= e->window);
             REQUIRE(!fl_enc_may_send(e, now + e->ack_timeout_ms - 1u));
             REQUIRE(fl_enc_may_send(e, now + e->ack_timeout_ms));
-            REQUIRE(e->timeouts == timeouts + 1u && e->in_count == 0);
+            REQUIRE(e->timeouts == timeouts + 1u && e->in_count == in_flight - 1u);
         }
         prev_no = frame_no;
     }
@@ -906,7 +1073,10 @@ static void run_round_trip(cursor *c, uint32_t knobs)
     }
     harness_end(&h, fed, sent);
     REQUIRE(e->frames == sent && e->keyframes == keys && e->deltas == sent - keys);
-    REQUIRE(e->raw_fallbacks <= e->keyframes);
+    /* textured and noisy frames go COPY, never raw; every COPY frame message sent arrives
+     * (its method byte is under the CRC: no damage makes one of another) */
+    REQUIRE(e->raw_fallbacks == 0 && e->copy_frames <= sent);
+    REQUIRE(damaged ? h.copy_msgs <= e->copy_frames : h.copy_msgs == e->copy_frames);
     if (connected) {
         REQUIRE(e->rx_bad == 0);
         REQUIRE(e->acks == h.back_ack_shown + h.back_ack_dropped);

@@ -1,15 +1,20 @@
 #!/usr/bin/env python3
 """seeds_link.py OUTDIR - seeds for tests/fuzz/fuzz_link.c, in its input format.
 
-Real streams: build/fltool walks tests/scenes/default.scene for 12 frames and encodes
-them (as they come, with a short keyframe interval, without pixel CRC-32, and one frame
-as a raw keyframe). Each frame costs the receiver milliseconds under the sanitizers, so
-a seed holds a few messages of a stream: raw-mode seeds are such stretches as sent
-(from the start, mid-stream without a base, in chunks, cut, with a byte damaged, after
-garbage) and a receiver's acks and requests; framed-mode seeds are the messages decoded
-back into type, frame number and payload (also fixed up by the harness, as whole
-bodies, with a wrong frame check, after a HELLO with window 1); round-trip seeds are
-short drawing-command sequences. Run from the repository root. Standard library only."""
+Real streams: build/fltool walks tests/scenes/default.scene (flat-shaded) for 12 frames
+and encodes them (as they come, with a short keyframe interval, without pixel CRC-32),
+and encodes textured pictures drawn here (a wall and a floor of repeating textures,
+then the same moved sideways: COPY keyframes and deltas, with and without the match
+finder) and a picture of random bytes (a COPY keyframe that takes the escape). Each
+frame costs the receiver milliseconds under the sanitizers, so a seed holds a few
+messages of a stream: raw-mode seeds are such stretches as sent (from the start,
+mid-stream without a base, in chunks, cut, with a byte damaged, after garbage) and a
+receiver's acks and requests; framed-mode seeds are the messages decoded back into
+type, frame number and payload (also fixed up by the harness, as whole bodies, with a
+wrong frame check, after a HELLO with window 1, raw keyframes padded by the harness,
+the coded start of the escaping COPY picture whose plain tail the harness adds);
+round-trip seeds are short drawing-command sequences (flat shapes, textures, noise).
+Run from the repository root. Standard library only."""
 import os
 import struct
 import subprocess
@@ -17,11 +22,19 @@ import sys
 import tempfile
 import zlib
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools"))
+
 FLTOOL = "build/fltool"
 SCENE = "tests/scenes/default.scene"
 FRAME_BYTES = 320 * 200
 
+W, H = 320, 200
 MODE_RAW, MODE_FRAMED, MODE_ROUND_TRIP = 0, 1, 2
+KEYFRAME, DELTA = 3, 4
+METHOD_RAW, METHOD_EDGE, METHOD_RAW_HASH, METHOD_COPY = 0, 1, 2, 3
+LEN_STREAMED = 0xFFFFFF
+FRAME_PRE = 35  # info, flags, frame check
+VERSION = None  # the protocol version the tools speak: read from their first stream
 CTL_FRAME_NO, CTL_FIXUP, CTL_PAD, CTL_NO_CRC, CTL_DAMAGE = 0x08, 0x10, 0x20, 0x40, 0x80
 TYPE_BODY = 7  # framed: the payload is a whole message body
 
@@ -41,14 +54,25 @@ def cobs_decode(seg):
     return bytes(out)
 
 
+def pre_of(typ):
+    """A frame payload's bytes up to and including its method byte."""
+    return FRAME_PRE + (4 if typ == DELTA else 0) + 1
+
+
 def messages(stream):
-    """(type, frame number, payload) of every message of a clean stream."""
+    """(type, frame number, payload) of every message of a clean stream; a streamed
+    (COPY) frame's payload runs to the CRC."""
+    global VERSION
     out = []
     for seg in stream.split(b"\0"):
         if not seg:
             continue
         m = cobs_decode(seg)
+        VERSION = VERSION or m[0]
         n = m[6] | m[7] << 8 | m[8] << 16
+        if n == LEN_STREAMED:
+            n = len(m) - 13
+            assert m[1] in (KEYFRAME, DELTA) and m[9 + pre_of(m[1]) - 1] == METHOD_COPY, "not a COPY frame"
         assert len(m) == 9 + n + 4, "not a clean stream"
         out.append((m[1], struct.unpack_from("<I", m, 2)[0], m[9:9 + n]))
     return out
@@ -69,10 +93,24 @@ def cobs_encode(data):
     return bytes(out)
 
 
-def message(typ, no, payload):
-    """One message on the wire (docs/frame-link.md, sections 1 and 2)."""
-    body = struct.pack("<BBI", 1, typ, no) + struct.pack("<I", len(payload))[:3] + payload
-    return cobs_encode(body + struct.pack("<I", zlib.crc32(body))) + b"\0"
+def header(typ, no, n):
+    return struct.pack("<BBI", VERSION, typ, no) + struct.pack("<I", n)[:3]
+
+
+def message(typ, no, payload, flip=None):
+    """One message on the wire (docs/frame-link.md, sections 1 and 2): a COPY frame
+    streamed, its CRC (and a RAW_HASH keyframe's) over the header and the payload up to
+    the method byte. flip: a byte of header and payload damaged after the CRC."""
+    pre = pre_of(typ)
+    method = payload[pre - 1] if typ in (KEYFRAME, DELTA) and len(payload) >= pre else None
+    streamed = method == METHOD_COPY and len(payload) > pre
+    raw_hash = typ == KEYFRAME and method == METHOD_RAW_HASH and len(payload) == pre + W * H
+    body = header(typ, no, LEN_STREAMED if streamed else len(payload)) + payload
+    crc = zlib.crc32(body[:9 + pre] if streamed or raw_hash else body)
+    if flip is not None:
+        body = bytearray(body)
+        body[flip] ^= 0x04
+    return cobs_encode(body + struct.pack("<I", crc)) + b"\0"
 
 
 def segments(stream):
@@ -83,9 +121,8 @@ def segments(stream):
 def framed(msgs, ctl_extra=0, numbered=True, body=False):
     out = bytearray([MODE_FRAMED])
     for typ, no, payload in msgs:
-        if body:  # header and payload as they were; the harness adds CRC and COBS
-            hdr = struct.pack("<BBI", 1, typ, no) + struct.pack("<I", len(payload))[:3]
-            payload = hdr + payload
+        if body:  # header (with the length) and payload; the harness adds CRC and COBS
+            payload = header(typ, no, len(payload)) + payload
             typ = TYPE_BODY
         ctl = typ | (CTL_FRAME_NO if numbered else 0)
         if typ in (3, 4):
@@ -102,7 +139,8 @@ def raw(stream, chunk_knob=0, chunk_seed=0):
 
 
 def round_trip(knobs, start, scratch, key_interval, frames):
-    """frames: (ctl, [6-byte commands], damage or None)."""
+    """frames: (ctl, [6-byte commands], damage or None). key_interval | 16: the COPY
+    coder's match finder."""
     out = bytearray([MODE_ROUND_TRIP + 3 * knobs])
     out += struct.pack("<IHB", start, scratch, key_interval)
     for ctl, ops, damage in frames:
@@ -126,6 +164,65 @@ SCROLL_L = (3, 0xFD, 0, 0, 0, 12)
 SCROLL_UP = (4, 0, 0xFE, 0, 0, 40)
 NOISE = (2, 10, 10, 255, 255, 0x0F)
 COLUMNS = (5, 0, 20, 0, 10, 100)
+TEXTURE = (8, 0, 0, 1 | 1 << 3, 255, 64)             # the whole frame: texels 2 x 2
+WALL_TEX = (8, 40, 40, 3 | 2 << 3 | 64, 150, 96)     # texels 4 x 3, wider to the right
+WALL_TEX_LOW = (8, 40, 100, 3 | 2 << 3 | 64, 120, 96)  # the same from row 78 on
+BIG_NOISE = (9, 0, 0, 255, 255, 0xFF)                # every pixel a random byte
+MATCH_FINDER = 16                                    # round_trip key_interval bit
+
+
+def lcg(seed):
+    while True:
+        seed = (seed * 1103515245 + 12345) & 0x7FFFFFFF
+        yield seed >> 16
+
+
+def texture(seed, base):
+    g = lcg(seed)
+    return [bytes(base + next(g) % 24 for _ in range(16)) for _ in range(16)]
+
+
+def textured(shift):
+    """A textured picture: a sky, a wall of 4 x 3 texels (3 wide from column 200), a floor
+    of 2 x 2 texels; shift moves the textures sideways (a turn)."""
+    wall, floor = texture(1, 64), texture(2, 160)
+    rows = []
+    for y in range(H):
+        if y < 40:
+            rows.append(bytes([12]) * W)
+        elif y < 160:
+            t = wall[(y - 40) // 3 % 16]
+            rows.append(bytes(t[(x + shift) // (4 if x + shift < 200 else 3) % 16] for x in range(W)))
+        else:
+            t = floor[y // 2 % 16]
+            rows.append(bytes(t[(x + shift) // 2 % 16] for x in range(W)))
+    return b"".join(rows)
+
+
+def noise(seed):
+    g = lcg(seed)
+    return bytes(next(g) & 0xFF for _ in range(W * H))
+
+
+def copy_escape_prefix(payload, pixels):
+    """A COPY keyframe's picture that took the escape, without its plain tail: (coded
+    bytes, the pixel the tail starts at). The tail is the longest end of the picture that
+    is the pixels' end; a coded byte that happens to equal the pixel before it would
+    make it one too long: the split is right when the coded bytes with any other tail
+    decode to the pixels before it and that tail (tools/framelink_copy.py)."""
+    from framelink_copy import CopyError, decode_copy
+    pic = payload[pre_of(KEYFRAME):]
+    pos = W * H - 1
+    while pos > 0 and pic[len(pic) - (W * H - pos + 1):] == pixels[pos - 1:]:
+        pos -= 1
+    for pos in range(pos, min(pos + 8, W * H)):
+        coded, zeros = pic[:len(pic) - (W * H - pos)], bytes(W * H - pos)
+        try:
+            if decode_copy(coded + zeros) == pixels[:pos] + zeros:
+                return coded, pos
+        except CopyError:
+            pass
+    raise AssertionError("no escape in the COPY picture")
 
 
 def main():
@@ -155,8 +252,20 @@ def main():
         stream_nocrc = encode(frames_raw, "--no-crc")
         one = os.path.join(tmp, "one.raw")
         with open(frames_raw, "rb") as f, open(one, "wb") as g:
-            g.write(f.read(FRAME_BYTES))
-        stream_rawkey = encode(one, "--scratch", "40")  # does not fit: a raw keyframe
+            pixels0 = f.read(FRAME_BYTES)
+            g.write(pixels0)
+        stream_flatcopy = encode(one, "--scratch", "40")  # does not fit: a COPY keyframe
+        tex = os.path.join(tmp, "textured.raw")  # a keyframe and two deltas (turning)
+        with open(tex, "wb") as g:
+            g.write(textured(0) + textured(3) + textured(8))
+        # with the match finder, as hosts send, and a HELLO that names a scene
+        stream_tex = encode(tex, "--scene", "textured", "--scene-crc", "1234abcd")
+        stream_tex_fw = encode(tex, "--no-match-finder", "--no-crc")  # as the firmware sends
+        noisy = os.path.join(tmp, "noise.raw")
+        noise_px = noise(7)
+        with open(noisy, "wb") as g:
+            g.write(noise_px)
+        stream_noise = encode(noisy)  # codes worse than raw: the escape
 
     # Every frame decoded costs the receiver a few milliseconds under the sanitizers
     # and libFuzzer's tracing: seeds carry a few frames each, from different places.
@@ -193,11 +302,15 @@ def main():
     seeds["framed-frames-no-crc"] = framed(frames[:3], CTL_FIXUP | CTL_NO_CRC)
     seeds["framed-bodies"] = framed(msgs[:4], body=True)
     # a raw keyframe's header and first rows; the harness repeats them to 64,000 pixels
-    # (a 64 KB seed would make every input up to 64 KB long)
-    typ, no, payload = messages(stream_rawkey)[2]
-    rawkey = bytes([typ | CTL_FRAME_NO | CTL_PAD]) + struct.pack("<IH", no, 32 + 640) + payload[:32 + 640]
-    seeds["framed-rawkey"] = framed(msgs[:2]) + rawkey
-    seeds["framed-rawkey-fixup"] = framed(msgs[:2]) + bytes([rawkey[0] | CTL_FIXUP]) + rawkey[1:]
+    # (a 64 KB seed would make every input up to 64 KB long). The encoder sends no raw
+    # keyframes since COPY; receivers still take RAW_HASH (with its short CRC) and RAW.
+    typ, no, payload = messages(stream_flatcopy)[2]
+    for name, method in (("rawkey", METHOD_RAW_HASH), ("rawkey-raw", METHOD_RAW)):
+        pl = payload[:FRAME_PRE] + bytes([method]) + pixels0[:636]
+        rawkey = bytes([typ | CTL_FRAME_NO | CTL_PAD]) + struct.pack("<IH", no, len(pl)) + pl
+        seeds["framed-" + name] = framed(msgs[:2]) + rawkey
+        seeds["framed-%s-fixup" % name] = framed(msgs[:2]) + bytes([rawkey[0] | CTL_FIXUP]) + rawkey[1:]
+    seeds["framed-flat-copy"] = framed(msgs[:2] + messages(stream_flatcopy)[2:3])
     nocrc_msgs = messages(stream_nocrc)
     seeds["framed-no-crc-stream"] = framed(nocrc_msgs[:5])
     # a frame without pixel CRC-32 whose frame check is off: only the check can stop it
@@ -233,7 +346,60 @@ def main():
     # no acks, a full window given up after the timeout, a skipped frame number
     seeds["rt-no-back-channel"] = round_trip(16 | 1 << 5, 0x7FFFFFFF, 4096, 0,
                                              [(0, scene, None), (3 << 3, [SCROLL_UP], None)])
+    # window 2, no acks: the timeout gives up the oldest frame in flight, one stays
+    seeds["rt-no-back-channel-window-2"] = round_trip(16 | 2 << 5, 5, 0, 0, [(0, scene, None), (0, [SCROLL_UP], None)])
     seeds["rt-hello-no-crc"] = round_trip(8, 3, 0, 0, [(0x20, scene, None), (0x80 | 0x20, [WALL], None)])
+
+    # COPY: textured pictures (a keyframe and deltas, sent as they come), random bytes
+    # (the escape), damaged where the message CRC does not look (the coded picture)
+    tseg, tmsg = segments(stream_tex), messages(stream_tex)
+    fwseg, fwmsg = segments(stream_tex_fw), messages(stream_tex_fw)  # no match finder, no pixel CRC-32
+    assert all(m[2][pre_of(m[0]) - 1] == METHOD_COPY for m in tmsg[2:] + fwmsg[2:]), "textured frames not COPY"
+    seeds["raw-copy-start"] = raw(b"".join(tseg[:4]))
+    seeds["raw-copy-firmware-chunks"] = raw(b"".join(fwseg[:4]), 40, 11)
+    typ, no, payload = tmsg[2]
+    for name, at in (("picture", 9 + len(payload) - 30), ("info", 9 + 20)):
+        seeds["raw-copy-damaged-" + name] = raw(b"".join(tseg[:2]) + message(typ, no, payload, at) + tseg[3])
+    seeds["framed-copy"] = framed(tmsg[:4])
+    seeds["framed-copy-fixup"] = framed(tmsg[:4], CTL_FIXUP)
+    seeds["framed-copy-no-crc-fixup"] = framed(tmsg[2:5], CTL_FIXUP | CTL_NO_CRC)
+    seeds["framed-copy-bodies"] = framed(tmsg[:4], body=True)  # with their length and a whole CRC
+    typ, no, payload = tmsg[2]
+    dmg = bytearray(framed(tmsg[:2]))
+    dmg += bytes([typ | CTL_FRAME_NO | CTL_DAMAGE]) + struct.pack("<IHBH", no, 200, 0x10, len(payload)) + payload
+    dmg += framed(tmsg[3:4])[1:]
+    seeds["framed-copy-damaged"] = bytes(dmg)
+    wrong = payload[:FRAME_PRE - 4] + struct.pack("<I", struct.unpack_from("<I", payload, FRAME_PRE - 4)[0] ^ 1)
+    seeds["framed-copy-wrong-check"] = framed(tmsg[:2] + [(typ, no, wrong + payload[FRAME_PRE:])] + tmsg[3:4])
+    # edge-coded pictures' bytes fixed up as COPY (method byte 3): arbitrary coded bytes
+    edge_as_copy = [(t, n, p[:pre_of(t) - 1] + bytes([METHOD_COPY]) + p[pre_of(t):]) for t, n, p in frames[:3]]
+    seeds["framed-edge-as-copy-fixup"] = framed(msgs[:2] + edge_as_copy, CTL_FIXUP)
+    # the escaping picture's coded start: fix-up pads it with the plain tail
+    typ, no, payload = messages(stream_noise)[2]
+    coded, pos = copy_escape_prefix(payload, noise_px)
+    pl = payload[:pre_of(typ)] + coded
+    seeds["framed-copy-escape-pad"] = framed(msgs[:2]) + bytes([typ | CTL_FRAME_NO | CTL_FIXUP | CTL_PAD]) + \
+        struct.pack("<IH", no, len(pl)) + pl
+
+    # round trip with textures and noise: COPY keyframes and deltas (from the base moved,
+    # from the frame itself), the escape in a keyframe and in a delta
+    seeds["rt-textured"] = round_trip(1 | 2 | 8, 0, 0, 0, [(0, [TEXTURE], None), (0, [SCROLL_L], None)])
+    seeds["rt-textured-match-finder"] = round_trip(1 | 2 | 8, 9, 0, MATCH_FINDER,
+                                                   [(0, [SKY, WALL_TEX], None), (0, [SCROLL_L], None)])
+    seeds["rt-textured-small-scratch-unaligned"] = round_trip(4 | 8, 40, 300, MATCH_FINDER | 3,
+                                                              [(0, [TEXTURE, DIAMOND], None), (0, [SCROLL_L], None)])
+    seeds["rt-noise-escape"] = round_trip(1 | 2 | 8, 1, 0, MATCH_FINDER,
+                                          [(0, [BIG_NOISE], None), (0, [SCROLL_L], None)])
+    seeds["rt-noise-escape-delta"] = round_trip(1 | 2 | 8, 1, 0, 0, [(0, [SKY], None), (0, [BIG_NOISE], None)])
+    # a COPY keyframe damaged in its coded picture (dropped; the keyframe asked for
+    # comes next); COPY deltas onto a wrong base (row 37 ^ 0x55): shown where the coding
+    # never looks at that row, dropped by the pixel hash where it copies it
+    seeds["rt-copy-damaged"] = round_trip(1 | 2 | 8, 70, 0, 0, [(0, [TEXTURE], (30, 0x08)), (0, [SCROLL_L], None)])
+    seeds["rt-copy-wrong-base-shown"] = round_trip(1 | 8, 7, 0, 0, [(0, [TEXTURE], None), (2 << 3, [SCROLL_UP], None)])
+    row37_sky = [op[:5] + (12,) for op in row37]
+    seeds["rt-copy-wrong-base-dropped"] = round_trip(1 | 2 | 8, 7, 0, MATCH_FINDER,
+                                                     [(0, [TEXTURE] + row37_sky, None),
+                                                      (2 << 3, row37 + [WALL_TEX_LOW], None)])
 
     for name, data in seeds.items():
         with open(os.path.join(outdir, "link-" + name + ".bin"), "wb") as f:
