@@ -13,7 +13,7 @@ import zlib
 
 import pytest
 
-from conftest import BUILD, program, run
+from conftest import BUILD, ROOT, program, run
 
 VIDPID = "1209:0001"
 
@@ -243,10 +243,19 @@ def test_loopback_is_the_projects_device(tmp_path):
     assert proc.returncode == 3 and "no device found for 1234:5678" in proc.stderr
 
 
+def board_slot():
+    """The display board's application slot and page (hal/board/board_layout.h)."""
+    text = (ROOT / "hal" / "board" / "board_layout.h").read_text()
+    num = lambda name: int(re.search(rf"#define {name} (0x[0-9A-Fa-f]+|\d+)u", text).group(1), 0)
+    return num("BOARD_SLOT_BYTES"), num("BOARD_PAGE_BYTES")
+
+
 def test_oversized_image_refused_before_anything_is_sent(tmp_path):
-    """An image past the device's application area (4 MiB - 4 KiB on the loopback)
-    is refused before the first request, so an old valid mark is never erased."""
-    cap = 4 * 1024 * 1024 - 4096
+    """An image past the device's application area (the board's slot less its mark page:
+    4,124,672 bytes on the loopback, as on the board) is refused before the first request,
+    so an old valid mark is never erased."""
+    slot, page = board_slot()
+    cap = slot - page
     dfu, _ = add_suffix(tmp_path, b"\x5A" * (cap + 1))
     proc = flash(dfu, "--loopback")
     assert proc.returncode == 2, (proc.stdout, proc.stderr)
@@ -254,3 +263,22 @@ def test_oversized_image_refused_before_anything_is_sent(tmp_path):
     assert "loopback: 0 requests" in proc.stdout
     fits, _ = add_suffix(tmp_path, b"\x5A" * cap, name="fits")
     assert flash(fits, "--loopback").returncode == 0
+
+
+def test_loopback_and_board_image_agree_on_the_largest_image(tmp_path):
+    """The largest image the loopback takes is the largest the board's slot holds: board_image (which
+    assembles the board's flash through the same DFU device) takes it and refuses one byte more,
+    as the loopback does."""
+    slot, page = board_slot()
+    cap = slot - page
+    boot = tmp_path / "boot.bin"
+    boot.write_bytes(b"\x01" * 256)
+    for size, ok in ((cap, True), (cap + 1, False)):
+        app = tmp_path / f"app{size}.bin"
+        app.write_bytes(bytes((i * 7 + 1) & 0xFF for i in range(size)))
+        img = run([program("board_image", sanitized=False), boot, app, tmp_path / f"img{size}.bin"], check=False,
+                  timeout=120)
+        assert (img.returncode == 0) == ok, (size, img.stderr)
+        dfu, _ = add_suffix(tmp_path, app.read_bytes(), name=f"app{size}")
+        lb = flash(dfu, "--loopback")
+        assert (lb.returncode == 0) == ok, (size, lb.stdout, lb.stderr)

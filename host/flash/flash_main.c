@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../hal/board/board_layout.h"
 #include "crc32.h"
 #include "dfu/dfu_device.h"
 #include "dfu/dfu_image.h"
@@ -20,8 +21,10 @@
 enum { EXIT_USAGE = 1, EXIT_IMAGE = 2, EXIT_DEVICE = 3, EXIT_DOWNLOAD = 4 };
 
 #define MAX_FILE (256u << 20)
-#define LOOP_FLASH_SIZE (4u << 20)
-#define LOOP_PAGE_SIZE 4096u
+/* the loopback is the display board's application slot (hal/board/board_layout.h):
+ * an image it takes is one board_image and the board take, and no larger */
+#define LOOP_FLASH_SIZE BOARD_SLOT_BYTES
+#define LOOP_PAGE_SIZE BOARD_PAGE_BYTES
 /* The project's own device (the pid.codes test id the docs use): the loopback
  * enumerates as it, as the real board would, whatever the image's suffix says. */
 #define LOOP_VID 0x1209u
