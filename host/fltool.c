@@ -36,6 +36,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "crc32.h"
 #include "engine.h"
@@ -183,6 +184,33 @@ static void print_fx(FILE *f, const char *key, int32_t v, const char *sep)
     fprintf(f, "\"%s\": %s%s", key, buf, sep);
 }
 
+/* Create dir and any missing parents (mkdir -p). 0, or -1 with errno set (a
+ * part that exists and is not a folder: ENOTDIR). */
+static int make_dirs(const char *dir)
+{
+    char p[4096];
+    size_t n = strlen(dir);
+    if (n == 0 || n >= sizeof p) {
+        errno = ENAMETOOLONG;
+        return -1;
+    }
+    memcpy(p, dir, n + 1);
+    for (size_t i = 1; i <= n; i++) {
+        if (p[i] != '/' && p[i] != '\0') continue;
+        char c = p[i];
+        p[i] = '\0';
+        struct stat st;
+        if (stat(p, &st) != 0) {
+            if (mkdir(p, 0777) != 0 && errno != EEXIST) return -1;
+        } else if (!S_ISDIR(st.st_mode)) {
+            errno = ENOTDIR;
+            return -1;
+        }
+        p[i] = c;
+    }
+    return 0;
+}
+
 static int cmd_walk(int argc, char **argv)
 {
     const char *spec = NULL, *out = ".", *script = NULL;
@@ -221,6 +249,10 @@ static int cmd_walk(int argc, char **argv)
     e.flat = (uint8_t)flat;
 
     char path[4096];
+    if (make_dirs(out) != 0) {
+        fprintf(stderr, "fltool: cannot create the folder %s: %s\n", out, strerror(errno));
+        return 1;
+    }
     snprintf(path, sizeof path, "%s/frames.raw", out);
     FILE *fr = fopen(path, "wb");
     snprintf(path, sizeof path, "%s/frames.jsonl", out);

@@ -528,3 +528,21 @@ def test_add_suffix_refusal_leaves_no_output(tmp_path):
     refused([program("flash"), "--add-suffix", image, "--vid", "1209", "--pid", "0001", "-o", out],
             f"flash: {image}: ", "already ends with a valid DFU suffix", status=2)
     assert not out.exists()
+
+
+def test_fltool_walk_creates_its_folder(tmp_path):
+    """fltool walk --out DIR creates DIR and its missing parents, as the other programs do."""
+    out = tmp_path / "a" / "b"
+    run([program("fltool"), "walk", DEFAULT, "--frames", 2, "--out", out])
+    assert (out / "frames.raw").stat().st_size == 2 * 64000
+    assert len((out / "frames.jsonl").read_text().splitlines()) == 2
+
+
+def test_fltool_walk_refuses_a_file_for_its_folder(tmp_path):
+    """A path that is a file, or lies under one, is refused by name, and the file is left alone."""
+    f = tmp_path / "file"
+    f.write_text("x")
+    for out in (f, f / "sub"):
+        proc = run([program("fltool"), "walk", DEFAULT, "--frames", 1, "--out", out], check=False)
+        assert proc.returncode == 1 and f"fltool: cannot create the folder {out}" in proc.stderr, proc.stderr
+    assert f.read_text() == "x"
