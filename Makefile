@@ -133,7 +133,8 @@ all: $(PROGRAMS) nofloat
 help:
 	@echo "make deps       install missing Debian packages and the Python venv (idempotent)"
 	@echo "make            build build/bspc, build/render, build/emu (and check: no floating point)"
-	@echo "make run        walk the built-in scene in a window (headless: fly-through PNGs)"
+	@echo "make run        walk freedoom2.wad:MAP01 in a window (the built-in scene without the WAD;"
+	@echo "                SCENE=... for another; headless: fly-through PNGs)"
 	@echo "make test       deps, build, unit tests and pytest, with ASan and UBSan"
 	@echo "make bench      instructions per frame (callgrind, x86-64) per render mode, world alone and with"
 	@echo "                things (textured), and world alone textured against --flat: median, p95, max and the"

@@ -149,3 +149,14 @@ def test_keys_print_the_camera_and_save_a_screenshot(tmp_path):
 def test_help_lists_the_keys():
     proc = subprocess.run([str(BUILD / "emu"), "--help"], capture_output=True, text=True)
     assert "V print the camera" in proc.stdout and "S or F12 save a screenshot" in proc.stdout
+
+
+def test_make_help_says_what_make_run_walks():
+    """`make help` names the scene `make run` walks: freedoom2.wad:MAP01 when the WAD is installed
+    (the Makefile's run rule looks for it first), the built-in scene only without it."""
+    out = subprocess.run(["make", "-s", "--no-print-directory", "help"], cwd=ROOT, capture_output=True, text=True,
+                         timeout=60).stdout
+    line = next(l for l in out.splitlines() if l.startswith("make run "))
+    assert "freedoom2.wad:MAP01" in line, line
+    rule = (ROOT / "Makefile").read_text()
+    assert "scene=freedoom2.wad:MAP01" in rule
