@@ -43,7 +43,7 @@ FLOATFREE := firmware/% hal/fb.c hal/perf.c hal/ram_target.c hal/null/% hal/seri
 LINK_SRC   := $(wildcard hal/serial/*.c)
 # Shared by the bare-metal targets (hal/mps2, hal/pcvga): camera paths, options, printf, memory functions.
 BARE_SRC   := $(sort $(wildcard hal/bare/*.c))
-UNIT_EXTRA := tests/unit/scene_fixture.c
+UNIT_EXTRA := tests/unit/scene_fixture.c hal/board/boot_vectors.c
 EXTRA_NOFLOAT_SRC :=
 # The float checks (tools/check_nofloat.sh) take seconds, so each set of files is
 # checked again only when a file of it, a header it can include, the script or the

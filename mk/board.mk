@@ -32,7 +32,7 @@ BOARD_BASE_SRC := hal/mps2/startup.c hal/mps2/uart.c hal/mps2/semihost.c hal/mps
                   hal/bare/format.c hal/bare/libc.c firmware/crc32.c
 BOARD_APP_SRC  := $(BOARD_BASE_SRC) hal/board/main.c hal/board/board_args.c \
                   hal/serial/fl_framing.c hal/serial/fl_codec.c hal/serial/fl_copy.c hal/serial/fl_decoder.c
-BOARD_BOOT_SRC := $(BOARD_BASE_SRC) hal/board/boot.c firmware/dfu/dfu_device.c firmware/dfu/dfu_proto.c
+BOARD_BOOT_SRC := $(BOARD_BASE_SRC) hal/board/boot.c hal/board/boot_vectors.c firmware/dfu/dfu_device.c firmware/dfu/dfu_proto.c
 BOARD_CFLAGS = $(ARM_CFLAGS) -Ihal/board -DUART_RX_RING=$(BOARD_RX_RING) -DUART_RX_SPANS=1
 # $(1): ROM origin, $(2): ROM bytes
 board_ld = -T hal/mps2/mps2.ld -Wl,--gc-sections -Wl,--defsym=MPS2_ROM_ORIGIN=$(1) -Wl,--defsym=MPS2_ROM_BYTES=$(2) \
@@ -43,9 +43,9 @@ board_ld = -T hal/mps2/mps2.ld -Wl,--gc-sections -Wl,--defsym=MPS2_ROM_ORIGIN=$(
 .PHONY: nofloat-board
 nofloat: nofloat-board
 nofloat-board: $(NOFLOAT_DIR)/board.ok
-$(NOFLOAT_DIR)/board.ok: hal/board/main.c hal/board/board_args.c hal/board/boot.c $(NOFLOAT_DEPS)
+$(NOFLOAT_DIR)/board.ok: hal/board/main.c hal/board/board_args.c hal/board/boot.c hal/board/boot_vectors.c $(NOFLOAT_DEPS)
 	@printf 'hal/board: '; NOFLOAT_INC='-Ihal/mps2 -Ihal/serial -Ihal/board' tools/check_nofloat.sh hal/board/main.c hal/board/board_args.c
-	@printf 'hal/board (bootloader): '; NOFLOAT_INC='-Ihal/mps2 -Ihal/board' tools/check_nofloat.sh hal/board/boot.c
+	@printf 'hal/board (bootloader): '; NOFLOAT_INC='-Ihal/mps2 -Ihal/board' tools/check_nofloat.sh hal/board/boot.c hal/board/boot_vectors.c
 	@touch $@
 
 # No image may link libgcc's floating-point helpers.

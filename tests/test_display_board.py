@@ -217,3 +217,24 @@ def test_bootloader_refuses_a_bad_slot(built, tmp_path, damage):
     assert "bootloader: no valid application in the slot (" in board.text and why in board.text
     assert "staying in DFU mode" in board.text
     assert "board:" not in board.text  # the application never ran
+
+
+@pytest.mark.parametrize("sp, reset, why", [
+    (0x12345678, 0x00010101, "its initial stack pointer is not in RAM"),
+    (0x20008000, 0x00010100, "its reset vector lacks the Thumb bit"),
+    (0x20008000, 0x00011389, "its reset vector points outside the application"),
+], ids=["stack", "thumb", "reset"])
+def test_bootloader_refuses_an_image_that_is_no_program(built, tmp_path, sp, reset, why):
+    """5,000 random bytes in the slot with a valid mark, as a DFU download of them leaves it (board_image):
+    the CRC matches, but the vector table cannot be started, so the bootloader refuses with status 7
+    and never jumps. (0x00011389 is the first halfword past the 5,000 bytes at 0x00010000.)"""
+    rng = random.Random(28)
+    app = struct.pack("<II", sp, reset) + bytes(rng.randrange(256) for _ in range(5000 - 8))
+    app_bin, img = tmp_path / "app.bin", tmp_path / "img.bin"
+    app_bin.write_bytes(app)
+    run([program("board_image", sanitized=False), ARM / "board-boot.app.bin", app_bin, img])
+    board = Board(img, listen=False, tmp=tmp_path)
+    rc = board.wait(30)
+    assert rc == EXIT_NO_APP, board.text
+    assert f"cannot be started: {why}" in board.text and "staying in DFU mode" in board.text, board.text
+    assert "board:" not in board.text and "application valid" not in board.text

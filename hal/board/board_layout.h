@@ -14,5 +14,8 @@
 #define BOARD_SLOT_ADDR 0x00010000u
 #define BOARD_SLOT_BYTES 4128768u
 #define BOARD_PAGE_BYTES 4096u
+/* the AN385's SSRAM2 and SSRAM3, 4 MiB at 0x20000000: where any application's stack may start */
+#define BOARD_RAM_ORIGIN 0x20000000u
+#define BOARD_RAM_END 0x20400000u
 
 #endif

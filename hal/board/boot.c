@@ -4,7 +4,8 @@
  * At reset it asks firmware/dfu's dfu_app_check whether the application slot
  * (board_layout.h) holds an application marked valid by a DFU download: the
  * 16-byte mark at the start of the slot's last page, whose length and CRC-32
- * must match the application bytes. If so, it points VTOR at the application's
+ * must match the application bytes; and boot_vectors.h whether its vector table
+ * can be started (stack in RAM, reset handler in the image). If so, it points VTOR at the application's
  * vector table, loads MSP from it and jumps to its reset handler. If not, it
  * says why on semihosting and exits with BOOT_EXIT_NO_APP: a real board would
  * stay in DFU mode and wait for a download over USB, which the emulated board
@@ -16,6 +17,7 @@
 #include <stdint.h>
 
 #include "board_layout.h"
+#include "boot_vectors.h"
 #include "crc32.h"
 #include "dfu/dfu_device.h"
 #include "format.h"
@@ -108,6 +110,13 @@ int main(void)
     dfu_app_info_t info;
     if (dfu_app_check(&flash, &info)) {
         const uint32_t *vectors = (const uint32_t *)(uintptr_t)BOARD_SLOT_ADDR;
+        const char *refusal = boot_vectors_refusal(vectors[0], vectors[1], BOARD_SLOT_ADDR, info.length);
+        if (refusal) {
+            log_printf("bootloader: the application (%u bytes, CRC-32 0x%08x) cannot be started: %s "
+                       "(stack 0x%08x, reset 0x%08x); staying in DFU mode\n",
+                       (unsigned)info.length, (unsigned)info.crc, refusal, (unsigned)vectors[0], (unsigned)vectors[1]);
+            return BOOT_EXIT_NO_APP;
+        }
         log_printf("bootloader: application valid (%u bytes, CRC-32 0x%08x); starting it at 0x%08x\n",
                    (unsigned)info.length, (unsigned)info.crc, (unsigned)vectors[1]);
         start_app(vectors);
