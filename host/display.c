@@ -40,7 +40,8 @@ static const char usage[] =
     "the CRC-32 the sender put in it; damaged frames are counted and dropped. Frames\n"
     "that arrive before any palette are not shown (counted; the palette is asked for).\n"
     "Exits 1 when the input ended or went quiet without a frame shown and it held no\n"
-    "frame-link message, bad messages, or frames without a palette.\n";
+    "frame-link message, bad messages, or frames without a palette; and when a --png\n"
+    "file cannot be written (DIR is checked before anything is received).\n";
 
 typedef struct {
     int fd;
@@ -55,6 +56,7 @@ typedef struct {
     int have_palette;
     uint8_t palette[HAL_PALETTE_BYTES];
     int quit;
+    int write_failed; /* a --png file could not be written: the run ends and fails */
     fl_decoder dec;
 } board;
 
@@ -86,18 +88,28 @@ static int palette_missing(board *b, const fl_event *ev)
     return 1;
 }
 
+/* The frame as DIR/frame_NNNNN.png; 0, or -1 after saying why. */
+static int write_png(const board *b, const fl_event *ev)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/frame_%05u.png", b->png_dir, (unsigned)ev->frame_no);
+    if (png_write_indexed(path, b->dec.frame, FL_W, FL_H, b->palette) == 0) return 0;
+    fprintf(stderr, "display: %s: cannot write: %s; stopping\n", path, strerror(errno));
+    return -1;
+}
+
 static void show_frame(board *b, const fl_event *ev)
 {
-    if (palette_missing(b, ev)) return;
+    if (b->write_failed || palette_missing(b, ev)) return;
+    /* a frame asked for as a file and lost is not shown: the run stops and fails */
+    if (b->png_dir && write_png(b, ev) != 0) {
+        b->write_failed = 1;
+        b->quit = 1;
+        return;
+    }
     b->shown++;
     b->frame_bytes += b->dec.count.bytes - b->bytes_at_last;
     b->bytes_at_last = b->dec.count.bytes;
-    if (b->png_dir) {
-        char path[4096];
-        snprintf(path, sizeof path, "%s/frame_%05u.png", b->png_dir, (unsigned)ev->frame_no);
-        if (png_write_indexed(path, b->dec.frame, FL_W, FL_H, b->palette) != 0)
-            fprintf(stderr, "display: %s: cannot write: %s\n", path, strerror(errno));
-    }
     if (b->window) {
         hal_set_palette(b->palette);
         uint8_t *page = hal_target_vram(0);
@@ -182,6 +194,7 @@ static int verdict(const board *b, const char *port)
     const char *name = strcmp(port, "-") ? port : "stdin";
     char nbytes[32];
     grouped(c->bytes, nbytes, sizeof nbytes);
+    if (b->write_failed) return 1; /* said when it happened */
     if (b->shown > 0) return 0;
     if (c->msgs_ok == 0) {
         fprintf(stderr, "display: %s: no frame-link message in %s bytes (%u bad messages)\n", name, nbytes,
@@ -197,6 +210,30 @@ static int verdict(const board *b, const char *port)
         fprintf(stderr, "display: %s: no frame shown: %u good and %u bad messages, %u frames dropped, in %s bytes\n",
                 name, c->msgs_ok, c->msgs_bad, c->frames_dropped, nbytes);
         return 1;
+    }
+    return 0;
+}
+
+/* --png DIR, made if missing: a folder this program can write into, found
+ * before the link opens, not after each frame has failed to be written. */
+static int png_dir_ready(const char *dir)
+{
+    struct stat st;
+    if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
+        fprintf(stderr, "display: --png %s: cannot create: %s\n", dir, strerror(errno));
+        return -1;
+    }
+    if (stat(dir, &st) != 0) { /* a dangling symbolic link, say */
+        fprintf(stderr, "display: --png %s: cannot use: %s\n", dir, strerror(errno));
+        return -1;
+    }
+    if (!S_ISDIR(st.st_mode)) {
+        fprintf(stderr, "display: --png %s: exists and is not a directory\n", dir);
+        return -1;
+    }
+    if (access(dir, W_OK | X_OK) != 0) {
+        fprintf(stderr, "display: --png %s: cannot write into it: %s\n", dir, strerror(errno));
+        return -1;
     }
     return 0;
 }
@@ -239,10 +276,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "display: no port given (see --help)\n");
         return 2;
     }
-    if (b.png_dir && mkdir(b.png_dir, 0777) != 0 && errno != EEXIST) {
-        fprintf(stderr, "display: %s: cannot create: %s\n", b.png_dir, strerror(errno));
-        return 1;
-    }
+    if (b.png_dir && png_dir_ready(b.png_dir) != 0) return 1;
     b.window = want_window || !b.png_dir;
     if (b.window && hal_sdl_init(HAL_SDL_DEFAULT_SCALE, "bspvga display board") != 0) {
         fprintf(stderr, "display: no window: %s%s\n", hal_sdl_error(),

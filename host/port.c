@@ -12,12 +12,31 @@
 #include <termios.h>
 #include <unistd.h>
 
+/* 1 if s is a TCP port number, 1..65535, in decimal digits and nothing else.
+ * getaddrinfo would take more: a service name, and a number past 65535 that
+ * it cuts to 16 bits (99999 became 34463), connecting somewhere not asked. */
+static int valid_port(const char *s)
+{
+    long v = 0;
+    if (!*s) return 0;
+    for (; *s; s++) {
+        if (*s < '0' || *s > '9') return 0;
+        v = v * 10 + (*s - '0');
+        if (v > 65535) return 0; /* also stops before a long string overflows v */
+    }
+    return v >= 1;
+}
+
 static int open_socket(const char *spec, char *err, size_t errlen)
 {
     char host[256];
     const char *colon = strrchr(spec, ':');
     if (!colon || colon == spec || (size_t)(colon - spec) >= sizeof host) {
         snprintf(err, errlen, "socket://%s: expected socket://HOST:PORT", spec);
+        return -1;
+    }
+    if (!valid_port(colon + 1)) {
+        snprintf(err, errlen, "socket://%s: invalid port '%s' (expected a number in 1..65535)", spec, colon + 1);
         return -1;
     }
     memcpy(host, spec, (size_t)(colon - spec));
@@ -57,6 +76,18 @@ static speed_t baud_code(long baud)
     }
 }
 
+/* A FIFO is one pipe, not a pair: opened both ways, this end reads back its
+ * own bytes (the sender its frames, the board its acks); opened one way, the
+ * end that must answer cannot. It is refused before anything goes through it
+ * (a receiver can still read one as stdin). Closes fd when open; returns -1. */
+static int fifo_refused(const char *port, int fd, char *err, size_t errlen)
+{
+    snprintf(err, errlen,
+             "%s: a FIFO (named pipe) cannot carry the link both ways: use a tty, a pty or socket://HOST:PORT", port);
+    if (fd >= 0) close(fd);
+    return -1;
+}
+
 int port_open(const char *port, long baud, int *writable, char *err, size_t errlen)
 {
     *writable = 0;
@@ -66,6 +97,8 @@ int port_open(const char *port, long baud, int *writable, char *err, size_t errl
         *writable = fd >= 0;
         return fd;
     }
+    struct stat st;
+    if (stat(port, &st) == 0 && S_ISFIFO(st.st_mode)) return fifo_refused(port, -1, err, errlen);
     int fd = open(port, O_RDWR | O_NOCTTY);
     if (fd < 0 && (errno == EACCES || errno == EROFS || errno == EISDIR))
         fd = open(port, O_RDONLY);
@@ -75,8 +108,10 @@ int port_open(const char *port, long baud, int *writable, char *err, size_t errl
         snprintf(err, errlen, "%s: cannot open: %s", port, strerror(errno));
         return -1;
     }
-    struct stat st;
-    if (fstat(fd, &st) == 0 && S_ISREG(st.st_mode)) *writable = 0; /* a captured stream */
+    if (fstat(fd, &st) == 0) {
+        if (S_ISFIFO(st.st_mode)) return fifo_refused(port, fd, err, errlen); /* one made since the stat */
+        if (S_ISREG(st.st_mode)) *writable = 0;                               /* a captured stream */
+    }
     if (isatty(fd)) {
         struct termios t;
         speed_t sp = baud_code(baud);

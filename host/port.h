@@ -9,9 +9,11 @@
 
 /* Open PORT for the frame link:
  *   /dev/ttyUSB0, /dev/pts/3   a serial device or pty, set raw at baud
- *   socket://HOST:PORT         a TCP connection (this end is the client)
+ *   socket://HOST:PORT         a TCP connection (this end is the client);
+ *                              PORT a decimal number in 1..65535, nothing else
  *   -                          stdin (fd 0), read only
- *   any other file             opened as it is (a captured stream: read only)
+ *   any other file             opened as it is (a captured stream: read only);
+ *                              a FIFO is refused (it would echo this end's bytes)
  * Returns the file descriptor, with *writable set when bytes can go out on it
  * (not on stdin, regular files, or files only readable); or -1 with a message
  * naming PORT in err. */

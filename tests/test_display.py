@@ -4,7 +4,9 @@ link at all. Streams come from build/fltool (a short flat walk of freedoom2.wad:
 at message delimiters."""
 import json
 import random
+import shutil
 import subprocess
+import time
 
 import pytest
 
@@ -108,3 +110,64 @@ def test_empty_stdin_fails(tmp_path):
     proc = subprocess.run([program("display"), "-", "--png", str(tmp_path / "png")], input=b"",
                           capture_output=True, timeout=60)
     assert proc.returncode == 1 and b"stdin: no frame-link message in 0 bytes" in proc.stderr
+
+
+# --png DIR: checked before anything is received, and a frame that cannot be written ends the run
+# with a failure (before: "cannot write" for every frame, then exit 0 and every frame counted shown).
+
+def test_png_at_a_regular_file_is_refused_up_front(stream, tmp_path):
+    segs, _ = stream
+    (tmp_path / "s.bin").write_bytes(joined(segs))
+    target = tmp_path / "taken"
+    target.write_bytes(b"not a folder")
+    proc = subprocess.run([program("display"), str(tmp_path / "s.bin"), "--png", str(target), "--json"],
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 1 and proc.stdout == ""
+    assert proc.stderr == f"display: --png {target}: exists and is not a directory\n"
+    assert target.read_bytes() == b"not a folder"
+
+
+def test_png_under_a_regular_file_is_refused_up_front(stream, tmp_path):
+    segs, _ = stream
+    (tmp_path / "s.bin").write_bytes(joined(segs))
+    (tmp_path / "taken").write_bytes(b"")
+    target = tmp_path / "taken" / "png"
+    proc = subprocess.run([program("display"), str(tmp_path / "s.bin"), "--png", str(target), "--json"],
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 1 and proc.stdout == ""
+    assert proc.stderr == f"display: --png {target}: cannot create: Not a directory\n"
+
+
+@pytest.mark.parametrize("exists", [False, True], ids=["made", "existing"])
+def test_png_folder_made_or_existing_gets_every_frame(stream, tmp_path, exists):
+    segs, _ = stream
+    (tmp_path / "s.bin").write_bytes(joined(segs))
+    if exists:
+        (tmp_path / "png").mkdir()
+    proc, c, pngs = display(tmp_path / "s.bin", tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert c["frames_shown"] == FRAMES and [p.name for p in pngs] == [f"frame_{n:05d}.png" for n in range(FRAMES)]
+
+
+def test_a_png_that_cannot_be_written_mid_run_stops_with_a_failure(stream, tmp_path):
+    """The folder goes away after the first frame is written: the second frame is the first one
+    lost, and the run stops there, says so once, counts one frame shown and exits 1."""
+    segs, _ = stream
+    png = tmp_path / "png"
+    proc = subprocess.Popen([program("display"), "-", "--png", str(png), "--json", "--idle-timeout", "20"],
+                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdin.write(joined(segs[:3]))  # hello, palette, frame 0
+    proc.stdin.flush()
+    first = png / "frame_00000.png"
+    deadline = time.monotonic() + 30
+    while not (first.exists() and first.stat().st_size > 0) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert first.exists(), "frame 0 was not written"
+    time.sleep(0.2)  # png_write_indexed has closed it
+    shutil.rmtree(png)
+    out, err = proc.communicate(joined(segs[3:]), timeout=60)  # a pipe it closed early is no error here
+    err = err.decode()
+    assert proc.returncode == 1, err
+    assert err.count("cannot write") == 1, err
+    assert f"display: {png}/frame_00001.png: cannot write: No such file or directory; stopping" in err
+    assert json.loads(out)["frames_shown"] == 1
