@@ -170,7 +170,7 @@ def test_a_slow_receiver_gets_fewer_frames_and_the_game_does_not_wait(tmp_path):
 
 def test_a_receiver_that_stops_acking_costs_frames_not_time(tmp_path):
     """Its first ack turns flow control on; then the window fills, frames are skipped until the ack
-    timeout (500 ms) gives the window up, and sending resumes."""
+    timeout (500 ms) gives the oldest frame in flight up, and one more frame goes each time."""
     frames = 36
     rx = Receiver(acks=1)
     proc, took = run_emu(DEFAULT, frames, rx.url, tmp_path / "emu")

@@ -308,7 +308,6 @@ uint32_t fl_copy_encode(fl_copy_model *m, const uint8_t *px, const uint8_t *base
         }
         uint32_t best_len = best.len, best_i = best.i;
         int32_t best_off = best.off;
-        uint32_t best_kind = best.kind == K_REP0 || best.kind == K_REP ? 1u : best.kind == K_NEAR ? 2u : 3u;
         if (best_len == 0) {
             enc_bit(&r, m->p + P_IS_COPY + state, 0);
             lit_encode(&r, m, px, pos);
@@ -317,7 +316,7 @@ uint32_t fl_copy_encode(fl_copy_model *m, const uint8_t *px, const uint8_t *base
             state = K_LIT;
             continue;
         }
-        uint32_t kind = best_kind == 1 ? (best_i == 0 ? K_REP0 : K_REP) : best_kind == 2 ? K_NEAR : K_NEW;
+        uint32_t kind = best.kind; /* K_REP0 .. K_NEW: consider() named it */
         enc_bit(&r, m->p + P_IS_COPY + state, 1);
         enc_bit(&r, m->p + P_IS_REP0 + state, kind == K_REP0);
         if (kind != K_REP0) {
